@@ -1,0 +1,40 @@
+# saloam_module(NAME DEPS ...): a static library saloam_<NAME> built from every
+# .cpp in the calling folder. Headers are included as "saloam/<NAME>/x.hpp".
+function(saloam_module name)
+  cmake_parse_arguments(ARG "" "" "DEPS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/*.cpp)
+  if(NOT sources)  # header-only (or not yet written) module
+    add_library(saloam_${name} INTERFACE)
+    target_include_directories(saloam_${name} INTERFACE ${PROJECT_SOURCE_DIR}/src)
+    target_link_libraries(saloam_${name} INTERFACE ${ARG_DEPS})
+    add_library(saloam::${name} ALIAS saloam_${name})
+    return()
+  endif()
+  add_library(saloam_${name} STATIC ${sources})
+  target_include_directories(saloam_${name} PUBLIC ${PROJECT_SOURCE_DIR}/src)
+  target_link_libraries(saloam_${name} PUBLIC ${ARG_DEPS})
+  saloam_warnings(saloam_${name})
+  add_library(saloam::${name} ALIAS saloam_${name})
+endfunction()
+
+function(saloam_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic)
+  if(SALOAM_NATIVE)
+    target_compile_options(${target} PRIVATE -march=native)
+  endif()
+endfunction()
+
+# saloam_test(MODULE LIBS ...): one GoogleTest executable per module from
+# tests/<MODULE>/*_test.cpp, registered with CTest test by test.
+function(saloam_test module)
+  cmake_parse_arguments(ARG "" "" "LIBS" ${ARGN})
+  file(GLOB sources CONFIGURE_DEPENDS ${CMAKE_CURRENT_SOURCE_DIR}/${module}/*_test.cpp)
+  if(NOT sources)
+    return()
+  endif()
+  set(target saloam_${module}_tests)
+  add_executable(${target} ${sources})
+  target_link_libraries(${target} PRIVATE ${ARG_LIBS} saloam_testing GTest::gtest GTest::gtest_main)
+  saloam_warnings(${target})
+  gtest_discover_tests(${target} DISCOVERY_TIMEOUT 60 PROPERTIES LABELS ${module})
+endfunction()

@@ -1,0 +1,149 @@
+#pragma once
+// The configuration of the whole system: plain structs with documented
+// defaults (the paper's Table I where it gives one), plus one generic field
+// visitor per struct so that YAML loading, saving and `--set key=value`
+// overrides share one list of names. To add a parameter: add the member with
+// its default and one line to the struct's `visit_fields`.
+//
+// Keys are "<section>.<field>", e.g. "odometry.alpha". Table I symbols are
+// named in each comment.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace saloam {
+
+/// Per-class values keyed by SemanticKITTI class name ("road", "pole", ...);
+/// the key "default" applies to classes not listed.
+using ClassValueMap = std::map<std::string, double>;
+
+/// Value of `map` for a raw class id, falling back to map["default"], then to `fallback`.
+double class_value(const ClassValueMap& map, std::uint16_t raw_id, double fallback);
+
+/// LOAM feature extraction (paper Sec. III-B, Eq. 1).
+struct FeatureConfig {
+  double alpha = 0.1;           ///< alpha: roughness threshold; c > alpha edge, c < alpha planar
+  int num_sectors = 6;          ///< N_r: sectors per ring
+  int edges_per_sector = 20;    ///< N_e: sharpest points kept as edges per sector
+  int planars_per_sector = 50;  ///< N_p: flattest points kept as planars per sector
+  int roughness_half_window = 5;  ///< neighbours on each side in Eq. 1 (LOAM uses 5)
+  double min_range = 2.5;       ///< [m] closer returns are ignored (vehicle body)
+  double max_range = 120.0;     ///< [m]
+  int num_beams = 0;            ///< 0 = detect 64/32/16 from the data
+  /// Seconds into the 0.1 s sweep that a scan's pose refers to: 0 for sweep
+  /// start (the simulator), 0.05 for real KITTI (pose when facing forward).
+  double pose_time_in_sweep = 0.0;
+  double sweep_duration = 0.1;  ///< [s] one LiDAR revolution
+};
+
+/// Scan-to-local-map registration (paper Sec. III-B, Eq. 2).
+struct OdometryConfig {
+  FeatureConfig features;
+  int local_map_frames = 20;     ///< N_m: frames kept in the local map
+  int edge_neighbours = 5;       ///< N_ne: map points fitted to a line per edge feature
+  int planar_neighbours = 5;     ///< N_np: map points fitted to a plane per planar feature
+  /// sigma: tolerance of the plane constraint. A plane of a ground class is
+  /// kept only if |n . z| >= 1 - sigma (normal near vertical), one of
+  /// building/fence only if |n . z| <= sigma (normal near horizontal).
+  double sigma = 0.05;
+  bool use_semantics = true;     ///< false: label-agnostic FLOAM-style baseline
+  bool deskew = true;            ///< undistort scans with the constant-velocity motion
+  int max_iterations = 10;       ///< Gauss-Newton iterations per outer loop
+  int outer_iterations = 3;      ///< re-association rounds
+  double robust_kernel_scale = 0.1;  ///< [m] Huber/Cauchy scale of the residuals
+  double max_correspondence_distance = 1.0;  ///< [m] farthest map neighbour accepted
+  double voxel_size = 0.4;       ///< [m] voxel size without semantics (and default class size)
+  /// Semantic downsampling: per-class voxel size [m]. Small objects keep their points.
+  ClassValueMap class_voxel_size{{"default", 0.4}, {"road", 0.8}, {"sidewalk", 0.8},
+                                 {"parking", 0.8}, {"terrain", 0.8}, {"building", 0.6},
+                                 {"vegetation", 0.8}, {"pole", 0.1}, {"trunk", 0.1},
+                                 {"traffic-sign", 0.1}, {"fence", 0.4}};
+  /// w^l of Eq. 2: per-class residual weights (equal by default).
+  ClassValueMap class_weight{{"default", 1.0}};
+  int threads = 1;               ///< worker threads for association (0 = all cores)
+};
+
+/// Loop closure (paper Sec. III-C).
+struct LoopClosureConfig {
+  double delta_min = 15.0;    ///< delta_min [m]: smallest candidate search radius
+  double delta_max = 100.0;   ///< delta_max [m]: largest search radius (radius grows with drift)
+  int num_candidates = 64;    ///< N_candi: candidates scored by SGPR per query
+  double zeta = 0.95;         ///< zeta: SGPR similarity threshold
+  int num_loop_frames = 5;    ///< N_loop: frames on each side forming a candidate submap
+  int delta_r = 100;          ///< delta_r: most recent frames excluded from the search
+  std::string sgpr_model;     ///< path of the .sgw weights; empty = <shared>/models/sgpr/sgpr_kitti.sgw
+};
+
+struct SaloamConfig {
+  OdometryConfig odometry;
+  LoopClosureConfig loop;
+};
+
+/// Calls v(name, member, description) for every scalar field.
+template <class Visitor>
+void visit_fields(FeatureConfig& c, Visitor&& v) {
+  v("alpha", c.alpha, "alpha: roughness threshold edge/planar");
+  v("num_sectors", c.num_sectors, "N_r: sectors per ring");
+  v("edges_per_sector", c.edges_per_sector, "N_e: edge features per sector");
+  v("planars_per_sector", c.planars_per_sector, "N_p: planar features per sector");
+  v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1");
+  v("min_range", c.min_range, "min range [m]");
+  v("max_range", c.max_range, "max range [m]");
+  v("num_beams", c.num_beams, "beams (0 = detect)");
+  v("pose_time_in_sweep", c.pose_time_in_sweep, "[s] instant of the sweep a pose refers to");
+  v("sweep_duration", c.sweep_duration, "[s] one revolution");
+}
+
+template <class Visitor>
+void visit_fields(OdometryConfig& c, Visitor&& v) {
+  v("local_map_frames", c.local_map_frames, "N_m: frames in the local map");
+  v("edge_neighbours", c.edge_neighbours, "N_ne: neighbours per edge feature");
+  v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature");
+  v("sigma", c.sigma, "sigma: plane constraint tolerance");
+  v("use_semantics", c.use_semantics, "semantic assistance on/off");
+  v("deskew", c.deskew, "constant-velocity de-skewing");
+  v("max_iterations", c.max_iterations, "Gauss-Newton iterations");
+  v("outer_iterations", c.outer_iterations, "re-association rounds");
+  v("robust_kernel_scale", c.robust_kernel_scale, "[m] robust kernel scale");
+  v("max_correspondence_distance", c.max_correspondence_distance, "[m] max neighbour distance");
+  v("voxel_size", c.voxel_size, "[m] voxel size (label-agnostic)");
+  v("class_voxel_size", c.class_voxel_size, "[m] per-class voxel size");
+  v("class_weight", c.class_weight, "w^l: per-class residual weight");
+  v("threads", c.threads, "threads (0 = all cores)");
+}
+
+template <class Visitor>
+void visit_fields(LoopClosureConfig& c, Visitor&& v) {
+  v("delta_min", c.delta_min, "delta_min [m]: min search radius");
+  v("delta_max", c.delta_max, "delta_max [m]: max search radius");
+  v("num_candidates", c.num_candidates, "N_candi: candidates per query");
+  v("zeta", c.zeta, "zeta: SGPR score threshold");
+  v("num_loop_frames", c.num_loop_frames, "N_loop: submap half-width [frames]");
+  v("delta_r", c.delta_r, "delta_r: recent frames excluded");
+  v("sgpr_model", c.sgpr_model, "SGPR weights (.sgw)");
+}
+
+/// Calls v(section, struct) for every section; nested sections use dots.
+template <class Visitor>
+void visit_sections(SaloamConfig& c, Visitor&& v) {
+  v("odometry", c.odometry);
+  v("odometry.features", c.odometry.features);
+  v("loop", c.loop);
+}
+
+/// Loads a YAML file over the defaults. Unknown keys and wrong types are
+/// errors naming the file and the key.
+SaloamConfig load_config(const std::filesystem::path& path);
+/// Applies YAML text over `config` (used by load_config; `origin` names the source in errors).
+void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin);
+/// Applies one "key=value" override, e.g. "odometry.alpha=0.2" or
+/// "odometry.class_weight.pole=2". A bare Table I name ("alpha") works when unique.
+void apply_config_override(SaloamConfig& config, std::string_view assignment);
+/// The full configuration as commented YAML (every key, its value and meaning).
+std::string config_to_yaml(const SaloamConfig& config);
+
+}  // namespace saloam

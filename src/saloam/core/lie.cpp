@@ -1,0 +1,121 @@
+#include "saloam/core/lie.hpp"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+
+namespace saloam {
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+Eigen::Matrix3d so3_exp(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  if (theta < 1e-10) {
+    return orthonormalize(Eigen::Matrix3d::Identity() + skew(phi));
+  }
+  return Eigen::AngleAxisd(theta, phi / theta).toRotationMatrix();
+}
+
+Eigen::Vector3d so3_log(const Eigen::Matrix3d& R) {
+  const Eigen::AngleAxisd aa(Eigen::Quaterniond(R).normalized());
+  double angle = aa.angle();
+  Eigen::Vector3d axis = aa.axis();
+  if (angle > M_PI) {  // Eigen may return angles in (pi, 2 pi)
+    angle = 2.0 * M_PI - angle;
+    axis = -axis;
+  }
+  return axis * angle;
+}
+
+namespace {
+// Left Jacobian of SO(3) and its inverse, used to couple rotation and translation.
+Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  const Eigen::Matrix3d K = skew(phi);
+  if (theta < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * K + K * K / 6.0;
+  const double t2 = theta * theta;
+  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * K +
+         (theta - std::sin(theta)) / (t2 * theta) * K * K;
+}
+
+Eigen::Matrix3d so3_left_jacobian_inverse(const Eigen::Vector3d& phi) {
+  const double theta = phi.norm();
+  const Eigen::Matrix3d K = skew(phi);
+  if (theta < 1e-6) return Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 12.0;
+  const double half = 0.5 * theta;
+  const double cot_half = std::cos(half) / std::sin(half);
+  return Eigen::Matrix3d::Identity() - 0.5 * K +
+         (1.0 - half * cot_half) / (theta * theta) * K * K;
+}
+}  // namespace
+
+Pose se3_exp(const Vector6d& xi) {
+  const Eigen::Vector3d rho = xi.head<3>();
+  const Eigen::Vector3d phi = xi.tail<3>();
+  Pose T = Pose::Identity();
+  T.linear() = so3_exp(phi);
+  T.translation() = so3_left_jacobian(phi) * rho;
+  return T;
+}
+
+Vector6d se3_log(const Pose& T) {
+  Vector6d xi;
+  const Eigen::Vector3d phi = so3_log(T.linear());
+  xi.head<3>() = so3_left_jacobian_inverse(phi) * T.translation();
+  xi.tail<3>() = phi;
+  return xi;
+}
+
+Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& R) {
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(R, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d U = svd.matrixU();
+  const Eigen::Matrix3d& V = svd.matrixV();
+  if ((U * V.transpose()).determinant() < 0.0) U.col(2) *= -1.0;
+  return U * V.transpose();
+}
+
+Pose orthonormalized(const Pose& T) {
+  Pose out = T;
+  out.linear() = orthonormalize(T.linear());
+  out.makeAffine();
+  return out;
+}
+
+Pose interpolate(const Pose& a, const Pose& b, double s) {
+  // Rotation by slerp, translation linearly: the motion model of a spinning
+  // LiDAR over one sweep, and what trajectory interpolation conventionally uses.
+  const Eigen::Quaterniond qa(a.linear());
+  const Eigen::Quaterniond qb(b.linear());
+  Pose out = Pose::Identity();
+  out.linear() = qa.slerp(s, qb).normalized().toRotationMatrix();
+  out.translation() = (1.0 - s) * a.translation() + s * b.translation();
+  return out;
+}
+
+double rotation_angle(const Pose& T) {
+  // Clamped acos of (trace - 1) / 2, as in the KITTI devkit.
+  const double c = std::clamp(0.5 * (T.linear().trace() - 1.0), -1.0, 1.0);
+  return std::acos(c);
+}
+
+Pose pose_from_3x4(const double* v) {
+  Pose T = Pose::Identity();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) T.linear()(r, c) = v[r * 4 + c];
+    T.translation()(r) = v[r * 4 + 3];
+  }
+  return T;
+}
+
+void pose_to_3x4(const Pose& T, double* v) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) v[r * 4 + c] = T.linear()(r, c);
+    v[r * 4 + 3] = T.translation()(r);
+  }
+}
+
+}  // namespace saloam

@@ -1,0 +1,106 @@
+#include "saloam/io/calibration.hpp"
+
+#include <array>
+#include <cmath>
+#include <optional>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+
+namespace saloam {
+namespace {
+
+std::optional<std::vector<double>> parse_values(const std::string& text) {
+  std::istringstream ss(text);
+  std::vector<double> v;
+  std::string token;
+  while (ss >> token) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(token, &used));
+      if (used != token.size() || !std::isfinite(v.back())) return std::nullopt;
+    } catch (const std::exception&) {
+      return std::nullopt;
+    }
+  }
+  return v;
+}
+
+}  // namespace
+
+Pose read_velo_to_cam(const std::filesystem::path& file, int sequence) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "calibration file not found");
+  std::ifstream in(file);
+  std::string line;
+  std::size_t line_no = 0;
+  std::optional<Pose> bare;  // a line with 12 numbers and no key
+  const std::string wanted = sequence >= 0 ? fmt::format("{:02d}", sequence) : std::string("Tr");
+  while (std::getline(in, line)) {
+    ++line_no;
+    const auto colon = line.find(':');
+    const std::string key = colon == std::string::npos ? "" : line.substr(0, colon);
+    const auto values = parse_values(colon == std::string::npos ? line : line.substr(colon + 1));
+    const bool relevant = key == wanted || (key.empty() && values && values->size() == 12);
+    if (!relevant) continue;
+    if (!values || values->size() != 12) {
+      throw InputError(file, fmt::format("line {}: '{}' needs 12 numbers (3x4 row-major)", line_no,
+                                         key.empty() ? "Tr" : key));
+    }
+    const Pose T = pose_from_3x4(values->data());
+    if (std::abs(T.linear().determinant() - 1.0) > 1e-2) {
+      throw InputError(file, fmt::format("line {}: rotation of '{}' is not orthonormal", line_no, key));
+    }
+    if (!key.empty()) return orthonormalized(T);
+    if (!bare) bare = orthonormalized(T);
+  }
+  if (bare) return *bare;
+  throw InputError(file, sequence >= 0 ? fmt::format("no line for sequence {}", wanted)
+                                       : std::string("no 'Tr:' line (velodyne to camera 0 transform)"));
+}
+
+void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::trunc);
+  if (!out) throw InputError(file, "cannot open for writing");
+  // KITTI odometry's rectified camera projections (sequences 00-02), so that
+  // tools expecting all five lines can read the file.
+  out << "P0: 7.188560000000e+02 0.000000000000e+00 6.071928000000e+02 0.000000000000e+00 0.000000000000e+00 "
+         "7.188560000000e+02 1.852157000000e+02 0.000000000000e+00 0.000000000000e+00 0.000000000000e+00 "
+         "1.000000000000e+00 0.000000000000e+00\n";
+  out << "P1: 7.188560000000e+02 0.000000000000e+00 6.071928000000e+02 -3.861448000000e+02 0.000000000000e+00 "
+         "7.188560000000e+02 1.852157000000e+02 0.000000000000e+00 0.000000000000e+00 0.000000000000e+00 "
+         "1.000000000000e+00 0.000000000000e+00\n";
+  out << "P2: 7.188560000000e+02 0.000000000000e+00 6.071928000000e+02 4.538225000000e+01 0.000000000000e+00 "
+         "7.188560000000e+02 1.852157000000e+02 -1.130887000000e-01 0.000000000000e+00 0.000000000000e+00 "
+         "1.000000000000e+00 3.779761000000e-03\n";
+  out << "P3: 7.188560000000e+02 0.000000000000e+00 6.071928000000e+02 -3.372877000000e+02 0.000000000000e+00 "
+         "7.188560000000e+02 1.852157000000e+02 2.369057000000e+00 0.000000000000e+00 0.000000000000e+00 "
+         "1.000000000000e+00 4.915215000000e-03\n";
+  std::array<double, 12> v{};
+  pose_to_3x4(velo_to_cam, v.data());
+  out << "Tr: " << fmt::format("{:.12e}", fmt::join(v, " ")) << '\n';
+  if (!out) throw InputError(file, "write failed");
+}
+
+std::vector<Pose> camera_to_lidar_poses(const std::vector<Pose>& camera_poses, const Pose& velo_to_cam) {
+  const Pose tr_inv = velo_to_cam.inverse();
+  std::vector<Pose> out;
+  out.reserve(camera_poses.size());
+  for (const auto& P : camera_poses) out.push_back(orthonormalized(tr_inv * P * velo_to_cam));
+  return out;
+}
+
+std::vector<Pose> lidar_to_camera_poses(const std::vector<Pose>& lidar_poses, const Pose& velo_to_cam) {
+  const Pose tr_inv = velo_to_cam.inverse();
+  std::vector<Pose> out;
+  out.reserve(lidar_poses.size());
+  for (const auto& Q : lidar_poses) out.push_back(orthonormalized(velo_to_cam * Q * tr_inv));
+  return out;
+}
+
+}  // namespace saloam

@@ -1,0 +1,126 @@
+#include "saloam/io/scan_io.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/semantic_classes.hpp"
+
+namespace saloam {
+namespace {
+
+std::vector<char> read_bytes(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "file not found");
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(file, "cannot open for reading");
+  const auto size = std::filesystem::file_size(file);
+  std::vector<char> bytes(size);
+  if (size > 0 && !in.read(bytes.data(), static_cast<std::streamsize>(size))) {
+    throw InputError(file, "read failed");
+  }
+  return bytes;
+}
+
+void write_bytes(const std::filesystem::path& file, const void* data, std::size_t size) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(file, "cannot open for writing");
+  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
+  if (!out) throw InputError(file, "write failed (disk full?)");
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> read_label_file(const std::filesystem::path& label_file) {
+  const auto bytes = read_bytes(label_file);
+  if (bytes.size() % sizeof(std::uint32_t) != 0) {
+    throw InputError(label_file, fmt::format("size {} bytes is not a multiple of 4 (truncated label file?)",
+                                             bytes.size()));
+  }
+  std::vector<std::uint32_t> labels(bytes.size() / sizeof(std::uint32_t));
+  std::memcpy(labels.data(), bytes.data(), bytes.size());
+  return labels;
+}
+
+LabelledCloud read_scan(const std::filesystem::path& bin_file,
+                        const std::optional<std::filesystem::path>& label_file, ScanReadStats* stats) {
+  constexpr std::size_t kPointBytes = 4 * sizeof(float);
+  const auto bytes = read_bytes(bin_file);
+  if (bytes.empty()) throw InputError(bin_file, "empty scan (0 bytes)");
+  if (bytes.size() % kPointBytes != 0) {
+    throw InputError(bin_file,
+                     fmt::format("size {} bytes is not a multiple of 16 (x, y, z, remission as float32): "
+                                 "truncated or not a KITTI .bin scan",
+                                 bytes.size()));
+  }
+  const std::size_t n = bytes.size() / kPointBytes;
+  std::vector<float> raw(n * 4);
+  std::memcpy(raw.data(), bytes.data(), bytes.size());
+
+  std::vector<std::uint32_t> labels;
+  if (label_file) {
+    labels = read_label_file(*label_file);
+    if (labels.size() != n) {
+      throw InputError(*label_file, fmt::format("{} labels for {} points in {}", labels.size(), n,
+                                                bin_file.filename().string()));
+    }
+  }
+
+  ScanReadStats local;
+  local.points_in_file = n;
+  LabelledCloud cloud;
+  cloud.has_labels = label_file.has_value();
+  cloud.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const float* p = &raw[4 * i];
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+      ++local.dropped_nonfinite;
+      continue;
+    }
+    const float remission = std::isfinite(p[3]) ? p[3] : 0.0f;
+    std::uint16_t cls = 0, inst = 0;
+    if (!labels.empty()) {
+      cls = static_cast<std::uint16_t>(labels[i] & 0xFFFFu);
+      inst = static_cast<std::uint16_t>(labels[i] >> 16);
+      if (!find_semantic_class(cls)) ++local.unknown_labels;
+    }
+    cloud.push_back({p[0], p[1], p[2]}, remission, cls, inst);
+  }
+  if (cloud.empty()) throw InputError(bin_file, fmt::format("no finite point among {} points", n));
+  if (local.dropped_nonfinite > 0) {
+    spdlog::warn("{}: dropped {} of {} points with NaN/Inf coordinates", bin_file.string(),
+                 local.dropped_nonfinite, n);
+  }
+  if (local.unknown_labels > 0) {
+    spdlog::warn("{}: {} points carry class ids unknown to SemanticKITTI", label_file->string(),
+                 local.unknown_labels);
+  }
+  if (stats) *stats = local;
+  return cloud;
+}
+
+void write_scan_bin(const std::filesystem::path& bin_file, const LabelledCloud& cloud) {
+  std::vector<float> raw(cloud.size() * 4);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    raw[4 * i + 0] = cloud.points[i].x();
+    raw[4 * i + 1] = cloud.points[i].y();
+    raw[4 * i + 2] = cloud.points[i].z();
+    raw[4 * i + 3] = cloud.remission[i];
+  }
+  write_bytes(bin_file, raw.data(), raw.size() * sizeof(float));
+}
+
+void write_scan_labels(const std::filesystem::path& label_file, const LabelledCloud& cloud) {
+  std::vector<std::uint32_t> raw(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    raw[i] = static_cast<std::uint32_t>(cloud.label[i]) | (static_cast<std::uint32_t>(cloud.instance[i]) << 16);
+  }
+  write_bytes(label_file, raw.data(), raw.size() * sizeof(std::uint32_t));
+}
+
+}  // namespace saloam

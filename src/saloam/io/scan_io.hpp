@@ -1,0 +1,36 @@
+#pragma once
+// Reading and writing single scans in the SemanticKITTI binary formats:
+// `.bin` = float32 x, y, z, remission per point; `.label` = uint32 per point,
+// low 16 bits class id, high 16 bits instance id.
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+struct ScanReadStats {
+  std::size_t points_in_file = 0;
+  std::size_t dropped_nonfinite = 0;  ///< points with NaN/Inf coordinates, dropped
+  std::size_t unknown_labels = 0;     ///< class ids outside the SemanticKITTI table (kept)
+};
+
+/// Reads a .bin scan and, if given, its .label file. Points with non-finite
+/// coordinates are dropped (counted in `stats`, warned once per file).
+/// Throws InputError for a missing, truncated or odd-sized file, a label
+/// count that differs from the point count, or an empty scan.
+LabelledCloud read_scan(const std::filesystem::path& bin_file,
+                        const std::optional<std::filesystem::path>& label_file = std::nullopt,
+                        ScanReadStats* stats = nullptr);
+
+/// Writes the points as a KITTI .bin file.
+void write_scan_bin(const std::filesystem::path& bin_file, const LabelledCloud& cloud);
+/// Writes the labels (class | instance << 16) as a .label file.
+void write_scan_labels(const std::filesystem::path& label_file, const LabelledCloud& cloud);
+
+/// Reads only a .label file: one uint32 per point.
+std::vector<std::uint32_t> read_label_file(const std::filesystem::path& label_file);
+
+}  // namespace saloam

@@ -1,0 +1,186 @@
+#include "saloam/io/trajectory_io.hpp"
+
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+
+namespace saloam {
+namespace {
+
+std::ifstream open_text(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "file not found");
+  std::ifstream in(file);
+  if (!in) throw InputError(file, "cannot open for reading");
+  return in;
+}
+
+std::ofstream create_text(const std::filesystem::path& file) {
+  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  std::ofstream out(file, std::ios::trunc);
+  if (!out) throw InputError(file, "cannot open for writing");
+  return out;
+}
+
+bool is_blank_or_comment(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t\r");
+  return first == std::string::npos || line[first] == '#';
+}
+
+/// Parses all numbers of a line; throws with the line number on junk or non-finite values.
+std::vector<double> parse_numbers(const std::string& line, const std::filesystem::path& file, std::size_t line_no) {
+  std::vector<double> values;
+  std::istringstream ss(line);
+  std::string token;
+  while (ss >> token) {
+    double v = 0.0;
+    std::size_t used = 0;
+    try {
+      v = std::stod(token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != token.size()) throw InputError(file, fmt::format("line {}: '{}' is not a number", line_no, token));
+    if (!std::isfinite(v)) throw InputError(file, fmt::format("line {}: non-finite value '{}'", line_no, token));
+    values.push_back(v);
+  }
+  return values;
+}
+
+template <class OnLine>
+void for_each_data_line(const std::filesystem::path& file, OnLine&& on_line) {
+  auto in = open_text(file);
+  std::string line;
+  std::size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (is_blank_or_comment(line)) continue;
+    on_line(parse_numbers(line, file, line_no), line_no);
+  }
+}
+
+Pose checked_pose(const std::vector<double>& v, const std::filesystem::path& file, std::size_t line_no) {
+  const Pose T = pose_from_3x4(v.data());
+  const double det = T.linear().determinant();
+  if (std::abs(det - 1.0) > 1e-2) {
+    throw InputError(file, fmt::format("line {}: rotation is not orthonormal (det = {:.4f})", line_no, det));
+  }
+  return orthonormalized(T);
+}
+
+Pose tum_pose(const std::vector<double>& v, const std::filesystem::path& file, std::size_t line_no) {
+  Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
+  if (std::abs(q.norm() - 1.0) > 1e-2) {
+    throw InputError(file, fmt::format("line {}: quaternion norm {:.4f} is not 1", line_no, q.norm()));
+  }
+  Pose T = Pose::Identity();
+  T.linear() = q.normalized().toRotationMatrix();
+  T.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
+  return T;
+}
+
+}  // namespace
+
+std::vector<Pose> read_kitti_poses(const std::filesystem::path& file) {
+  std::vector<Pose> poses;
+  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+    if (v.size() != 12) {
+      throw InputError(file, fmt::format("line {}: expected 12 numbers (KITTI 3x4 pose), found {}", line_no, v.size()));
+    }
+    poses.push_back(checked_pose(v, file, line_no));
+  });
+  if (poses.empty()) throw InputError(file, "no poses in file");
+  return poses;
+}
+
+std::string kitti_pose_line(const Pose& pose) {
+  std::array<double, 12> v{};
+  pose_to_3x4(pose, v.data());
+  return fmt::format("{:.9e}", fmt::join(v, " "));
+}
+
+void write_kitti_poses(const std::filesystem::path& file, const std::vector<Pose>& poses) {
+  auto out = create_text(file);
+  for (const auto& T : poses) out << kitti_pose_line(T) << '\n';
+  if (!out) throw InputError(file, "write failed");
+}
+
+Trajectory read_tum_trajectory(const std::filesystem::path& file) {
+  Trajectory traj;
+  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+    if (v.size() != 8) {
+      throw InputError(file, fmt::format("line {}: expected 8 numbers (TUM: t x y z qx qy qz qw), found {}", line_no,
+                                         v.size()));
+    }
+    traj.timestamps.push_back(v[0]);
+    traj.poses.push_back(tum_pose(v, file, line_no));
+  });
+  if (traj.empty()) throw InputError(file, "no poses in file");
+  return traj;
+}
+
+std::string tum_pose_line(double timestamp, const Pose& pose) {
+  const Eigen::Quaterniond q(pose.linear());
+  const Eigen::Vector3d t = pose.translation();
+  return fmt::format("{:.6f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}", timestamp, t.x(), t.y(), t.z(),
+                     q.x(), q.y(), q.z(), q.w());
+}
+
+void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& trajectory) {
+  if (trajectory.timestamps.size() != trajectory.poses.size()) {
+    throw InputError(file, "trajectory has different numbers of timestamps and poses");
+  }
+  auto out = create_text(file);
+  out << "# timestamp x y z qx qy qz qw\n";
+  for (std::size_t i = 0; i < trajectory.size(); ++i) out << tum_pose_line(trajectory.timestamps[i], trajectory.poses[i]) << '\n';
+  if (!out) throw InputError(file, "write failed");
+}
+
+Trajectory read_trajectory(const std::filesystem::path& file) {
+  Trajectory traj;
+  std::size_t columns = 0;
+  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+    if (columns == 0) {
+      columns = v.size();
+      if (columns != 12 && columns != 8) {
+        throw InputError(file, fmt::format("line {}: {} numbers: neither KITTI (12) nor TUM (8)", line_no, columns));
+      }
+    }
+    if (v.size() != columns) {
+      throw InputError(file, fmt::format("line {}: expected {} numbers like the first line, found {}", line_no,
+                                         columns, v.size()));
+    }
+    if (columns == 12) {
+      traj.timestamps.push_back(0.1 * static_cast<double>(traj.poses.size()));
+      traj.poses.push_back(checked_pose(v, file, line_no));
+    } else {
+      traj.timestamps.push_back(v[0]);
+      traj.poses.push_back(tum_pose(v, file, line_no));
+    }
+  });
+  if (traj.empty()) throw InputError(file, "no poses in file");
+  return traj;
+}
+
+std::vector<double> read_times(const std::filesystem::path& file) {
+  std::vector<double> times;
+  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+    if (v.size() != 1) throw InputError(file, fmt::format("line {}: expected one timestamp, found {} numbers", line_no, v.size()));
+    times.push_back(v[0]);
+  });
+  return times;
+}
+
+void write_times(const std::filesystem::path& file, const std::vector<double>& times) {
+  auto out = create_text(file);
+  for (double t : times) out << fmt::format("{:.6e}", t) << '\n';
+  if (!out) throw InputError(file, "write failed");
+}
+
+}  // namespace saloam

@@ -1,0 +1,32 @@
+#pragma once
+// Trajectory files: KITTI (12 numbers per line, row-major 3x4 [R|t]) and TUM
+// (timestamp x y z qx qy qz qw). Bad lines are errors with their line number.
+
+#include <filesystem>
+#include <vector>
+
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+/// Reads a KITTI pose file. Rotations are re-orthonormalized on load.
+std::vector<Pose> read_kitti_poses(const std::filesystem::path& file);
+void write_kitti_poses(const std::filesystem::path& file, const std::vector<Pose>& poses);
+/// One KITTI line (no newline) for streaming writers.
+std::string kitti_pose_line(const Pose& pose);
+
+/// Reads a TUM trajectory (lines starting with '#' are comments).
+Trajectory read_tum_trajectory(const std::filesystem::path& file);
+void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& trajectory);
+/// One TUM line (no newline) for streaming writers.
+std::string tum_pose_line(double timestamp, const Pose& pose);
+
+/// Reads a KITTI or TUM trajectory, deciding by the number of columns
+/// (12 = KITTI, 8 = TUM). KITTI timestamps are the frame indices * 0.1 s.
+Trajectory read_trajectory(const std::filesystem::path& file);
+
+/// Reads a times.txt file (one timestamp in seconds per line).
+std::vector<double> read_times(const std::filesystem::path& file);
+void write_times(const std::filesystem::path& file, const std::vector<double>& times);
+
+}  // namespace saloam

@@ -1,0 +1,35 @@
+#pragma once
+// Helpers for the test suites.
+
+#include <filesystem>
+#include <string>
+
+namespace saloam::testing {
+
+/// ../shared (development data). Tests that need it call require_shared_data().
+std::filesystem::path shared_dir();
+/// Path of a file under shared/; fails the test (not skips) when missing,
+/// since CI always has shared/.
+std::filesystem::path shared_file(const std::string& relative);
+
+/// A fresh temporary folder, removed with the object.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& prefix = "saloam_test");
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  [[nodiscard]] std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// Path of the built `saloam` program (for end-to-end tests).
+std::filesystem::path cli_path();
+
+/// Runs a shell command, returns its exit status; stdout+stderr go to `output`.
+int run_command(const std::string& command, std::string* output = nullptr);
+
+}  // namespace saloam::testing
