@@ -36,6 +36,8 @@ TempDir::~TempDir() {
   std::filesystem::remove_all(path_, ec);
 }
 
+std::filesystem::path source_dir() { return SALOAM_TEST_SOURCE_DIR; }
+
 std::filesystem::path cli_path() { return SALOAM_CLI_PATH; }
 
 int run_command(const std::string& command, std::string* output) {

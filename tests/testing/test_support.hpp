@@ -26,6 +26,9 @@ class TempDir {
   std::filesystem::path path_;
 };
 
+/// The repository root.
+std::filesystem::path source_dir();
+
 /// Path of the built `saloam` program (for end-to-end tests).
 std::filesystem::path cli_path();
 

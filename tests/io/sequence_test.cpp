@@ -1,0 +1,127 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/io/calibration.hpp"
+#include "saloam/io/ply.hpp"
+#include "saloam/io/sequence.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+LabelledCloud small_cloud(std::uint16_t cls, std::size_t n = 5) {
+  LabelledCloud c;
+  c.has_labels = true;
+  for (std::size_t i = 0; i < n; ++i) c.push_back({1.0f + i, 2.0f, -1.7f}, 0.3f, cls, 1);
+  return c;
+}
+
+/// A three-scan sequence with labels, poses, calib and times.
+void write_sequence(const std::filesystem::path& root) {
+  SequenceWriter w(root);
+  for (std::size_t i = 0; i < 3; ++i) w.write_scan(i, small_cloud(40));
+  std::vector<Pose> poses(3, Pose::Identity());
+  poses[1].translation() = Eigen::Vector3d(0, 0, 1);
+  poses[2].translation() = Eigen::Vector3d(0, 0, 2);
+  w.write_camera_poses(poses);
+  w.write_calib(read_velo_to_cam(testing::shared_file("data/kitti/calib_velo_to_cam.txt"), 0));
+  w.write_times({0.0, 0.1, 0.2});
+}
+
+template <class F>
+std::string input_error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
+
+TEST(Sequence, WriteThenRead) {
+  testing::TempDir dir;
+  write_sequence(dir.path());
+  EXPECT_TRUE(std::filesystem::exists(dir / "velodyne/000002.bin"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "labels/000002.label"));
+  const SequenceReader seq(dir.path());
+  ASSERT_EQ(seq.size(), 3u);
+  EXPECT_TRUE(seq.has_labels());
+  EXPECT_TRUE(seq.has_poses());
+  EXPECT_TRUE(seq.has_calib());
+  EXPECT_DOUBLE_EQ(seq.times()[2], 0.2);
+  const auto scan = seq.load_scan(1);
+  EXPECT_EQ(scan.size(), 5u);
+  EXPECT_EQ(scan.label[0], 40);
+  // Camera z (forward) is LiDAR x (forward).
+  EXPECT_NEAR(seq.lidar_poses()[2].translation().x(), 2.0, 0.05);
+  EXPECT_EQ(frame_name(42), "000042");
+}
+
+TEST(Sequence, PredictionsFolderReplacesLabels) {
+  testing::TempDir dir;
+  write_sequence(dir.path());
+  for (std::size_t i = 0; i < 3; ++i) write_scan_labels(dir / "pred" / (frame_name(i) + ".label"), small_cloud(70));
+  const SequenceReader seq(dir.path(), SequenceOptions{dir / "pred", false});
+  EXPECT_EQ(seq.load_scan(0).label[0], 70);
+  const SequenceReader plain(dir.path(), SequenceOptions{std::nullopt, true});
+  EXPECT_FALSE(plain.has_labels());
+  EXPECT_EQ(plain.load_scan(0).label[0], 0);
+}
+
+TEST(Sequence, MissingPiecesGiveClearErrors) {
+  testing::TempDir dir;
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir / "nope"); }).find("sequence folder not found"),
+            std::string::npos);
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("missing velodyne/"), std::string::npos);
+  std::filesystem::create_directories(dir / "velodyne");
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("no .bin scans"), std::string::npos);
+
+  write_sequence(dir.path());
+  std::filesystem::remove(dir / "labels/000001.label");
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("first missing: 000001.label"),
+            std::string::npos);
+  std::filesystem::remove_all(dir / "labels");
+
+  std::filesystem::remove(dir / "calib.txt");
+  const SequenceReader seq(dir.path());
+  EXPECT_FALSE(seq.has_labels());
+  EXPECT_NE(input_error_of([&] { (void)seq.lidar_poses(); }).find("missing calib.txt"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path(), SequenceOptions{dir / "preds", false}); })
+                .find("labels folder not found"),
+            std::string::npos);
+
+  std::ofstream(dir / "times.txt") << "0\n0.1\n";
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("2 timestamps for 3 scans"), std::string::npos);
+  std::ofstream(dir / "times.txt") << "0\n0.1\n0.2\n";
+  std::ofstream(dir / "poses.txt") << "1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0 0 1 0 0 0 0 1\n";
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("poses.txt: line 2"), std::string::npos);
+}
+
+TEST(Ply, BinaryRoundTripWithColoursAndTransform) {
+  testing::TempDir dir;
+  auto cloud = small_cloud(50, 100);
+  cloud.instance[7] = 321;
+  Pose shift = Pose::Identity();
+  shift.translation() = Eigen::Vector3d(10, 0, 0);
+  write_ply(dir / "c.ply", cloud, shift);
+  std::ifstream in(dir / "c.ply", std::ios::binary);
+  std::string header((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_EQ(header.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  EXPECT_NE(header.find("element vertex 100\n"), std::string::npos);
+  EXPECT_NE(header.find("property uchar red\n"), std::string::npos);
+  const auto back = read_ply(dir / "c.ply");
+  ASSERT_EQ(back.size(), 100u);
+  EXPECT_NEAR(back.points[3].x(), cloud.points[3].x() + 10.0f, 1e-5);
+  EXPECT_EQ(back.label[3], 50);
+  EXPECT_EQ(back.instance[7], 321);
+  EXPECT_FLOAT_EQ(back.remission[3], 0.3f);
+  // Size: header + 23 bytes per vertex.
+  const auto body = std::filesystem::file_size(dir / "c.ply") - (header.find("end_header\n") + 11);
+  EXPECT_EQ(body, 100u * 23u);
+}
+
+}  // namespace
+}  // namespace saloam
