@@ -293,6 +293,30 @@ void RasterImage::set(int x, int y, Rgb c) {
   pixels_[static_cast<std::size_t>(y) * width_ + x] = c;
 }
 
+void RasterImage::draw_disc(int cx, int cy, int radius, Rgb c) {
+  for (int dy = -radius; dy <= radius; ++dy) {
+    for (int dx = -radius; dx <= radius; ++dx) {
+      if (dx * dx + dy * dy <= radius * radius) set(cx + dx, cy + dy, c);
+    }
+  }
+}
+
+void RasterImage::draw_line(int x0, int y0, int x1, int y1, Rgb c, int thickness) {
+  // Sample the segment at sub-pixel steps; each sample stamps a disc.
+  const int steps = std::max({std::abs(x1 - x0), std::abs(y1 - y0), 1});
+  const int radius = std::max(thickness / 2, 0);
+  for (int i = 0; i <= steps; ++i) {
+    const double t = static_cast<double>(i) / steps;
+    const int x = static_cast<int>(std::lround(x0 + t * (x1 - x0)));
+    const int y = static_cast<int>(std::lround(y0 + t * (y1 - y0)));
+    if (radius == 0) {
+      set(x, y, c);
+    } else {
+      draw_disc(x, y, radius, c);
+    }
+  }
+}
+
 Rgb RasterImage::get(int x, int y) const { return pixels_.at(static_cast<std::size_t>(y) * width_ + x); }
 
 void RasterImage::save_png(const std::filesystem::path& file, int scale_x, int scale_y) const {

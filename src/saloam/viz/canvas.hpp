@@ -39,6 +39,15 @@ class Plot {
   /// Range fitted to the given points with a 5 % margin.
   void fit_range(const std::vector<Eigen::Vector2d>& points, bool equal_aspect);
 
+  /// Pixel margins around the plot area (defaults 80, 30, 40, 60). Widen the
+  /// right one (about 90) before a colorbar. Call before set_range/fit_range.
+  void set_margins(int left, int right, int top, int bottom) {
+    left_ = left;
+    right_ = right;
+    top_ = top;
+    bottom_ = bottom;
+  }
+
   void set_title(const std::string& title) { title_ = title; }
   void set_labels(const std::string& x_label, const std::string& y_label) {
     x_label_ = x_label;
@@ -77,6 +86,10 @@ class RasterImage {
   [[nodiscard]] int height() const { return height_; }
   void set(int x, int y, Rgb c);
   [[nodiscard]] Rgb get(int x, int y) const;
+  /// A straight line of the given thickness [px] (clipped to the image).
+  void draw_line(int x0, int y0, int x1, int y1, Rgb c, int thickness = 1);
+  /// A filled disc (clipped to the image).
+  void draw_disc(int cx, int cy, int radius, Rgb c);
   /// Writes the PNG, optionally scaled by an integer factor (nearest neighbour).
   void save_png(const std::filesystem::path& file, int scale_x = 1, int scale_y = 1) const;
 

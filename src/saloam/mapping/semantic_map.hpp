@@ -1,0 +1,60 @@
+#pragma once
+// A global semantic map: labelled scans accumulated in a voxel hash, one
+// point per voxel (the centroid of its points) with the majority class.
+// Dynamic classes (moving-*, person, ...) are left out so that the map holds
+// the static world. Used for the map output of a run and for its pictures.
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+struct SemanticMapOptions {
+  double voxel_size = 0.2;      ///< [m] map resolution
+  double max_range = 60.0;      ///< [m] farther returns are noisy and sparse: skipped
+  bool skip_dynamic = true;     ///< leave out moving objects and people
+  bool skip_unlabeled = false;  ///< leave out class 0 (unlabeled) points
+};
+
+class SemanticMap {
+ public:
+  explicit SemanticMap(SemanticMapOptions options = {});
+
+  /// Adds a scan given in its sensor frame, with T_world<-sensor.
+  void insert(const LabelledCloud& scan, const Pose& world_from_sensor);
+
+  /// One point per voxel: centroid, majority class, mean remission, the
+  /// instance id most seen with that class. `has_labels` is true when any
+  /// inserted scan had labels.
+  [[nodiscard]] LabelledCloud to_cloud() const;
+  [[nodiscard]] std::size_t num_voxels() const { return voxels_.size(); }
+  [[nodiscard]] const SemanticMapOptions& options() const { return options_; }
+
+ private:
+  struct Voxel {
+    Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+    float remission_sum = 0.0f;
+    std::uint32_t count = 0;
+    // Small class histogram: the few classes seen in one voxel.
+    std::uint16_t labels[4] = {0, 0, 0, 0};
+    std::uint16_t instances[4] = {0, 0, 0, 0};
+    std::uint32_t votes[4] = {0, 0, 0, 0};
+  };
+  struct KeyHash {
+    std::size_t operator()(const Eigen::Vector3i& k) const {
+      return (static_cast<std::size_t>(k.x()) * 73856093u) ^ (static_cast<std::size_t>(k.y()) * 19349669u) ^
+             (static_cast<std::size_t>(k.z()) * 83492791u);
+    }
+  };
+
+  SemanticMapOptions options_;
+  bool has_labels_ = false;
+  std::unordered_map<Eigen::Vector3i, Voxel, KeyHash> voxels_;
+};
+
+}  // namespace saloam

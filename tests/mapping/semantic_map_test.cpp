@@ -1,0 +1,82 @@
+#include <gtest/gtest.h>
+
+#include "saloam/core/lie.hpp"
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/mapping/map_render.hpp"
+#include "saloam/mapping/semantic_map.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+/// A 10 x 10 m floor (road) with a 2 m wall (building) at x = 5, as seen from the origin.
+LabelledCloud scene() {
+  LabelledCloud c;
+  c.has_labels = true;
+  for (int i = 0; i < 100; ++i) {
+    for (int j = 0; j < 100; ++j) {
+      c.push_back({-5.0f + 0.1f * i, -5.0f + 0.1f * j, -1.7f}, 0.2f, cls::kRoad, 0);
+    }
+  }
+  for (int j = 0; j < 100; ++j) {
+    for (int k = 0; k < 20; ++k) c.push_back({5.0f, -5.0f + 0.1f * j, -1.7f + 0.1f * k}, 0.5f, cls::kBuilding, 0);
+  }
+  c.push_back({1.0f, 1.0f, -1.0f}, 0.1f, cls::kMovingCar, 3);
+  return c;
+}
+
+TEST(SemanticMap, SamePlaceTwiceFillsTheSameVoxels) {
+  SemanticMap map({0.5, 60.0, true, false});
+  const auto s = scene();
+  map.insert(s, Pose::Identity());
+  const std::size_t once = map.num_voxels();
+  // The same world seen from a pose 1 m further: points given in that sensor frame.
+  Pose shift = Pose::Identity();
+  shift.translation() = Eigen::Vector3d(1.0, 0.0, 0.0);
+  LabelledCloud moved = s;
+  for (auto& p : moved.points) p = (shift.inverse().cast<float>() * p);
+  map.insert(moved, shift);
+  EXPECT_EQ(map.num_voxels(), once);
+  const auto cloud = map.to_cloud();
+  EXPECT_EQ(cloud.size(), once);
+  EXPECT_TRUE(cloud.has_labels);
+  std::size_t road = 0, building = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    EXPECT_FALSE(is_dynamic(cloud.label[i]));  // the moving car is left out
+    road += cloud.label[i] == cls::kRoad;
+    building += cloud.label[i] == cls::kBuilding;
+    if (cloud.label[i] == cls::kBuilding) {
+      EXPECT_NEAR(cloud.points[i].x(), 5.0f, 1e-4);
+    }
+  }
+  EXPECT_EQ(road, 20u * 20u);  // 10 m / 0.5 m squared
+  EXPECT_GT(building, 0u);
+}
+
+TEST(SemanticMap, MajorityVoteAndRangeLimit) {
+  SemanticMap map({1.0, 10.0, true, false});
+  LabelledCloud c;
+  c.has_labels = true;
+  for (int i = 0; i < 3; ++i) c.push_back({0.5f, 0.5f, 0.5f}, 0.0f, cls::kVegetation, 0);
+  c.push_back({0.4f, 0.4f, 0.4f}, 0.0f, cls::kTrunk, 0);
+  c.push_back({50.0f, 0.0f, 0.0f}, 0.0f, cls::kBuilding, 0);  // beyond max_range
+  map.insert(c, Pose::Identity());
+  const auto cloud = map.to_cloud();
+  ASSERT_EQ(cloud.size(), 1u);
+  EXPECT_EQ(cloud.label[0], cls::kVegetation);
+  EXPECT_NEAR(cloud.points[0].x(), 0.475f, 1e-5);
+}
+
+TEST(MapRender, WritesAPicture) {
+  testing::TempDir dir;
+  SemanticMap map;
+  map.insert(scene(), Pose::Identity());
+  std::vector<Pose> trajectory(3, Pose::Identity());
+  trajectory[1].translation().x() = 1.0;
+  trajectory[2].translation().x() = 2.0;
+  render_top_down(dir / "map.png", map.to_cloud(), trajectory, {0.1, 2000, true});
+  EXPECT_GT(std::filesystem::file_size(dir / "map.png"), 500u);
+}
+
+}  // namespace
+}  // namespace saloam
