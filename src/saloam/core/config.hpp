@@ -38,6 +38,11 @@ struct FeatureConfig {
   /// start (the simulator), 0.05 for real KITTI (pose when facing forward).
   double pose_time_in_sweep = 0.0;
   double sweep_duration = 0.1;  ///< [s] one LiDAR revolution
+  /// Azimuth [deg] where a sweep starts (atan2(y, x) in the LiDAR frame);
+  /// 180 = behind the car, as KITTI's HDL-64E and the simulator.
+  double sweep_start_azimuth_deg = 180.0;
+  /// Rotation sense seen from above: true = clockwise (decreasing azimuth, Velodyne).
+  bool sweep_clockwise = true;
 };
 
 /// Scan-to-local-map registration (paper Sec. III-B, Eq. 2).
@@ -96,6 +101,8 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
   v("num_beams", c.num_beams, "beams (0 = detect)");
   v("pose_time_in_sweep", c.pose_time_in_sweep, "[s] instant of the sweep a pose refers to");
   v("sweep_duration", c.sweep_duration, "[s] one revolution");
+  v("sweep_start_azimuth_deg", c.sweep_start_azimuth_deg, "[deg] azimuth where a sweep starts");
+  v("sweep_clockwise", c.sweep_clockwise, "sweep turns clockwise seen from above");
 }
 
 template <class Visitor>

@@ -1,0 +1,249 @@
+#include "saloam/odometry/features.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include "saloam/core/semantic_classes.hpp"
+
+namespace saloam {
+
+int ring_count(BeamLayout layout) {
+  switch (layout) {
+    case BeamLayout::kHdl64: return 64;
+    case BeamLayout::kHdl32: return 32;
+    case BeamLayout::kVlp16: return 16;
+  }
+  return 64;
+}
+
+BeamLayout detect_beam_layout(const std::vector<Eigen::Vector3f>& points, int num_beams) {
+  if (num_beams == 64) return BeamLayout::kHdl64;
+  if (num_beams == 32) return BeamLayout::kHdl32;
+  if (num_beams == 16) return BeamLayout::kVlp16;
+  // Elevation range: HDL-64E +2..-24.9, HDL-32E +10.7..-30.7, VLP-16 +15..-15.
+  // Robust percentiles instead of extremes (noise, reflections).
+  std::vector<float> elevation;
+  elevation.reserve(points.size() / 8 + 1);
+  for (std::size_t i = 0; i < points.size(); i += 8) {
+    const auto& p = points[i];
+    elevation.push_back(std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0f / static_cast<float>(M_PI));
+  }
+  if (elevation.empty()) return BeamLayout::kHdl64;
+  std::sort(elevation.begin(), elevation.end());
+  const float low = elevation[elevation.size() / 200];
+  const float high = elevation[elevation.size() - 1 - elevation.size() / 200];
+  if (high > 12.0f && low > -17.0f) return BeamLayout::kVlp16;
+  if (low < -27.0f || high > 6.0f) return BeamLayout::kHdl32;
+  return BeamLayout::kHdl64;
+}
+
+int ring_from_elevation(double elevation_deg, BeamLayout layout) {
+  switch (layout) {
+    case BeamLayout::kHdl64: {
+      constexpr double kUpperTop = 2.0, kUpperBottom = -8.33, kLowerTop = -8.83, kLowerBottom = -24.9;
+      constexpr double kUpperStep = (kUpperTop - kUpperBottom) / 31.0;
+      constexpr double kLowerStep = (kLowerTop - kLowerBottom) / 31.0;
+      if (elevation_deg > kUpperTop + kUpperStep || elevation_deg < kLowerBottom - kLowerStep) return -1;
+      if (elevation_deg >= 0.5 * (kUpperBottom + kLowerTop)) {
+        const int ring = static_cast<int>(std::lround((kUpperTop - elevation_deg) / kUpperStep));
+        return std::clamp(ring, 0, 31);
+      }
+      const int ring = 32 + static_cast<int>(std::lround((kLowerTop - elevation_deg) / kLowerStep));
+      return std::clamp(ring, 32, 63);
+    }
+    case BeamLayout::kHdl32: {
+      constexpr double kTop = 10.67, kStep = 4.0 / 3.0;
+      const int ring = static_cast<int>(std::lround((kTop - elevation_deg) / kStep));
+      return (ring < -1 || ring > 32) ? -1 : std::clamp(ring, 0, 31);
+    }
+    case BeamLayout::kVlp16: {
+      constexpr double kTop = 15.0, kStep = 2.0;
+      const int ring = static_cast<int>(std::lround((kTop - elevation_deg) / kStep));
+      return (ring < -1 || ring > 16) ? -1 : std::clamp(ring, 0, 15);
+    }
+  }
+  return -1;
+}
+
+double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config) {
+  const double start = config.sweep_start_azimuth_deg * M_PI / 180.0;
+  double turned = config.sweep_clockwise ? start - azimuth_rad : azimuth_rad - start;
+  turned = std::fmod(turned, 2.0 * M_PI);
+  if (turned < 0.0) turned += 2.0 * M_PI;
+  return turned / (2.0 * M_PI) * config.sweep_duration;
+}
+
+std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int half_window) {
+  const int n = static_cast<int>(ring.size());
+  std::vector<double> c(ring.size(), std::numeric_limits<double>::infinity());
+  if (n < 2 * half_window + 1) return c;
+  // Running sum over the window: sum_{j in S} X_j = window_sum - X_i.
+  Eigen::Vector3d window = Eigen::Vector3d::Zero();
+  for (int j = 0; j < 2 * half_window + 1; ++j) window += ring[j];
+  for (int i = half_window; i < n - half_window; ++i) {
+    if (i > half_window) window += ring[i + half_window] - ring[i - half_window - 1];
+    const Eigen::Vector3d diff = window - static_cast<double>(2 * half_window + 1) * ring[i];
+    c[i] = diff.squaredNorm();
+  }
+  return c;
+}
+
+std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window,
+                                    double min_range, double max_range) {
+  const int n = static_cast<int>(ring.size());
+  std::vector<bool> bad(ring.size(), false);
+  std::vector<double> range(ring.size());
+  for (int i = 0; i < n; ++i) {
+    range[i] = ring[i].norm();
+    if (range[i] < min_range || range[i] > max_range) bad[i] = true;
+  }
+  for (int i = 0; i + 1 < n; ++i) {
+    const double gap = (ring[i + 1] - ring[i]).norm();
+    // Neighbouring returns far apart relative to their range: either a depth
+    // jump (occlusion) or a hole in azimuth. Angular step of the HDL-64E is
+    // ~0.17 deg (3e-3 rad); 0.3 m at 10 m is ~10 steps.
+    if (gap > 0.03 * std::max(range[i], 1.0) + 0.1) {
+      const double near = std::min(range[i], range[i + 1]);
+      const bool depth_jump = std::abs(range[i] - range[i + 1]) > 0.1 * near + 0.1;
+      if (depth_jump) {
+        // Occluded side: the farther points next to the jump lie on a surface
+        // that continues behind the nearer object; their "edge" is an artefact.
+        if (range[i] > range[i + 1]) {
+          for (int k = std::max(0, i - half_window + 1); k <= i; ++k) bad[k] = true;
+        } else {
+          for (int k = i + 1; k <= std::min(n - 1, i + half_window); ++k) bad[k] = true;
+        }
+      } else {
+        // A hole in azimuth (no return): windows across it are not local.
+        for (int k = std::max(0, i - half_window + 1); k <= std::min(n - 1, i + half_window); ++k) {
+          bad[k] = true;
+        }
+      }
+    }
+  }
+  // Beams nearly parallel to the surface: both neighbour gaps large relative
+  // to the range (LOAM's 0.0002 * range^2 on the squared gap).
+  for (int i = 1; i + 1 < n; ++i) {
+    const double limit = 0.0002 * range[i] * range[i];
+    if ((ring[i] - ring[i - 1]).squaredNorm() > limit && (ring[i + 1] - ring[i]).squaredNorm() > limit) {
+      bad[i] = true;
+    }
+  }
+  return bad;
+}
+
+RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
+                                   const std::vector<double>& roughness,
+                                   const std::vector<bool>& unreliable, const FeatureConfig& config) {
+  RingSelection out;
+  const int n = static_cast<int>(ring.size());
+  const int w = config.roughness_half_window;
+  if (n < 2 * w + 1) return out;
+  std::vector<bool> blocked(unreliable);
+  const int first = w, last = n - w;  // points with a full window
+  const int sectors = std::max(1, config.num_sectors);
+  std::vector<int> order;
+  // Blocks the ring neighbours of a selected point, as long as they are
+  // close in space (not across an occlusion).
+  auto block_neighbours = [&](int i) {
+    blocked[i] = true;
+    for (int step : {-1, 1}) {
+      for (int k = 1; k <= w; ++k) {
+        const int j = i + step * k;
+        const int prev = j - step;
+        if (j < 0 || j >= n) break;
+        if ((ring[j] - ring[prev]).squaredNorm() > 0.05) break;
+        blocked[j] = true;
+      }
+    }
+  };
+  for (int s = 0; s < sectors; ++s) {
+    const int begin = first + (last - first) * s / sectors;
+    const int end = first + (last - first) * (s + 1) / sectors;
+    if (end <= begin) continue;
+    order.resize(end - begin);
+    std::iota(order.begin(), order.end(), begin);
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return roughness[a] < roughness[b]; });
+    int picked = 0;
+    for (auto it = order.rbegin(); it != order.rend() && picked < config.edges_per_sector; ++it) {
+      const int i = *it;
+      if (blocked[i] || !std::isfinite(roughness[i])) continue;
+      if (roughness[i] <= config.alpha) break;
+      out.edges.push_back(i);
+      block_neighbours(i);
+      ++picked;
+    }
+    picked = 0;
+    for (const int i : order) {
+      if (picked >= config.planars_per_sector) break;
+      if (roughness[i] >= config.alpha) break;
+      if (blocked[i]) continue;
+      out.planars.push_back(i);
+      block_neighbours(i);
+      ++picked;
+    }
+  }
+  return out;
+}
+
+int odometry_class(std::uint16_t raw_label) {
+  if (raw_label == cls::kUnlabeled || raw_label == cls::kOutlier || is_dynamic(raw_label)) return -1;
+  const int learning = to_learning_class(static_class(raw_label));
+  return learning == 0 ? -1 : learning;
+}
+
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels) {
+  ScanFeatures out;
+  const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
+  const int rings = ring_count(layout);
+  // Bucket points by ring with their sweep time, then order each ring in time
+  // so that ring neighbours are neighbours in azimuth.
+  struct Entry {
+    float time;
+    std::uint32_t index;
+  };
+  std::vector<std::vector<Entry>> buckets(rings);
+  for (auto& b : buckets) b.reserve(cloud.size() / rings * 2);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    const double horizontal = std::hypot(p.x(), p.y());
+    if (horizontal < 1e-3) continue;
+    const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
+    if (ring < 0) continue;
+    const double t = sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config);
+    buckets[ring].push_back({static_cast<float>(t), static_cast<std::uint32_t>(i)});
+  }
+  std::vector<Eigen::Vector3d> ring_points;
+  for (auto& bucket : buckets) {
+    std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
+    ring_points.resize(bucket.size());
+    for (std::size_t k = 0; k < bucket.size(); ++k) ring_points[k] = cloud.points[bucket[k].index].cast<double>();
+    const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
+    auto unreliable =
+        unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
+    if (use_labels) {  // unusable classes must not take a sector's feature slots
+      for (std::size_t k = 0; k < bucket.size(); ++k) {
+        if (odometry_class(cloud.label[bucket[k].index]) < 0) unreliable[k] = true;
+      }
+    }
+    const auto selection = select_ring_features(ring_points, roughness, unreliable, config);
+    auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
+      for (const int k : indices) {
+        const auto& e = bucket[k];
+        int c = 0;
+        if (use_labels) {
+          c = odometry_class(cloud.label[e.index]);
+          if (c < 0) continue;
+        }
+        target.push_back(ring_points[k], static_cast<ClassIndex>(c), e.time);
+      }
+    };
+    emit(selection.edges, out.edges);
+    emit(selection.planars, out.planars);
+  }
+  return out;
+}
+
+}  // namespace saloam

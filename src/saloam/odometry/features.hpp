@@ -1,0 +1,104 @@
+#pragma once
+// LOAM feature extraction (paper Sec. III-B): ring assignment, azimuth
+// ordering, roughness (Eq. 1), rejection of unreliable points and the
+// per-sector selection of edge and planar features. Each feature keeps its
+// semantic class so that matching can stay within a class.
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+/// Compact class index used by the odometry: the SemanticKITTI training class
+/// (0..19) of the point's static class. Index 0 holds every point of an
+/// unlabeled scan or of a label-agnostic run.
+using ClassIndex = std::uint8_t;
+inline constexpr int kNumClassIndices = kNumLearningClasses;
+
+/// Point sets of one scan, in the sensor frame at the instant the scan's pose
+/// refers to (after de-skewing).
+struct FeatureCloud {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<ClassIndex> classes;
+  std::vector<float> sweep_time;  ///< [s] since sweep start, for de-skewing
+
+  [[nodiscard]] std::size_t size() const { return points.size(); }
+  void push_back(const Eigen::Vector3d& p, ClassIndex c, float t) {
+    points.push_back(p);
+    classes.push_back(c);
+    sweep_time.push_back(t);
+  }
+  void clear() {
+    points.clear();
+    classes.clear();
+    sweep_time.clear();
+  }
+};
+
+struct ScanFeatures {
+  FeatureCloud edges;
+  FeatureCloud planars;
+};
+
+/// Vertical layout of a spinning LiDAR, used to assign rings from elevation.
+enum class BeamLayout { kHdl64, kHdl32, kVlp16 };
+
+/// Number of rings of a layout (64, 32, 16).
+int ring_count(BeamLayout layout);
+/// Layout from `num_beams` (64/32/16), or detected from the elevation range
+/// of the scan when num_beams is 0.
+BeamLayout detect_beam_layout(const std::vector<Eigen::Vector3f>& points, int num_beams);
+/// Ring of a point with elevation `elevation_deg`, or -1 outside the layout's
+/// field of view. The HDL-64E has two blocks with different spacing: upper
+/// +2.0..-8.33 deg at ~1/3 deg, lower -8.83..-24.9 deg at ~1/2 deg.
+int ring_from_elevation(double elevation_deg, BeamLayout layout);
+
+/// Time of a return within the sweep [s] from its azimuth, for a sensor that
+/// starts the sweep at `start_azimuth_deg` and turns clockwise seen from above
+/// (decreasing azimuth, as the Velodyne HDL-64E in KITTI) or counter-clockwise.
+double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config);
+
+/// Roughness of Eq. 1 for every point of one azimuth-ordered ring:
+/// c_i = || sum_{j in S} (X_j - X_i) ||^2 over `half_window` neighbours on each
+/// side, NOT normalised by |S| ||X_i||: this is the form of A-LOAM / F-LOAM,
+/// for which the threshold alpha = 0.1 [m^2] of Table I is calibrated.
+/// Points without a full window get +infinity.
+std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int half_window);
+
+/// Marks points whose roughness is not trustworthy (LOAM Sec. V-A): returns
+/// too near or too far, occluded edges (a depth jump between ring neighbours:
+/// the farther side is hidden behind the nearer one), surfaces hit at a
+/// grazing angle (beam nearly parallel to the surface), and windows crossing
+/// gaps in azimuth.
+std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window,
+                                    double min_range, double max_range);
+
+/// Selects features of one ring: split into N_r sectors; in each, up to N_e
+/// points with roughness > alpha (sharpest first) become edges and up to N_p
+/// with roughness < alpha (flattest first) planars; a selected point blocks
+/// its ring neighbours (non-maximum suppression). Returns indices into ring.
+struct RingSelection {
+  std::vector<int> edges;
+  std::vector<int> planars;
+};
+RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
+                                   const std::vector<double>& roughness,
+                                   const std::vector<bool>& unreliable, const FeatureConfig& config);
+
+/// The class index of a raw label for the odometry, or -1 when the point must
+/// not be used (dynamic classes, unlabeled, outlier).
+int odometry_class(std::uint16_t raw_label);
+
+/// Full extraction on one scan. With `use_labels` false (unlabeled scan or
+/// label-agnostic mode) every point is class 0; otherwise dynamic and
+/// unlabeled points are dropped from the features (after the roughness, which
+/// is pure geometry: removing them first would create false edges).
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels);
+
+}  // namespace saloam

@@ -1,0 +1,74 @@
+#pragma once
+// The odometry pipeline (paper Sec. III-B): per frame, feature extraction,
+// constant-velocity prediction and de-skewing, semantic downsampling,
+// scan-to-local-map registration and the local-map update. Composable: the
+// SLAM pipeline and the demo feed it frames and read its poses.
+
+#include <memory>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/types.hpp"
+#include "saloam/odometry/features.hpp"
+#include "saloam/odometry/local_map.hpp"
+#include "saloam/odometry/registration.hpp"
+
+namespace saloam {
+
+/// Wall-clock time of each stage of one frame [ms].
+struct FrameTimings {
+  double features_ms = 0.0;
+  double deskew_downsample_ms = 0.0;
+  double registration_ms = 0.0;
+  double map_update_ms = 0.0;
+  [[nodiscard]] double total_ms() const {
+    return features_ms + deskew_downsample_ms + registration_ms + map_update_ms;
+  }
+};
+
+struct FrameStats {
+  std::size_t edge_features = 0;    ///< after downsampling
+  std::size_t planar_features = 0;  ///< after downsampling
+  RegistrationResult registration;
+};
+
+class OdometryPipeline {
+ public:
+  explicit OdometryPipeline(OdometryConfig config);
+  ~OdometryPipeline();
+  OdometryPipeline(const OdometryPipeline&) = delete;
+  OdometryPipeline& operator=(const OdometryPipeline&) = delete;
+
+  /// Registers the next scan; returns its pose T_world<-sensor (world = the
+  /// first scan's sensor frame at its pose instant). Labels are used when the
+  /// cloud has them and semantics are on; otherwise everything is one class.
+  Pose register_frame(const LabelledCloud& cloud, double timestamp);
+
+  [[nodiscard]] const std::vector<Pose>& poses() const { return poses_; }
+  [[nodiscard]] const std::vector<double>& timestamps() const { return timestamps_; }
+  [[nodiscard]] const std::vector<FrameTimings>& timings() const { return timings_; }
+  [[nodiscard]] const FrameStats& last_frame_stats() const { return last_stats_; }
+  [[nodiscard]] const SemanticLocalMap& local_map() const { return map_; }
+  /// Features of the last frame in the world frame (after downsampling).
+  [[nodiscard]] const ScanFeatures& last_features_world() const { return last_world_; }
+  [[nodiscard]] const OdometryConfig& config() const { return config_; }
+
+ private:
+  Pose process(const LabelledCloud& cloud, double timestamp);
+
+  OdometryConfig config_;
+  RegistrationSettings settings_;
+  ClassVoxelSizes voxel_sizes_;
+  SemanticLocalMap map_;
+  std::unique_ptr<tbb::task_arena> arena_;
+  std::vector<Pose> poses_;
+  std::vector<double> timestamps_;
+  std::vector<FrameTimings> timings_;
+  FrameStats last_stats_;
+  ScanFeatures last_world_;
+  ScanFeatures first_raw_;  ///< first frame's features before de-skewing (bootstrap)
+};
+
+}  // namespace saloam

@@ -1,0 +1,169 @@
+#include "saloam/odometry/registration.hpp"
+
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <tbb/parallel_for.h>
+
+#include "saloam/core/semantic_classes.hpp"
+
+namespace saloam {
+
+RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& config) {
+  RegistrationSettings s;
+  s.edge_neighbours = config.edge_neighbours;
+  s.planar_neighbours = config.planar_neighbours;
+  s.max_correspondence_distance = config.max_correspondence_distance;
+  s.robust_kernel_scale = config.robust_kernel_scale;
+  s.max_iterations = config.max_iterations;
+  s.outer_iterations = config.outer_iterations;
+  s.sigma = config.sigma;
+  s.class_weight = class_weights(config);
+  for (int c = 0; c < kNumClassIndices; ++c) {
+    s.orientation[c] = config.use_semantics
+                           ? plane_orientation(from_learning_class(static_cast<std::uint8_t>(c)))
+                           : PlaneOrientation::kAny;
+  }
+  s.parallel = config.threads != 1;
+  return s;
+}
+
+namespace {
+
+constexpr int kMaxNeighbours = 32;
+
+struct EdgeMatch {
+  Line line;
+  bool valid = false;
+};
+struct PlaneMatch {
+  Plane plane;
+  bool valid = false;
+  bool rejected_by_constraint = false;
+};
+
+template <class Body>
+void for_each_index(std::size_t n, bool parallel, Body&& body) {
+  if (parallel && n > 256) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
+    });
+  } else {
+    for (std::size_t i = 0; i < n; ++i) body(i);
+  }
+}
+
+// Gathers the k nearest neighbours of q in a class submap; false if too few
+// or the farthest is beyond the correspondence distance.
+bool gather(const ClassSubmap& submap, const Eigen::Vector3d& q, int k, double max_distance,
+            std::array<Eigen::Vector3d, kMaxNeighbours>& out) {
+  std::array<std::uint32_t, kMaxNeighbours> idx{};
+  std::array<double, kMaxNeighbours> d2{};
+  const int kk = std::min(k, kMaxNeighbours);
+  if (submap.size() < static_cast<std::size_t>(kk)) return false;
+  const std::size_t found = submap.nearest(q, static_cast<std::size_t>(kk), idx.data(), d2.data());
+  if (found < static_cast<std::size_t>(kk) || d2[kk - 1] > max_distance * max_distance) return false;
+  for (int i = 0; i < kk; ++i) out[i] = submap.points()[idx[i]];
+  return true;
+}
+
+double huber_weight(double r, double k) {
+  const double a = std::abs(r);
+  return a <= k ? 1.0 : k / a;
+}
+
+}  // namespace
+
+RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& planars,
+                                 const SemanticLocalMap& map, const Pose& initial,
+                                 const RegistrationSettings& settings) {
+  RegistrationResult result;
+  result.pose = initial;
+  Pose T = initial;
+  std::vector<EdgeMatch> edge_matches(edges.size());
+  std::vector<PlaneMatch> plane_matches(planars.size());
+  const int ne = std::min(settings.edge_neighbours, kMaxNeighbours);
+  const int np = std::min(settings.planar_neighbours, kMaxNeighbours);
+
+  for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
+    // Association at the current pose (the expensive part: kd-tree queries and fits).
+    for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
+      std::array<Eigen::Vector3d, kMaxNeighbours> nb;
+      EdgeMatch m;
+      const Eigen::Vector3d q = T * edges.points[i];
+      if (gather(map.edges(edges.classes[i]), q, ne, settings.max_correspondence_distance, nb)) {
+        if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
+          m.line = *line;
+          m.valid = true;
+        }
+      }
+      edge_matches[i] = m;
+    });
+    for_each_index(planars.size(), settings.parallel, [&](std::size_t i) {
+      std::array<Eigen::Vector3d, kMaxNeighbours> nb;
+      PlaneMatch m;
+      const Eigen::Vector3d q = T * planars.points[i];
+      const ClassIndex c = planars.classes[i];
+      if (gather(map.planars(c), q, np, settings.max_correspondence_distance, nb)) {
+        if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
+          if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.sigma)) {
+            m.plane = *plane;
+            m.valid = true;
+          } else {
+            m.rejected_by_constraint = true;
+          }
+        }
+      }
+      plane_matches[i] = m;
+    });
+    int n_edges = 0, n_planes = 0, n_rejected = 0;
+    for (const auto& m : edge_matches) n_edges += m.valid;
+    for (const auto& m : plane_matches) {
+      n_planes += m.valid;
+      n_rejected += m.rejected_by_constraint;
+    }
+    result.edge_matches = n_edges;
+    result.planar_matches = n_planes;
+    result.rejected_by_constraint = n_rejected;
+    if (n_edges + n_planes < 20) return result;  // not enough to constrain 6 DoF reliably
+
+    bool converged = false;
+    for (int it = 0; it < settings.max_iterations; ++it) {
+      Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+      Vector6d g = Vector6d::Zero();
+      const double k = settings.robust_kernel_scale;
+      for (std::size_t i = 0; i < edges.size(); ++i) {
+        if (!edge_matches[i].valid) continue;
+        Eigen::Matrix<double, 3, 6> J;
+        const Eigen::Vector3d r = point_to_line_residual(T, edges.points[i], edge_matches[i].line, &J);
+        const double w = settings.class_weight[edges.classes[i]] * huber_weight(r.norm(), k);
+        H.noalias() += w * J.transpose() * J;
+        g.noalias() += w * J.transpose() * r;
+      }
+      for (std::size_t i = 0; i < planars.size(); ++i) {
+        if (!plane_matches[i].valid) continue;
+        Eigen::Matrix<double, 1, 6> J;
+        const double r = point_to_plane_residual(T, planars.points[i], plane_matches[i].plane, &J);
+        const double w = settings.class_weight[planars.classes[i]] * huber_weight(r, k);
+        H.noalias() += w * J.transpose() * J;
+        g.noalias() += (w * r) * J.transpose();
+      }
+      // Small Levenberg-Marquardt damping keeps weakly constrained directions stable.
+      H.diagonal().array() += 1e-6 * H.diagonal().maxCoeff() + 1e-9;
+      const Vector6d delta = -H.ldlt().solve(g);
+      if (!delta.allFinite()) return result;
+      T = apply_update(delta, T);
+      ++result.iterations;
+      if (delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6) {
+        converged = true;
+        break;
+      }
+    }
+    (void)converged;
+  }
+  result.pose = T;
+  result.ok = true;
+  return result;
+}
+
+}  // namespace saloam

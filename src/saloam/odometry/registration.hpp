@@ -1,0 +1,49 @@
+#pragma once
+// Scan-to-local-map registration (paper Sec. III-B, Eq. 2): each edge feature
+// is matched to a line and each planar feature to a plane fitted to its
+// nearest map neighbours of the same class, and the pose minimises the
+// weighted, robustified sum of squared point-to-line and point-to-plane
+// distances by Gauss-Newton (Levenberg-Marquardt damped) on SE(3), with a few
+// outer rounds that re-associate at the new pose.
+
+#include <array>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/types.hpp"
+#include "saloam/odometry/features.hpp"
+#include "saloam/odometry/local_map.hpp"
+#include "saloam/odometry/residuals.hpp"
+
+namespace saloam {
+
+struct RegistrationSettings {
+  int edge_neighbours = 5;         ///< N_ne
+  int planar_neighbours = 5;       ///< N_np
+  double max_correspondence_distance = 1.0;  ///< [m]
+  double robust_kernel_scale = 0.1;  ///< [m] Huber scale
+  int max_iterations = 10;
+  int outer_iterations = 3;
+  double sigma = 0.05;             ///< plane-constraint tolerance
+  std::array<double, kNumClassIndices> class_weight{};          ///< w^l
+  std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
+  bool parallel = false;           ///< associate with TBB (inside the caller's task arena)
+
+  /// From the config; without semantics all weights are 1 and no plane constraint applies.
+  static RegistrationSettings from_config(const OdometryConfig& config);
+};
+
+struct RegistrationResult {
+  Pose pose = Pose::Identity();
+  int edge_matches = 0;
+  int planar_matches = 0;
+  int rejected_by_constraint = 0;  ///< planes dropped by the semantic plane constraint
+  int iterations = 0;
+  bool ok = false;  ///< false: too few correspondences, pose = initial guess
+};
+
+/// Registers features (sensor frame) to the map starting from `initial` (T_world<-sensor).
+RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& planars,
+                                 const SemanticLocalMap& map, const Pose& initial,
+                                 const RegistrationSettings& settings);
+
+}  // namespace saloam

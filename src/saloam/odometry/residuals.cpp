@@ -1,0 +1,90 @@
+#include "saloam/odometry/residuals.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include "saloam/core/semantic_classes.hpp"
+
+namespace saloam {
+
+namespace {
+struct Moments {
+  Eigen::Vector3d mean;
+  Eigen::Matrix3d covariance;
+};
+Moments moments(std::span<const Eigen::Vector3d> points) {
+  Moments m{Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero()};
+  for (const auto& p : points) m.mean += p;
+  m.mean /= static_cast<double>(points.size());
+  for (const auto& p : points) {
+    const Eigen::Vector3d d = p - m.mean;
+    m.covariance += d * d.transpose();
+  }
+  m.covariance /= static_cast<double>(points.size());
+  return m;
+}
+}  // namespace
+
+std::optional<Line> fit_line(std::span<const Eigen::Vector3d> points, double min_ratio) {
+  if (points.size() < 2) return std::nullopt;
+  const Moments m = moments(points);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m.covariance);
+  const Eigen::Vector3d& values = eig.eigenvalues();  // ascending
+  if (values(2) <= 1e-12 || values(2) < min_ratio * values(1)) return std::nullopt;
+  return Line{m.mean, eig.eigenvectors().col(2).normalized()};
+}
+
+std::optional<Plane> fit_plane(std::span<const Eigen::Vector3d> points, double max_distance) {
+  if (points.size() < 3) return std::nullopt;
+  const Moments m = moments(points);
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m.covariance);
+  const Eigen::Vector3d& values = eig.eigenvalues();
+  // Collinear neighbours do not define a plane.
+  if (values(1) < 1e-3 * values(2) || values(2) <= 1e-12) return std::nullopt;
+  const Eigen::Vector3d normal = eig.eigenvectors().col(0).normalized();
+  for (const auto& p : points) {
+    if (std::abs(normal.dot(p - m.mean)) > max_distance) return std::nullopt;
+  }
+  return Plane{m.mean, normal};
+}
+
+PlaneOrientation plane_orientation(std::uint16_t raw_class) {
+  const std::uint16_t c = static_class(raw_class);
+  if (is_ground(c)) return PlaneOrientation::kHorizontal;
+  if (c == cls::kBuilding || c == cls::kFence) return PlaneOrientation::kVertical;
+  return PlaneOrientation::kAny;
+}
+
+bool plane_satisfies_constraint(const Eigen::Vector3d& normal, PlaneOrientation orientation, double sigma) {
+  const double up = std::abs(normal.z());
+  switch (orientation) {
+    case PlaneOrientation::kHorizontal: return up >= 1.0 - sigma;
+    case PlaneOrientation::kVertical: return up <= sigma;
+    case PlaneOrientation::kAny: return true;
+  }
+  return true;
+}
+
+double point_to_plane_residual(const Pose& T, const Eigen::Vector3d& p, const Plane& plane,
+                               Eigen::Matrix<double, 1, 6>* jacobian) {
+  const Eigen::Vector3d q = T * p;
+  if (jacobian) {
+    jacobian->leftCols<3>() = plane.normal.transpose();
+    jacobian->rightCols<3>() = -plane.normal.transpose() * skew(q);
+  }
+  return plane.normal.dot(q - plane.point);
+}
+
+Eigen::Vector3d point_to_line_residual(const Pose& T, const Eigen::Vector3d& p, const Line& line,
+                                       Eigen::Matrix<double, 3, 6>* jacobian) {
+  const Eigen::Vector3d q = T * p;
+  const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - line.direction * line.direction.transpose();
+  if (jacobian) {
+    jacobian->leftCols<3>() = P;
+    jacobian->rightCols<3>() = -P * skew(q);
+  }
+  return P * (q - line.point);
+}
+
+Pose apply_update(const Vector6d& delta, const Pose& T) { return orthonormalized(se3_exp(delta) * T); }
+
+}  // namespace saloam

@@ -1,0 +1,63 @@
+#pragma once
+// Geometric correspondences and residuals of the scan-to-map registration
+// (paper Sec. III-B, Eq. 2): lines and planes fitted to map neighbours, the
+// semantic plane constraint, and point-to-line / point-to-plane residuals
+// with their analytic Jacobians.
+//
+// Pose perturbation convention: T <- exp(delta) * T with delta = [rho; phi]
+// (left, world frame), so for q = T p: dq/d delta = [ I | -[q]x ].
+
+#include <cstdint>
+#include <optional>
+#include <span>
+
+#include <Eigen/Core>
+
+#include "saloam/core/lie.hpp"
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+struct Line {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();      ///< centroid of the neighbours
+  Eigen::Vector3d direction = Eigen::Vector3d::UnitX();  ///< unit
+};
+
+struct Plane {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();   ///< centroid of the neighbours
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit
+};
+
+/// PCA line through the points; nullopt unless line-like: the largest
+/// eigenvalue of the covariance must exceed `min_ratio` times the second.
+std::optional<Line> fit_line(std::span<const Eigen::Vector3d> points, double min_ratio = 3.0);
+
+/// PCA plane through the points; nullopt unless planar: every point within
+/// `max_distance` [m] of the plane and the points not collinear.
+std::optional<Plane> fit_plane(std::span<const Eigen::Vector3d> points, double max_distance = 0.2);
+
+/// Which orientation the plane constraint demands for a class.
+enum class PlaneOrientation { kAny, kHorizontal /* ground: normal near vertical */, kVertical /* building, fence */ };
+
+/// The constraint for a raw SemanticKITTI class: ground classes (road,
+/// sidewalk, parking, terrain, other-ground, lane-marking) need a near-vertical
+/// normal, building and fence a near-horizontal one, others anything.
+PlaneOrientation plane_orientation(std::uint16_t raw_class);
+
+/// The plane constraint with tolerance sigma on |n . up| (up = world z):
+/// horizontal planes need |n_z| >= 1 - sigma, vertical ones |n_z| <= sigma.
+bool plane_satisfies_constraint(const Eigen::Vector3d& normal, PlaneOrientation orientation, double sigma);
+
+/// Point-to-plane residual n . (T p - c) and its 1x6 Jacobian w.r.t. delta.
+double point_to_plane_residual(const Pose& T, const Eigen::Vector3d& p, const Plane& plane,
+                               Eigen::Matrix<double, 1, 6>* jacobian = nullptr);
+
+/// Point-to-line residual (I - d d^T)(T p - c): a 3-vector whose norm is the
+/// distance to the line, and its 3x6 Jacobian w.r.t. delta.
+Eigen::Vector3d point_to_line_residual(const Pose& T, const Eigen::Vector3d& p, const Line& line,
+                                       Eigen::Matrix<double, 3, 6>* jacobian = nullptr);
+
+/// Applies the left update T <- exp(delta) T and re-orthonormalizes the rotation.
+Pose apply_update(const Vector6d& delta, const Pose& T);
+
+}  // namespace saloam
