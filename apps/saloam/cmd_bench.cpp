@@ -1,0 +1,126 @@
+// `saloam bench`: odometry speed on a sequence: frequency (median and worst
+// frame, excluding disk I/O), time per stage, and peak memory (getrusage).
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <iostream>
+#include <memory>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "command.hpp"
+#include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/progress.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/odometry/pipeline.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct BenchOptions {
+  std::string sequence;
+  std::string frames;
+  std::string labels;
+  int threads = 1;
+  bool no_semantics = false;
+  ConfigOptions config;
+};
+
+std::pair<std::size_t, std::size_t> parse_range(const std::string& text, std::size_t n) {
+  if (text.empty()) return {0, n};
+  const auto colon = text.find(':');
+  try {
+    const std::size_t a = std::stoul(text.substr(0, colon));
+    std::size_t b = n;
+    if (colon != std::string::npos && colon + 1 < text.size()) b = std::stoul(text.substr(colon + 1));
+    b = std::min(b, n);
+    if (a >= b) throw ConfigError(fmt::format("--frames {}: empty range (sequence has {} frames)", text, n));
+    return {a, b};
+  } catch (const std::logic_error&) {
+    throw ConfigError(fmt::format("--frames {}: expected A:B with frame indices", text));
+  }
+}
+
+struct Summary {
+  double median = 0, mean = 0, max = 0;
+};
+Summary summarize(std::vector<double> v) {
+  Summary s;
+  if (v.empty()) return s;
+  std::sort(v.begin(), v.end());
+  s.median = v[v.size() / 2];
+  s.mean = std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+  s.max = v.back();
+  return s;
+}
+
+int run_bench(const BenchOptions& options) {
+  SaloamConfig config = options.config.resolve();
+  config.odometry.threads = options.threads;
+  if (options.no_semantics) config.odometry.use_semantics = false;
+  SequenceOptions seq_options;
+  if (!options.labels.empty()) seq_options.labels_dir = options.labels;
+  seq_options.ignore_labels = !config.odometry.use_semantics;
+  const SequenceReader reader(options.sequence, seq_options);
+  const auto [first, last] = parse_range(options.frames, reader.size());
+
+  OdometryPipeline odometry(config.odometry);
+  std::vector<double> wall_ms;
+  std::size_t points = 0;
+  ProgressBar progress(last - first, "bench");
+  for (std::size_t i = first; i < last && !stop_requested(); ++i) {
+    const LabelledCloud cloud = reader.load_scan(i);  // I/O outside the timed region
+    points += cloud.size();
+    const auto t0 = std::chrono::steady_clock::now();
+    odometry.register_frame(cloud, reader.times().at(i));
+    wall_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    progress.advance();
+  }
+  progress.finish();
+  if (wall_ms.empty()) return 130;
+
+  std::vector<double> features, deskew, registration, map;
+  for (const auto& t : odometry.timings()) {
+    features.push_back(t.features_ms);
+    deskew.push_back(t.deskew_downsample_ms);
+    registration.push_back(t.registration_ms);
+    map.push_back(t.map_update_ms);
+  }
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const Summary total = summarize(wall_ms);
+  std::cout << fmt::format("saloam bench: {} frames of {} ({:.0f} points/scan), threads {}, semantics {}\n",
+                           wall_ms.size(), options.sequence, static_cast<double>(points) / wall_ms.size(),
+                           options.threads, config.odometry.use_semantics && reader.has_labels() ? "on" : "off");
+  std::cout << fmt::format("frequency: median {:.1f} Hz ({:.1f} ms), worst frame {:.1f} Hz ({:.1f} ms), mean {:.1f} ms\n",
+                           1000.0 / total.median, total.median, 1000.0 / total.max, total.max, total.mean);
+  std::cout << "stage              median ms   mean ms    max ms\n";
+  for (const auto& [name, v] : {std::pair{"features", &features}, std::pair{"deskew+downsample", &deskew},
+                                std::pair{"registration", &registration}, std::pair{"map update", &map}}) {
+    const Summary s = summarize(*v);
+    std::cout << fmt::format("{:<18} {:>9.2f} {:>9.2f} {:>9.2f}\n", name, s.median, s.mean, s.max);
+  }
+  std::cout << fmt::format("peak memory (max RSS): {:.1f} MiB\n", usage.ru_maxrss / 1024.0);
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "bench", "Odometry speed (Hz median and worst frame, per stage) and peak memory on a sequence", 80,
+    [](CLI::App& app) {
+      auto options = std::make_shared<BenchOptions>();
+      app.add_option("SEQ_DIR", options->sequence, "Sequence folder (velodyne/ ...)")->required();
+      app.add_option("--frames", options->frames, "Frame range A:B (B exclusive)");
+      app.add_option("--threads", options->threads, "Worker threads (1 = single core, 0 = all)")
+          ->capture_default_str();
+      app.add_option("--labels", options->labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+      app.add_flag("--no-semantics", options->no_semantics, "Label-agnostic baseline");
+      options->config.add_to(app);
+      return [options] { return run_bench(*options); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli
