@@ -1,0 +1,200 @@
+#include "saloam/eval/evaluation_report.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/viz/canvas.hpp"
+
+namespace saloam {
+namespace {
+
+/// NaN/Inf become JSON null (nlohmann would do the same, made explicit here).
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+std::string fixed(double v, int decimals) { return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : "n/a"; }
+
+constexpr std::array<const char*, 3> kAxisNames{"x", "y", "z"};
+
+}  // namespace
+
+nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const EvaluationLabels& labels, bool per_frame) {
+  using nlohmann::json;
+  json j;
+  j["gt"] = labels.gt_name;
+  j["est"] = labels.est_name;
+  j["alignment"] = alignment_name(ev.ate.alignment);
+  j["num_poses"] = ev.evaluated_poses;
+  j["gt_poses"] = ev.gt_poses;
+  j["est_poses"] = ev.est_poses;
+  j["gt_length_m"] = number(ev.gt_length_m);
+
+  json kitti;
+  kitti["t_err_percent"] = number(ev.kitti.t_err_percent);
+  kitti["r_err_deg_per_100m"] = number(ev.kitti.r_err_deg_per_100m);
+  kitti["segments"] = ev.kitti.segments;
+  kitti["per_length"] = json::array();
+  for (const auto& l : ev.kitti.per_length) {
+    kitti["per_length"].push_back({{"length_m", l.length_m},
+                                   {"t_err_percent", number(l.t_err_percent)},
+                                   {"r_err_deg_per_100m", number(l.r_err_deg_per_100m)},
+                                   {"segments", l.segments}});
+  }
+  j["kitti"] = kitti;
+
+  json ate;
+  ate["alignment"] = alignment_name(ev.ate.alignment);
+  for (const auto& [suffix, s] : {std::pair{"aligned", ev.ate.aligned}, std::pair{"unaligned", ev.ate.unaligned}}) {
+    ate[fmt::format("rmse_{}", suffix)] = number(s.rmse);
+    ate[fmt::format("mean_{}", suffix)] = number(s.mean);
+    ate[fmt::format("median_{}", suffix)] = number(s.median);
+    ate[fmt::format("max_{}", suffix)] = number(s.max);
+  }
+  ate["scale"] = ev.ate.transform.scale;
+  json rotation = json::array();
+  for (int r = 0; r < 3; ++r) {
+    rotation.push_back({ev.ate.transform.rotation(r, 0), ev.ate.transform.rotation(r, 1), ev.ate.transform.rotation(r, 2)});
+  }
+  ate["rotation"] = rotation;
+  ate["translation"] = {ev.ate.transform.translation.x(), ev.ate.transform.translation.y(),
+                        ev.ate.transform.translation.z()};
+  if (per_frame) ate["per_pose_aligned_m"] = ev.ate.aligned_errors;
+  j["ate"] = ate;
+
+  json rpe;
+  rpe["delta"] = ev.rpe.delta;
+  rpe["trans_rmse_m"] = number(ev.rpe.trans.rmse);
+  rpe["trans_mean_m"] = number(ev.rpe.trans.mean);
+  rpe["trans_median_m"] = number(ev.rpe.trans.median);
+  rpe["trans_max_m"] = number(ev.rpe.trans.max);
+  rpe["rot_rmse_deg"] = number(ev.rpe.rot.rmse);
+  rpe["rot_mean_deg"] = number(ev.rpe.rot.mean);
+  rpe["rot_median_deg"] = number(ev.rpe.rot.median);
+  rpe["rot_max_deg"] = number(ev.rpe.rot.max);
+  if (per_frame) {
+    rpe["per_frame_trans_m"] = ev.rpe.trans_errors_m;
+    rpe["per_frame_rot_deg"] = ev.rpe.rot_errors_deg;
+  }
+  j["rpe"] = rpe;
+  j["warnings"] = ev.warnings;
+  return j;
+}
+
+void write_evaluation_json(const std::filesystem::path& file, const TrajectoryEvaluation& evaluation,
+                           const EvaluationLabels& labels) {
+  if (file.has_parent_path()) {
+    std::error_code ec;
+    std::filesystem::create_directories(file.parent_path(), ec);
+    if (ec) throw InputError(file, "cannot create its folder: " + ec.message());
+  }
+  std::ofstream out(file, std::ios::trunc);
+  if (!out) throw InputError(file, "cannot open for writing");
+  out << evaluation_to_json(evaluation, labels).dump(2) << '\n';
+  if (!out) throw InputError(file, "write failed");
+}
+
+void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& ev, const EvaluationLabels& labels) {
+  out << "## Trajectory evaluation";
+  if (!labels.est_name.empty() || !labels.gt_name.empty()) {
+    out << ": " << (labels.est_name.empty() ? "estimate" : labels.est_name) << " vs "
+        << (labels.gt_name.empty() ? "ground truth" : labels.gt_name);
+  }
+  out << "\n\n";
+  const std::string align = alignment_name(ev.ate.alignment);
+  out << "| metric | value |\n|---|---|\n";
+  out << fmt::format("| poses evaluated | {} (ground truth {}, estimate {}) |\n", ev.evaluated_poses, ev.gt_poses,
+                     ev.est_poses);
+  out << fmt::format("| ground-truth path length | {} m |\n", fixed(ev.gt_length_m, 1));
+  out << fmt::format("| KITTI translation error | {} % |\n", fixed(ev.kitti.t_err_percent, 5));
+  out << fmt::format("| KITTI rotation error | {} deg/100 m |\n", fixed(ev.kitti.r_err_deg_per_100m, 5));
+  out << fmt::format("| KITTI segments (100..800 m) | {} |\n", ev.kitti.segments);
+  out << fmt::format("| ATE RMSE, {}-aligned | {} m |\n", align, fixed(ev.ate.aligned.rmse, 6));
+  out << fmt::format("| ATE mean / median / max, {}-aligned | {} / {} / {} m |\n", align, fixed(ev.ate.aligned.mean, 4),
+                     fixed(ev.ate.aligned.median, 4), fixed(ev.ate.aligned.max, 4));
+  if (ev.ate.alignment == Alignment::kSim3) out << fmt::format("| Sim(3) scale | {} |\n", fixed(ev.ate.transform.scale, 6));
+  out << fmt::format("| ATE RMSE, unaligned | {} m |\n", fixed(ev.ate.unaligned.rmse, 6));
+  out << fmt::format("| ATE mean / median / max, unaligned | {} / {} / {} m |\n", fixed(ev.ate.unaligned.mean, 4),
+                     fixed(ev.ate.unaligned.median, 4), fixed(ev.ate.unaligned.max, 4));
+  out << fmt::format("| RPE ({}-frame) translation RMSE | {} m |\n", ev.rpe.delta, fixed(ev.rpe.trans_rmse_m, 6));
+  out << fmt::format("| RPE ({}-frame) rotation RMSE | {} deg |\n", ev.rpe.delta, fixed(ev.rpe.rot_rmse_deg, 6));
+
+  out << "\n| segment length [m] | t_err [%] | r_err [deg/100 m] | segments |\n|---|---|---|---|\n";
+  for (const auto& l : ev.kitti.per_length) {
+    out << fmt::format("| {:.0f} | {} | {} | {} |\n", l.length_m, fixed(l.t_err_percent, 5),
+                       fixed(l.r_err_deg_per_100m, 5), l.segments);
+  }
+  for (const auto& w : ev.warnings) out << "\n> warning: " << w << '\n';
+}
+
+std::pair<int, int> top_down_axes(const std::vector<Pose>& gt) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (const auto& p : gt) {
+    lo = lo.cwiseMin(p.translation());
+    hi = hi.cwiseMax(p.translation());
+  }
+  const Eigen::Vector3d extent = gt.empty() ? Eigen::Vector3d::Zero() : Eigen::Vector3d(hi - lo);
+  // Drop the axis with the smallest extent (ties: drop the later axis, so a
+  // motionless or straight path keeps x and y).
+  int smallest = 2;
+  for (int a = 1; a >= 0; --a) {
+    if (extent[a] < extent[smallest]) smallest = a;
+  }
+  if (smallest == 0) return {1, 2};
+  if (smallest == 1) return {0, 2};
+  return {0, 1};
+}
+
+void plot_evaluation(const std::filesystem::path& file, const std::vector<Pose>& gt, const std::vector<Pose>& est,
+                     const TrajectoryEvaluation& ev, const EvaluationLabels& labels) {
+  const std::size_t n = std::min({gt.size(), est.size(), ev.ate.aligned_errors.size()});
+  const std::vector<Pose> gt_common(gt.begin(), gt.begin() + static_cast<std::ptrdiff_t>(n));
+  const auto [ax, ay] = top_down_axes(gt_common);
+
+  std::vector<Eigen::Vector2d> gt_xy, est_xy, all;
+  gt_xy.reserve(n);
+  est_xy.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d g = gt[i].translation();
+    const Eigen::Vector3d e = ev.ate.transform.apply(Eigen::Vector3d(est[i].translation()));
+    gt_xy.emplace_back(g[ax], g[ay]);
+    est_xy.emplace_back(e[ax], e[ay]);
+  }
+  all = gt_xy;
+  all.insert(all.end(), est_xy.begin(), est_xy.end());
+
+  const std::vector<double> errors(ev.ate.aligned_errors.begin(),
+                                   ev.ate.aligned_errors.begin() + static_cast<std::ptrdiff_t>(n));
+  const double vmax = std::max(1e-6, errors.empty() ? 0.0 : *std::max_element(errors.begin(), errors.end()));
+
+  Plot plot(1100, 950);
+  plot.set_margins(80, 100, 56, 60);
+  plot.fit_range(all, true);
+  const std::string align = alignment_name(ev.ate.alignment);
+  plot.set_title(fmt::format("KITTI t_err {} %  r_err {} deg/100m  |  ATE RMSE {} m ({})  |  RPE {} m",
+                             fixed(ev.kitti.t_err_percent, 3), fixed(ev.kitti.r_err_deg_per_100m, 3),
+                             fixed(ev.ate.aligned.rmse, 3), align, fixed(ev.rpe.trans_rmse_m, 4)));
+  plot.set_labels(fmt::format("{} [m]", kAxisNames[static_cast<std::size_t>(ax)]),
+                  fmt::format("{} [m]", kAxisNames[static_cast<std::size_t>(ay)]));
+
+  const Rgb grey{150, 150, 150};
+  plot.line(gt_xy, grey, 4.0);
+  plot.colored_line(est_xy, errors, 0.0, vmax, 2.0);
+  if (!gt_xy.empty()) plot.marker(gt_xy.front(), {0, 0, 0}, 5.0, "start");
+
+  const std::string est_name = labels.est_name.empty() ? "estimate" : labels.est_name;
+  const std::string gt_name = labels.gt_name.empty() ? "ground truth" : labels.gt_name;
+  const std::string est_label = ev.ate.alignment == Alignment::kNone
+                                    ? fmt::format("{} (unaligned), colour = ATE", est_name)
+                                    : fmt::format("{} ({}-aligned), colour = ATE", est_name, align);
+  plot.legend({{fmt::format("ground truth: {}", gt_name), grey}, {est_label, turbo(0.75)}});
+  plot.colorbar(0.0, vmax, "ATE [m]");
+  plot.save_png(file);
+}
+
+}  // namespace saloam

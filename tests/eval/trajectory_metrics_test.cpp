@@ -1,0 +1,366 @@
+// Synthetic trajectories with known errors for the KITTI, ATE and RPE metrics.
+
+#include "saloam/eval/trajectory_metrics.hpp"
+
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "saloam/core/lie.hpp"
+
+namespace saloam {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+Pose make_pose(const Eigen::Matrix3d& R, const Eigen::Vector3d& t) {
+  Pose T = Pose::Identity();
+  T.linear() = R;
+  T.translation() = t;
+  return T;
+}
+
+Eigen::Matrix3d rot_z(double angle) { return Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+
+/// Straight drive of `frames` poses spaced `step` metres along the body x axis
+/// of a fixed, non-trivial orientation (so no axis is special).
+std::vector<Pose> straight_path(std::size_t frames, double step) {
+  const Eigen::Matrix3d R0 = (Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()) *
+                              Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY()))
+                                 .toRotationMatrix();
+  std::vector<Pose> poses;
+  for (std::size_t i = 0; i < frames; ++i) {
+    poses.push_back(make_pose(R0, R0 * Eigen::Vector3d(step * static_cast<double>(i), 0, 0) + Eigen::Vector3d(5, -3, 1)));
+  }
+  return poses;
+}
+
+/// A winding drive: constant speed, yaw rate varying along the path, gentle
+/// pitch, so that all metrics see rotation and translation.
+std::vector<Pose> winding_path(std::size_t frames, double step) {
+  std::vector<Pose> poses{Pose::Identity()};
+  for (std::size_t i = 1; i < frames; ++i) {
+    const double s = static_cast<double>(i);
+    const Eigen::Matrix3d dR = (Eigen::AngleAxisd(0.02 * std::sin(0.01 * s), Eigen::Vector3d::UnitZ()) *
+                                Eigen::AngleAxisd(0.002 * std::cos(0.013 * s), Eigen::Vector3d::UnitY()))
+                                   .toRotationMatrix();
+    poses.push_back(orthonormalized(poses.back() * make_pose(dR, Eigen::Vector3d(step, 0, 0))));
+  }
+  return poses;
+}
+
+TEST(KittiMetrics, TrajectoryDistancesAccumulatePathLength) {
+  const auto poses = straight_path(11, 0.5);
+  const auto dist = trajectory_distances(poses);
+  ASSERT_EQ(dist.size(), 11u);
+  EXPECT_DOUBLE_EQ(dist[0], 0.0);
+  EXPECT_NEAR(dist[10], 5.0, 1e-12);
+  EXPECT_TRUE(trajectory_distances({}).empty());
+}
+
+TEST(KittiMetrics, OnePercentScaleErrorGivesOnePercentTranslationError) {
+  const auto gt = straight_path(9000, 0.1);  // 900 m: every length 100..800 fits
+  std::vector<Pose> est = gt;
+  for (auto& T : est) T.translation() *= 1.01;
+  const auto m = compute_kitti_metrics(gt, est);
+  // A segment ends at the first frame strictly beyond its length, so it is up
+  // to one 0.1 m step longer: 1 % within 0.15 % of itself.
+  EXPECT_NEAR(m.t_err_percent, 1.0, 1.5e-3);
+  EXPECT_NEAR(m.r_err_deg_per_100m, 0.0, 1e-5);
+  ASSERT_EQ(m.per_length.size(), 8u);
+  std::size_t total = 0;
+  for (const auto& l : m.per_length) {
+    EXPECT_GT(l.segments, 0u) << l.length_m;
+    EXPECT_NEAR(l.t_err_percent, 1.0, 1.5e-3) << l.length_m;
+    total += l.segments;
+  }
+  EXPECT_EQ(total, m.segments);
+  // First frames every 10th frame; a 100 m segment fits from frames 0..7990 (strictly beyond 100 m).
+  EXPECT_EQ(m.per_length[0].segments, 800u);
+  EXPECT_EQ(m.per_length[7].segments, 100u);
+}
+
+TEST(KittiMetrics, ConstantYawDriftGivesItsDegreesPer100m) {
+  const double drift_deg_per_100m = 2.0;
+  const double step = 0.1;
+  const auto gt = straight_path(9000, step);
+  // The estimate turns by an extra, constant yaw per metre driven.
+  std::vector<Pose> est{gt.front()};
+  const Pose increment = make_pose(rot_z(drift_deg_per_100m * kDegToRad / 100.0 * step), Eigen::Vector3d(step, 0, 0));
+  for (std::size_t i = 1; i < gt.size(); ++i) est.push_back(orthonormalized(est.back() * increment));
+  const auto m = compute_kitti_metrics(gt, est);
+  EXPECT_NEAR(m.r_err_deg_per_100m, drift_deg_per_100m, 2e-3 * drift_deg_per_100m);
+  for (const auto& l : m.per_length) EXPECT_NEAR(l.r_err_deg_per_100m, drift_deg_per_100m, 2e-3 * drift_deg_per_100m);
+  EXPECT_GT(m.t_err_percent, 0.1);  // turning away also displaces the end point
+}
+
+TEST(KittiMetrics, IdenticalTrajectoriesGiveZero) {
+  const auto gt = winding_path(2000, 0.8);
+  const auto m = compute_kitti_metrics(gt, gt);
+  ASSERT_GT(m.segments, 0u);
+  EXPECT_NEAR(m.t_err_percent, 0.0, 1e-9);
+  // acos near 1 resolves ~1e-8 rad: "zero" rotation is ~1e-6 deg/100 m.
+  EXPECT_NEAR(m.r_err_deg_per_100m, 0.0, 1e-5);
+}
+
+TEST(KittiMetrics, ShortPathHasNoSegments) {
+  const auto gt = straight_path(50, 1.0);
+  const auto m = compute_kitti_metrics(gt, gt);
+  EXPECT_EQ(m.segments, 0u);
+  EXPECT_TRUE(std::isnan(m.t_err_percent));
+  EXPECT_TRUE(std::isnan(m.r_err_deg_per_100m));
+  for (const auto& l : m.per_length) EXPECT_EQ(l.segments, 0u);
+}
+
+TEST(KittiMetrics, CustomLengthsAndStep) {
+  // Integer positions: distances are exact, so the strict "beyond" rule is testable.
+  std::vector<Pose> gt;
+  for (int i = 0; i <= 100; ++i) gt.push_back(make_pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(i, 0, 0)));
+  KittiOptions options;
+  options.lengths_m = {10, 20};
+  options.step_frames = 5;
+  const auto m = compute_kitti_metrics(gt, gt, options);
+  ASSERT_EQ(m.per_length.size(), 2u);
+  // Start frames 0, 5, ..., 85 fit a 10 m segment (last frame = first + 11 <= 100).
+  EXPECT_EQ(m.per_length[0].segments, 18u);
+  EXPECT_EQ(m.segment_errors.front().last_frame, 11u);
+}
+
+TEST(KittiMetrics, RejectsDifferentSizes) {
+  const auto gt = straight_path(20, 1.0);
+  const std::vector<Pose> est(gt.begin(), gt.begin() + 10);
+  EXPECT_THROW(compute_kitti_metrics(gt, est), std::invalid_argument);
+}
+
+TEST(Umeyama, RecoversKnownSimilarity) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-50.0, 50.0);
+  std::vector<Eigen::Vector3d> source, target;
+  const Eigen::Matrix3d R = (Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
+  const Eigen::Vector3d t(10, -4, 2.5);
+  const double s = 1.7;
+  for (int i = 0; i < 100; ++i) {
+    source.emplace_back(u(rng), u(rng), u(rng));
+    target.push_back(s * R * source.back() + t);
+  }
+  const auto sim = umeyama_alignment(source, target, true);
+  EXPECT_NEAR(sim.scale, s, 1e-9);
+  EXPECT_TRUE(sim.rotation.isApprox(R, 1e-9));
+  EXPECT_TRUE(sim.translation.isApprox(t, 1e-9));
+
+  // Without scale, a rigid transform is recovered exactly.
+  for (std::size_t i = 0; i < source.size(); ++i) target[i] = R * source[i] + t;
+  const auto se3 = umeyama_alignment(source, target, false);
+  EXPECT_DOUBLE_EQ(se3.scale, 1.0);
+  EXPECT_TRUE(se3.rotation.isApprox(R, 1e-9));
+  EXPECT_TRUE(se3.translation.isApprox(t, 1e-9));
+}
+
+TEST(Umeyama, NeverReturnsAReflection) {
+  // Target is a mirror image of the source: the best proper rotation has det +1.
+  std::vector<Eigen::Vector3d> source{{1, 0, 0}, {0, 2, 0}, {0, 0, 3}, {1, 1, 1}, {-2, 1, 0.5}};
+  std::vector<Eigen::Vector3d> target;
+  for (const auto& p : source) target.emplace_back(p.x(), p.y(), -p.z());
+  const auto T = umeyama_alignment(source, target, false);
+  EXPECT_NEAR(T.rotation.determinant(), 1.0, 1e-12);
+  EXPECT_TRUE((T.rotation.transpose() * T.rotation).isIdentity(1e-12));
+}
+
+TEST(Umeyama, RejectsBadInput) {
+  EXPECT_THROW(umeyama_alignment({}, {}, false), std::invalid_argument);
+  EXPECT_THROW(umeyama_alignment({{0, 0, 0}}, {{0, 0, 0}, {1, 1, 1}}, false), std::invalid_argument);
+}
+
+TEST(ErrorStats, RmseMeanMedianMax) {
+  const auto s = error_stats({3.0, 1.0, 4.0, 2.0});
+  EXPECT_EQ(s.count, 4u);
+  EXPECT_DOUBLE_EQ(s.mean, 2.5);
+  EXPECT_DOUBLE_EQ(s.median, 2.5);
+  EXPECT_DOUBLE_EQ(s.max, 4.0);
+  EXPECT_DOUBLE_EQ(s.min, 1.0);
+  EXPECT_DOUBLE_EQ(s.rmse, std::sqrt(30.0 / 4.0));
+  EXPECT_DOUBLE_EQ(error_stats({5.0, 1.0, 3.0}).median, 3.0);
+  EXPECT_TRUE(std::isnan(error_stats({}).rmse));
+}
+
+TEST(Ate, RigidlyMovedCopyHasZeroAlignedError) {
+  const auto gt = winding_path(600, 1.0);
+  const Pose offset = make_pose(Eigen::AngleAxisd(0.3, Eigen::Vector3d(0.2, -0.5, 1).normalized()).toRotationMatrix(),
+                                Eigen::Vector3d(12, -7, 3));
+  std::vector<Pose> est;
+  for (const auto& T : gt) est.push_back(offset * T);
+
+  const auto ate = compute_ate(gt, est, Alignment::kSE3);
+  EXPECT_LT(ate.aligned.rmse, 1e-9);
+  EXPECT_LT(ate.aligned.max, 1e-9);
+  EXPECT_GT(ate.unaligned.rmse, 5.0);
+  EXPECT_TRUE(ate.transform.rotation.isApprox(offset.linear().transpose(), 1e-9));
+  EXPECT_TRUE(ate.transform.apply(offset).isApprox(Pose::Identity(), 1e-9));
+  ASSERT_EQ(ate.aligned_errors.size(), gt.size());
+
+  const auto none = compute_ate(gt, est, Alignment::kNone);
+  EXPECT_DOUBLE_EQ(none.aligned.rmse, none.unaligned.rmse);
+
+  // Relative metrics do not see a rigid offset at all.
+  EXPECT_NEAR(compute_kitti_metrics(gt, est).t_err_percent, 0.0, 1e-9);
+  EXPECT_NEAR(compute_rpe(gt, est).trans_rmse_m, 0.0, 1e-9);
+}
+
+TEST(Ate, KnownOffsetWithoutAlignment) {
+  const auto gt = winding_path(100, 1.0);
+  std::vector<Pose> est = gt;
+  for (auto& T : est) T.translation() += Eigen::Vector3d(0.3, 0.4, 0.0);  // |offset| = 0.5 m
+  const auto ate = compute_ate(gt, est, Alignment::kSE3);
+  EXPECT_NEAR(ate.unaligned.rmse, 0.5, 1e-12);
+  EXPECT_NEAR(ate.unaligned.median, 0.5, 1e-12);
+  EXPECT_LT(ate.aligned.rmse, 1e-9);
+}
+
+TEST(Ate, Sim3RemovesScale) {
+  const auto gt = winding_path(400, 1.0);
+  std::vector<Pose> est;
+  for (const auto& T : gt) {
+    Pose scaled = T;
+    scaled.translation() = 0.5 * T.translation() + Eigen::Vector3d(1, 2, 3);
+    est.push_back(scaled);
+  }
+  const auto sim3 = compute_ate(gt, est, Alignment::kSim3);
+  EXPECT_NEAR(sim3.transform.scale, 2.0, 1e-9);
+  EXPECT_LT(sim3.aligned.rmse, 1e-8);
+  const auto se3 = compute_ate(gt, est, Alignment::kSE3);
+  EXPECT_GT(se3.aligned.rmse, 1.0);
+}
+
+TEST(Ate, ParseAlignment) {
+  EXPECT_EQ(parse_alignment("se3"), Alignment::kSE3);
+  EXPECT_EQ(parse_alignment("SIM3"), Alignment::kSim3);
+  EXPECT_EQ(parse_alignment("none"), Alignment::kNone);
+  EXPECT_THROW(parse_alignment("affine"), std::invalid_argument);
+  EXPECT_EQ(alignment_name(Alignment::kSim3), "sim3");
+}
+
+TEST(Rpe, TranslationPerturbationOfOneFrame) {
+  std::vector<Pose> gt;
+  for (int i = 0; i < 101; ++i) gt.push_back(make_pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(i, 0, 0)));
+  std::vector<Pose> est = gt;
+  const Eigen::Vector3d d(0.0, 0.06, 0.08);  // 0.1 m
+  est[50].translation() += d;
+  const auto rpe = compute_rpe(gt, est);
+  ASSERT_EQ(rpe.trans_errors_m.size(), 100u);
+  for (std::size_t k = 0; k < 100; ++k) {
+    const double expected = (k == 49 || k == 50) ? 0.1 : 0.0;
+    EXPECT_NEAR(rpe.trans_errors_m[k], expected, 1e-12) << k;
+    EXPECT_NEAR(rpe.rot_errors_deg[k], 0.0, 1e-6) << k;
+  }
+  EXPECT_NEAR(rpe.trans_rmse_m, std::sqrt(2 * 0.01 / 100.0), 1e-12);
+  EXPECT_NEAR(rpe.trans.max, 0.1, 1e-12);
+}
+
+TEST(Rpe, RotationPerturbationOfOneFrame) {
+  const auto gt = winding_path(80, 1.0);
+  std::vector<Pose> est = gt;
+  const double angle_deg = 1.5;
+  est[30] = est[30] * make_pose(Eigen::AngleAxisd(angle_deg * kDegToRad, Eigen::Vector3d(0, 1, 1).normalized())
+                                    .toRotationMatrix(),
+                                Eigen::Vector3d::Zero());
+  const auto rpe = compute_rpe(gt, est);
+  ASSERT_EQ(rpe.rot_errors_deg.size(), 79u);
+  for (std::size_t k = 0; k < 79; ++k) {
+    EXPECT_NEAR(rpe.rot_errors_deg[k], (k == 29 || k == 30) ? angle_deg : 0.0, 1e-5) << k;
+  }
+  EXPECT_NEAR(rpe.rot_rmse_deg, angle_deg * std::sqrt(2.0 / 79.0), 1e-5);
+  // Pair 29->30 keeps its translation (the frame turned in place), 30->31 sees
+  // the next 1 m step from a rotated frame: 2 sin(angle/2) m off.
+  EXPECT_NEAR(rpe.trans_errors_m[29], 0.0, 1e-9);
+  EXPECT_NEAR(rpe.trans_errors_m[30], 2.0 * std::sin(0.5 * angle_deg * kDegToRad), 1e-9);
+}
+
+TEST(Rpe, LargerDelta) {
+  const auto gt = winding_path(50, 1.0);
+  const auto rpe = compute_rpe(gt, gt, 10);
+  EXPECT_EQ(rpe.delta, 10u);
+  EXPECT_EQ(rpe.trans_errors_m.size(), 40u);
+  EXPECT_NEAR(rpe.trans_rmse_m, 0.0, 1e-9);
+  EXPECT_THROW(compute_rpe(gt, gt, 0), std::invalid_argument);
+}
+
+TEST(EvaluateTrajectories, IdenticalTrajectoriesAreZeroEverywhere) {
+  const auto gt = winding_path(1500, 0.9);
+  const auto ev = evaluate_trajectories(gt, gt);
+  EXPECT_TRUE(ev.warnings.empty());
+  EXPECT_EQ(ev.evaluated_poses, 1500u);
+  EXPECT_NEAR(ev.gt_length_m, 1499 * 0.9, 1e-6);
+  ASSERT_GT(ev.kitti.segments, 0u);
+  EXPECT_NEAR(ev.kitti.t_err_percent, 0.0, 1e-9);
+  EXPECT_NEAR(ev.kitti.r_err_deg_per_100m, 0.0, 1e-5);
+  EXPECT_NEAR(ev.ate.aligned.rmse, 0.0, 1e-9);
+  EXPECT_NEAR(ev.ate.unaligned.rmse, 0.0, 1e-12);
+  EXPECT_NEAR(ev.rpe.trans_rmse_m, 0.0, 1e-9);
+  EXPECT_NEAR(ev.rpe.rot_rmse_deg, 0.0, 1e-5);
+}
+
+TEST(EvaluateTrajectories, ShorterEstimateUsesCommonPrefixWithWarning) {
+  const auto gt = winding_path(1500, 0.9);
+  std::vector<Pose> est;
+  for (const auto& T : gt) {
+    Pose noisy = T;
+    noisy.translation() *= 1.02;
+    est.push_back(noisy);
+  }
+  const std::vector<Pose> est_short(est.begin(), est.begin() + 1200);
+  const auto ev = evaluate_trajectories(gt, est_short);
+  EXPECT_EQ(ev.gt_poses, 1500u);
+  EXPECT_EQ(ev.est_poses, 1200u);
+  EXPECT_EQ(ev.evaluated_poses, 1200u);
+  ASSERT_EQ(ev.warnings.size(), 1u);
+  EXPECT_NE(ev.warnings[0].find("first 1200 poses"), std::string::npos) << ev.warnings[0];
+
+  const std::vector<Pose> gt_prefix(gt.begin(), gt.begin() + 1200);
+  const auto expected = evaluate_trajectories(gt_prefix, est_short);
+  EXPECT_DOUBLE_EQ(ev.kitti.t_err_percent, expected.kitti.t_err_percent);
+  EXPECT_DOUBLE_EQ(ev.ate.aligned.rmse, expected.ate.aligned.rmse);
+  EXPECT_DOUBLE_EQ(ev.rpe.trans_rmse_m, expected.rpe.trans_rmse_m);
+  EXPECT_EQ(ev.ate.aligned_errors.size(), 1200u);
+
+  // A longer estimate is cut the same way.
+  const auto longer = evaluate_trajectories(gt_prefix, est);
+  EXPECT_EQ(longer.evaluated_poses, 1200u);
+  EXPECT_EQ(longer.warnings.size(), 1u);
+}
+
+TEST(EvaluateTrajectories, NoOverlapIsAnError) {
+  const auto gt = winding_path(10, 1.0);
+  EXPECT_THROW(evaluate_trajectories(gt, {}), std::invalid_argument);
+  EXPECT_THROW(evaluate_trajectories({}, gt), std::invalid_argument);
+}
+
+TEST(EvaluateTrajectories, ShortPathWarnsAboutKitti) {
+  const auto gt = winding_path(30, 1.0);
+  const auto ev = evaluate_trajectories(gt, gt);
+  EXPECT_EQ(ev.kitti.segments, 0u);
+  ASSERT_EQ(ev.warnings.size(), 1u);
+  EXPECT_NE(ev.warnings[0].find("shorter than the shortest KITTI segment"), std::string::npos);
+  EXPECT_NEAR(ev.ate.aligned.rmse, 0.0, 1e-9);
+}
+
+TEST(EvaluateTrajectories, Sim3OptionReachesAte) {
+  const auto gt = winding_path(300, 1.0);
+  std::vector<Pose> est = gt;
+  for (auto& T : est) T.translation() *= 0.8;
+  EvaluationOptions options;
+  options.alignment = Alignment::kSim3;
+  const auto ev = evaluate_trajectories(gt, est, options);
+  EXPECT_EQ(ev.ate.alignment, Alignment::kSim3);
+  EXPECT_NEAR(ev.ate.transform.scale, 1.25, 1e-9);
+  EXPECT_LT(ev.ate.aligned.rmse, 1e-8);
+  // KITTI and RPE are computed on the unaligned estimate: the scale error stays
+  // visible (every 1 m step is 0.2 m short; KITTI sees 20 % of the chord, which
+  // is shorter than the curved segment).
+  EXPECT_NEAR(ev.rpe.trans_rmse_m, 0.2, 1e-9);
+  EXPECT_GT(ev.kitti.t_err_percent, 10.0);
+  EXPECT_LT(ev.kitti.t_err_percent, 20.0 + 1e-9);
+}
+
+}  // namespace
+}  // namespace saloam
