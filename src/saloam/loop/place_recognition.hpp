@@ -1,0 +1,59 @@
+#pragma once
+// Place-recognition evaluation (SGPR's protocol): every frame is compared with
+// the earlier frames except the most recent ones; a pair is a true match when
+// the two scans are within `positive_distance`, a true non-match beyond
+// `negative_distance`, and ignored in between. Scores are swept over all
+// pairs to give a precision-recall curve.
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace saloam {
+
+struct PlaceEvalConfig {
+  double positive_distance = 3.0;   ///< [m] pairs closer than this are matches
+  double negative_distance = 20.0;  ///< [m] pairs farther than this are non-matches
+  std::size_t exclude_recent = 50;  ///< frames just before the query that are not compared
+};
+
+/// One evaluated pair: query frame, earlier candidate frame, truth.
+struct PlacePair {
+  std::uint32_t query = 0;
+  std::uint32_t candidate = 0;
+  bool positive = false;
+};
+
+/// All pairs (i, j) with j < i - exclude_recent whose distance is within
+/// positive_distance (positive) or beyond negative_distance (negative),
+/// ordered by query then candidate. Distances are between the positions given.
+std::vector<PlacePair> place_pairs(std::span<const Eigen::Vector3d> positions, const PlaceEvalConfig& config = {});
+
+struct PrPoint {
+  double threshold = 0;  ///< pairs with score >= threshold are predicted matches
+  double precision = 0;
+  double recall = 0;
+};
+
+struct PrSummary {
+  std::size_t positives = 0, negatives = 0;
+  std::vector<PrPoint> curve;  ///< one point per distinct score, decreasing threshold
+  double max_f1 = 0;
+  double max_f1_threshold = 0;
+  double max_f1_precision = 0, max_f1_recall = 0;
+  double precision_at_full_recall = 0;  ///< precision when every positive is accepted
+  double recall_at_full_precision = 0;  ///< largest recall with no false positive
+};
+
+/// Precision-recall analysis of scores (higher = more similar) against truth.
+/// Ties are handled as one threshold. With no positives all metrics are 0.
+PrSummary precision_recall(std::span<const double> scores, std::span<const std::uint8_t> positive);
+
+/// At most `max_points` points of a curve, evenly spread over its length,
+/// always keeping the first and last points and the max-F1 point.
+std::vector<PrPoint> thin_curve(const PrSummary& summary, std::size_t max_points);
+
+}  // namespace saloam
