@@ -1,0 +1,64 @@
+// `saloam render`: pictures of a sequence (top-down labelled map with the
+// trajectory, and a range image of one scan), to judge data by eye.
+
+#include <iostream>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "command.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/sim/render.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct RenderArgs {
+  std::string sequence;
+  std::string out;
+  std::size_t frame = 0;
+  double resolution = 0.25;
+  std::size_t frame_step = 0;
+  std::string labels_dir;
+};
+
+int run_render(const RenderArgs& args) {
+  const std::filesystem::path out(args.out);
+  std::filesystem::create_directories(out);
+  SequenceOptions seq_options;
+  if (!args.labels_dir.empty()) seq_options.labels_dir = args.labels_dir;
+  const SequenceReader reader(args.sequence, seq_options);
+  if (args.frame >= reader.size()) {
+    throw InputError(args.sequence, fmt::format("--frame {} out of range: the sequence has {} scans", args.frame, reader.size()));
+  }
+  const auto range_png = out / fmt::format("range_{}.png", frame_name(args.frame));
+  sim::render_range_image(reader.load_scan(args.frame), range_png);
+  std::cout << "range image: " << range_png.string() << '\n';
+
+  sim::MapRenderOptions options;
+  options.metres_per_pixel = args.resolution;
+  options.frame_step = args.frame_step;
+  options.show_progress = spdlog::get_level() <= spdlog::level::info;
+  const auto map_png = out / "map.png";
+  const sim::MapRenderStats s = sim::render_map(args.sequence, map_png, options);
+  std::cout << fmt::format("map: {} ({}x{} px, {:.2f} m/px, {} scans, {} points)\n", map_png.string(), s.width, s.height,
+                           s.metres_per_pixel, s.scans_used, s.points_drawn);
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "render", "Draw a sequence: top-down labelled map with the trajectory, and a range image of one scan", 80,
+    [](CLI::App& app) {
+      auto args = std::make_shared<RenderArgs>();
+      app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt, calib.txt)")->required();
+      app.add_option("--out", args->out, "Output folder for map.png and range_NNNNNN.png")->required();
+      app.add_option("--frame", args->frame, "Scan shown as a range image (default 0)");
+      app.add_option("--resolution", args->resolution, "Map metres per pixel (default 0.25)")->check(CLI::PositiveNumber);
+      app.add_option("--frame-step", args->frame_step, "Accumulate every n-th scan (default: about 300 scans)");
+      app.add_option("--labels-dir", args->labels_dir, "Labels folder instead of labels/ (e.g. labels_gt or predictions)");
+      return [args] { return run_render(*args); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli

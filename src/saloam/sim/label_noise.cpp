@@ -1,0 +1,152 @@
+#include "saloam/sim/label_noise.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "saloam/core/error.hpp"
+
+namespace saloam::sim {
+namespace {
+
+// Learning class ids (SemanticKITTI order).
+enum L : std::uint8_t {
+  kCar = 1, kBicycle, kMotorcycle, kTruck, kOtherVehicle, kPerson, kBicyclist, kMotorcyclist, kRoad, kParking,
+  kSidewalk, kOtherGround, kBuilding, kFence, kVegetation, kTrunk, kTerrain, kPole, kTrafficSign
+};
+
+struct Confusion {
+  double rate;                    // chance that a blob of this class is mislabelled
+  std::array<std::uint8_t, 3> to; // what it is mistaken for (first = most likely)
+};
+
+// Rates loosely follow where RangeNet++ is weak: parking, other-ground,
+// trucks, other vehicles, fences, trunks, poles and signs.
+Confusion confusion_of(std::uint8_t c) {
+  switch (c) {
+    case kCar: return {0.04, {kTruck, kOtherVehicle, kCar}};
+    case kTruck: return {0.55, {kCar, kOtherVehicle, kBuilding}};
+    case kOtherVehicle: return {0.5, {kCar, kTruck, kBuilding}};
+    case kPerson: return {0.15, {kBicyclist, kPole, kVegetation}};
+    case kRoad: return {0.03, {kParking, kSidewalk, kRoad}};
+    case kParking: return {0.45, {kRoad, kSidewalk, kTerrain}};
+    case kSidewalk: return {0.12, {kRoad, kParking, kTerrain}};
+    case kOtherGround: return {0.6, {kSidewalk, kTerrain, kRoad}};
+    case kBuilding: return {0.06, {kFence, kVegetation, kBuilding}};
+    case kFence: return {0.4, {kBuilding, kVegetation, kTerrain}};
+    case kVegetation: return {0.06, {kTerrain, kTrunk, kBuilding}};
+    case kTrunk: return {0.3, {kVegetation, kPole, kTrunk}};
+    case kTerrain: return {0.12, {kVegetation, kSidewalk, kTerrain}};
+    case kPole: return {0.25, {kTrafficSign, kTrunk, kBuilding}};
+    case kTrafficSign: return {0.25, {kPole, kBuilding, kPole}};
+    default: return {0.3, {kBuilding, kFence, kBuilding}};
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int beams, int columns, std::uint64_t seed,
+                                                const LabelNoiseOptions& options) {
+  const std::size_t n = scan.cloud.size();
+  if (scan.ring.size() != n || scan.column.size() != n) throw ConfigError("scan without range-image indices");
+  // Ground-truth learning classes on the range image (-1 = no return).
+  std::vector<std::int32_t> image(static_cast<std::size_t>(beams) * static_cast<std::size_t>(columns), -1);
+  std::vector<std::uint8_t> truth(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint8_t c = to_learning_class(scan.cloud.label[i]);
+    if (c == 0) c = kBuilding;  // other-structure etc.: the network calls it something solid
+    truth[i] = c;
+    image[static_cast<std::size_t>(scan.ring[i]) * static_cast<std::size_t>(columns) + scan.column[i]] =
+        static_cast<std::int32_t>(i);
+  }
+  std::vector<std::uint8_t> out(truth);
+  Rng rng(hash_combine(seed, 0x1abe1ull));
+
+  // 1. Blurry class boundaries: range-image networks smear labels across edges.
+  for (std::size_t i = 0; i < n; ++i) {
+    const int r = scan.ring[i], c = scan.column[i];
+    std::array<std::uint8_t, 16> other{};
+    int n_other = 0;
+    for (int dr = -1; dr <= 1; ++dr) {
+      for (int dc = -options.boundary_columns; dc <= options.boundary_columns; ++dc) {
+        const int rr = r + dr, cc = (c + dc + columns) % columns;
+        if ((dr == 0 && dc == 0) || rr < 0 || rr >= beams) continue;
+        const std::int32_t j = image[static_cast<std::size_t>(rr) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(cc)];
+        if (j >= 0 && truth[static_cast<std::size_t>(j)] != truth[i] && n_other < 16) other[static_cast<std::size_t>(n_other++)] = truth[static_cast<std::size_t>(j)];
+      }
+    }
+    const double u = rng.uniform(), v = rng.uniform();
+    if (n_other > 0 && u < options.boundary_flip) out[i] = other[static_cast<std::size_t>(v * n_other)];
+  }
+
+  // 2. Correlated confusions between similar classes, blob by blob.
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t block = hash3(static_cast<std::uint64_t>(scan.ring[i] / options.block_rings),
+                                      static_cast<std::uint64_t>(scan.column[i] / options.block_columns), truth[i]);
+    Rng blob(hash_combine(seed, block));
+    const Confusion conf = confusion_of(truth[i]);
+    if (blob.uniform() < conf.rate * options.confusion_scale) {
+      const double pick = blob.uniform();
+      out[i] = conf.to[pick < 0.6 ? 0 : (pick < 0.85 ? 1 : 2)];
+    }
+  }
+
+  // 3. A few plainly wrong labels.
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u = rng.uniform(), v = rng.uniform();
+    if (u < options.random_label) out[i] = static_cast<std::uint8_t>(1 + static_cast<int>(v * 19));
+  }
+
+  std::vector<std::uint16_t> labels(n);
+  for (std::size_t i = 0; i < n; ++i) labels[i] = from_learning_class(out[i]);
+  return labels;
+}
+
+void SegmentationScore::add(const std::vector<std::uint16_t>& truth, const std::vector<std::uint16_t>& predicted) {
+  if (truth.size() != predicted.size()) throw ConfigError("label vectors of different sizes");
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    ++confusion_[to_learning_class(truth[i])][to_learning_class(predicted[i])];
+  }
+}
+
+std::uint64_t SegmentationScore::truth_count(int c) const {
+  std::uint64_t sum = 0;
+  for (int p = 0; p < kNumLearningClasses; ++p) sum += confusion_[static_cast<std::size_t>(c)][static_cast<std::size_t>(p)];
+  return sum;
+}
+
+double SegmentationScore::iou(int c) const {
+  // As in the SemanticKITTI API: points whose truth is ignored (0) do not count.
+  const auto uc = static_cast<std::size_t>(c);
+  const std::uint64_t tp = confusion_[uc][uc];
+  std::uint64_t fn = 0, fp = 0;
+  for (std::size_t k = 1; k < static_cast<std::size_t>(kNumLearningClasses); ++k) {
+    if (k == uc) continue;
+    fn += confusion_[uc][k];
+    fp += confusion_[k][uc];
+  }
+  fn += confusion_[uc][0];
+  const std::uint64_t denom = tp + fp + fn;
+  return denom == 0 ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(tp) / static_cast<double>(denom);
+}
+
+double SegmentationScore::miou() const {
+  double sum = 0;
+  int count = 0;
+  for (int c = 1; c < kNumLearningClasses; ++c) {
+    if (truth_count(c) == 0) continue;
+    sum += iou(c);
+    ++count;
+  }
+  return count == 0 ? std::numeric_limits<double>::quiet_NaN() : sum / count;
+}
+
+double SegmentationScore::accuracy() const {
+  std::uint64_t ok = 0, all = 0;
+  for (std::size_t c = 1; c < static_cast<std::size_t>(kNumLearningClasses); ++c) {
+    for (std::size_t p = 0; p < static_cast<std::size_t>(kNumLearningClasses); ++p) all += confusion_[c][p];
+    ok += confusion_[c][c];
+  }
+  return all == 0 ? 0.0 : static_cast<double>(ok) / static_cast<double>(all);
+}
+
+}  // namespace saloam::sim

@@ -1,0 +1,121 @@
+#include "saloam/sim/lidar.hpp"
+
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+
+namespace saloam::sim {
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+}  // namespace
+
+LidarModel LidarModel::hdl64e(int beams) {
+  if (beams != 64 && beams != 32 && beams != 16) throw ConfigError("beams must be 64, 32 or 16");
+  LidarModel m;
+  std::vector<double> all;
+  for (int i = 0; i < 32; ++i) all.push_back(2.0 - (2.0 + 8.33) * i / 31.0);
+  for (int i = 0; i < 32; ++i) all.push_back(-8.83 - (24.9 - 8.83) * i / 31.0);
+  const int step = 64 / beams;
+  for (int i = 0; i < 64; i += step) m.elevation_deg.push_back(all[static_cast<std::size_t>(i)]);
+  return m;
+}
+
+double LidarModel::column_fraction(int column) const { return (column + 0.5) / azimuth_steps; }
+
+double LidarModel::column_azimuth(int column) const { return kPi - 2.0 * kPi * column_fraction(column); }
+
+SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep) {
+  const int columns = lidar.azimuth_steps, beams = lidar.beams();
+  if (columns <= 0 || beams <= 0) throw ConfigError("lidar model needs beams and azimuth steps");
+  struct Return {
+    Eigen::Vector3f point;
+    float remission;
+    float range;
+    std::uint16_t label, instance;
+    bool valid;
+  };
+  std::vector<Return> grid(static_cast<std::size_t>(columns) * static_cast<std::size_t>(beams));
+  std::vector<double> sin_el(static_cast<std::size_t>(beams)), cos_el(static_cast<std::size_t>(beams));
+  for (int b = 0; b < beams; ++b) {
+    const double e = lidar.elevation_deg[static_cast<std::size_t>(b)] * kPi / 180.0;
+    sin_el[static_cast<std::size_t>(b)] = std::sin(e);
+    cos_el[static_cast<std::size_t>(b)] = std::cos(e);
+  }
+  const Pose start_inv = sweep.start.inverse();
+
+  tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
+    std::vector<Primitive> agents, near;
+    for (int c = range.begin(); c < range.end(); ++c) {
+      const double frac = lidar.column_fraction(c);
+      const Pose sensor = sweep.skew ? interpolate(sweep.start, sweep.end, frac) : sweep.start;
+      const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
+      const double az = lidar.column_azimuth(c);
+      const Eigen::Vector3d origin = sensor.translation();
+      // Moving objects at this column's time, kept only near the column's vertical plane.
+      world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
+      const Eigen::Vector3d heading = sensor.linear() * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0);
+      Eigen::Vector2d h2 = heading.head<2>();
+      if (h2.norm() > 1e-9) h2.normalize();
+      near.clear();
+      for (const auto& p : agents) {
+        const Eigen::Vector2d rel = p.center.cast<double>() - origin.head<2>();
+        const double along = rel.dot(h2), across = std::abs(rel.x() * h2.y() - rel.y() * h2.x());
+        if (along > -p.footprint_radius() && across < p.footprint_radius() + 0.05) near.push_back(p);
+      }
+      Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
+      for (int b = 0; b < beams; ++b) {
+        const Eigen::Vector3d dir_s(cos_el[static_cast<std::size_t>(b)] * std::cos(az),
+                                    cos_el[static_cast<std::size_t>(b)] * std::sin(az), sin_el[static_cast<std::size_t>(b)]);
+        const Eigen::Vector3d dir = sensor.linear() * dir_s;
+        Return& out = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
+        out.valid = false;
+        const RayHit hit = world.cast_ray(origin, dir, lidar.max_range, t, near, rng);
+        // Draw every random number whether or not it is used, so that one
+        // ray's outcome never shifts the noise of the next.
+        const double noise = rng.normal() * lidar.range_noise;
+        const double drop = rng.uniform();
+        const double rem_noise = rng.normal() * lidar.remission_noise;
+        if (!hit.hit) continue;
+        const double range_m = hit.range + noise;
+        if (range_m < lidar.min_range || range_m > lidar.max_range) continue;
+        // Weak far returns from dark surfaces are lost more often.
+        const double far = range_m / lidar.max_range;
+        const double p_drop = lidar.dropout + 0.25 * far * far * (1.0 - std::min(1.0, static_cast<double>(hit.remission) * 2.0));
+        if (drop < p_drop) continue;
+        const Eigen::Vector3d world_point = origin + range_m * dir;
+        out.point = (start_inv * world_point).cast<float>();
+        out.remission = static_cast<float>(std::clamp(hit.remission + rem_noise, 0.0, 0.99));
+        out.range = static_cast<float>(range_m);
+        out.label = hit.label;
+        out.instance = hit.instance;
+        out.valid = true;
+      }
+    }
+  });
+
+  SimulatedScan scan;
+  std::size_t count = 0;
+  for (const auto& r : grid) count += r.valid ? 1 : 0;
+  scan.cloud.reserve(count);
+  scan.ring.reserve(count);
+  scan.column.reserve(count);
+  scan.range.reserve(count);
+  for (int b = 0; b < beams; ++b) {
+    for (int c = 0; c < columns; ++c) {
+      const Return& r = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
+      if (!r.valid) continue;
+      scan.cloud.push_back(r.point, r.remission, r.label, r.instance);
+      scan.ring.push_back(static_cast<std::uint16_t>(b));
+      scan.column.push_back(static_cast<std::uint16_t>(c));
+      scan.range.push_back(r.range);
+    }
+  }
+  scan.cloud.has_labels = true;
+  return scan;
+}
+
+}  // namespace saloam::sim

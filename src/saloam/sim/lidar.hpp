@@ -1,0 +1,61 @@
+#pragma once
+// A spinning multi-beam LiDAR (Velodyne HDL-64E as in KITTI) and the ray
+// casting of one sweep in a simulated World.
+//
+// Sweep convention: the head spins clockwise seen from above (azimuth
+// decreasing), starting and ending behind the car (azimuth +-180 deg), like
+// KITTI's scans. Column c is fired at time t0 + period * (c + 0.5) / columns
+// at azimuth pi - 2 pi (c + 0.5) / columns. Points are written ring by ring
+// (top beam first), each ring in firing order, and are expressed in the
+// sensor frame at sweep start.
+
+#include <cstdint>
+#include <vector>
+
+#include "saloam/core/types.hpp"
+#include "saloam/sim/world.hpp"
+
+namespace saloam::sim {
+
+struct LidarModel {
+  std::vector<double> elevation_deg;  ///< beam elevations, top to bottom
+  int azimuth_steps = 2083;           ///< columns per turn
+  double min_range = 2.5, max_range = 120.0;
+  double range_noise = 0.02;          ///< Gaussian sigma [m]
+  double dropout = 0.05;              ///< probability that a return is lost
+  double sweep_period = 0.1;          ///< [s]
+  double remission_noise = 0.04;
+
+  /// HDL-64E: upper block of 32 beams from +2 to -8.33 deg, lower block of 32
+  /// from -8.83 to -24.9 deg. With beams = 32 or 16, every 2nd / 4th beam.
+  static LidarModel hdl64e(int beams = 64);
+  [[nodiscard]] int beams() const { return static_cast<int>(elevation_deg.size()); }
+  /// Azimuth [rad] and time fraction within the sweep of column c.
+  [[nodiscard]] double column_azimuth(int column) const;
+  [[nodiscard]] double column_fraction(int column) const;
+};
+
+/// One sweep: sensor poses at sweep start and at the start of the next sweep
+/// (T_W<-L), the world times of both, and the noise seed.
+struct SweepSpec {
+  Pose start = Pose::Identity();
+  Pose end = Pose::Identity();
+  double time_start = 0;
+  double time_end = 0.1;
+  std::uint64_t seed = 0;
+  bool skew = true;  ///< false: every column at `start` and `time_start`
+};
+
+/// A simulated scan with the range-image position of every point.
+struct SimulatedScan {
+  LabelledCloud cloud;              ///< sensor frame at sweep start, ground-truth labels
+  std::vector<std::uint16_t> ring;  ///< beam index (0 = top)
+  std::vector<std::uint16_t> column;
+  std::vector<float> range;         ///< measured range [m]
+};
+
+/// Ray casts one sweep (columns in parallel; the output does not depend on
+/// the number of threads).
+SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep);
+
+}  // namespace saloam::sim

@@ -1,0 +1,161 @@
+#include "saloam/sim/render.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/progress.hpp"
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/sim/lidar.hpp"
+#include "saloam/viz/canvas.hpp"
+
+namespace fs = std::filesystem;
+
+namespace saloam::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Rgb shade(Rgb c, double f) {
+  auto s = [&](std::uint8_t v) { return static_cast<std::uint8_t>(std::clamp(v * f, 0.0, 255.0)); };
+  return {s(c.r), s(c.g), s(c.b)};
+}
+
+void draw_line(RasterImage& img, Eigen::Vector2d a, Eigen::Vector2d b, Rgb color, int thickness) {
+  const double len = (b - a).norm();
+  const int steps = std::max(1, static_cast<int>(std::ceil(len * 2)));
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / steps);
+    for (int dy = -thickness; dy <= thickness; ++dy) {
+      for (int dx = -thickness; dx <= thickness; ++dx) {
+        const int x = static_cast<int>(std::lround(p.x())) + dx, y = static_cast<int>(std::lround(p.y())) + dy;
+        if (x >= 0 && y >= 0 && x < img.width() && y < img.height()) img.set(x, y, color);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+MapRenderStats render_map(const fs::path& sequence_dir, const fs::path& png, const MapRenderOptions& options) {
+  const SequenceReader reader(sequence_dir);
+  const std::vector<Pose> poses = reader.lidar_poses();
+  const std::size_t n = reader.size();
+  const std::size_t step = options.frame_step > 0 ? options.frame_step : std::max<std::size_t>(1, n / 300);
+
+  // Extent: trajectory plus the range kept around it.
+  Eigen::Vector2d lo = poses.front().translation().head<2>(), hi = lo;
+  for (std::size_t i = 0; i < n; ++i) {
+    lo = lo.cwiseMin(poses[i].translation().head<2>());
+    hi = hi.cwiseMax(poses[i].translation().head<2>());
+  }
+  const double margin = std::min(options.max_range, 50.0);
+  lo.array() -= margin;
+  hi.array() += margin;
+  double mpp = options.metres_per_pixel;
+  const double longest = std::max(hi.x() - lo.x(), hi.y() - lo.y());
+  if (longest / mpp > options.max_pixels) mpp = longest / options.max_pixels;
+  MapRenderStats stats;
+  stats.width = static_cast<int>(std::ceil((hi.x() - lo.x()) / mpp));
+  stats.height = static_cast<int>(std::ceil((hi.y() - lo.y()) / mpp));
+  stats.metres_per_pixel = mpp;
+  const auto npx = static_cast<std::size_t>(stats.width) * static_cast<std::size_t>(stats.height);
+  std::vector<float> top(npx, -std::numeric_limits<float>::infinity());
+  std::vector<std::uint16_t> label(npx, 0);
+  std::vector<float> ground_z(npx, std::numeric_limits<float>::infinity());
+
+  auto pixel = [&](const Eigen::Vector2d& p) {
+    return Eigen::Vector2d((p.x() - lo.x()) / mpp, (hi.y() - p.y()) / mpp);  // north up
+  };
+  ProgressBar progress((n + step - 1) / step, "render map", options.show_progress);
+  for (std::size_t i = 0; i < n; i += step) {
+    if (stop_requested()) break;
+    const LabelledCloud cloud = reader.load_scan(i);
+    const Pose& T = poses[i];
+    for (std::size_t k = 0; k < cloud.size(); ++k) {
+      const Eigen::Vector3f& q = cloud.points[k];
+      if (q.head<2>().norm() > options.max_range) continue;
+      const Eigen::Vector3d w = T * q.cast<double>();
+      const Eigen::Vector2d px = pixel(w.head<2>());
+      const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
+      if (x < 0 || y < 0 || x >= stats.width || y >= stats.height) continue;
+      const std::size_t idx = static_cast<std::size_t>(y) * static_cast<std::size_t>(stats.width) + static_cast<std::size_t>(x);
+      const auto z = static_cast<float>(w.z());
+      if (z > top[idx]) {
+        top[idx] = z;
+        label[idx] = cloud.has_labels ? cloud.label[k] : 0;
+      }
+      ground_z[idx] = std::min(ground_z[idx], z);
+      ++stats.points_drawn;
+    }
+    ++stats.scans_used;
+    progress.advance();
+  }
+  progress.finish();
+
+  RasterImage img(stats.width, stats.height, {18, 18, 22});
+  for (int y = 0; y < stats.height; ++y) {
+    for (int x = 0; x < stats.width; ++x) {
+      const std::size_t idx = static_cast<std::size_t>(y) * static_cast<std::size_t>(stats.width) + static_cast<std::size_t>(x);
+      if (!std::isfinite(top[idx])) continue;
+      Rgb c = label[idx] == 0 ? Rgb{160, 160, 160} : class_color(label[idx]);
+      // Taller things brighter: gives the map some relief.
+      const double height = top[idx] - ground_z[idx];
+      c = shade(c, 0.75 + 0.25 * std::min(1.0, height / 8.0));
+      img.set(x, y, c);
+    }
+  }
+  for (std::size_t i = 1; i < n; ++i) {
+    draw_line(img, pixel(poses[i - 1].translation().head<2>()), pixel(poses[i].translation().head<2>()), {255, 255, 255}, 1);
+  }
+  // Start (green) and end (red) markers.
+  auto dot = [&](const Eigen::Vector2d& p, Rgb c) { draw_line(img, p, p, c, 5); };
+  dot(pixel(poses.front().translation().head<2>()), {0, 230, 0});
+  dot(pixel(poses.back().translation().head<2>()), {230, 0, 0});
+  img.save_png(png);
+  return stats;
+}
+
+void render_range_image(const LabelledCloud& cloud, const fs::path& png, int columns) {
+  const LidarModel lidar = LidarModel::hdl64e(64);
+  const int rows = lidar.beams();
+  // Beam row from the elevation: nearest HDL-64E beam.
+  auto row_of = [&](double elevation_deg) {
+    int best = 0;
+    double best_d = 1e9;
+    for (int b = 0; b < rows; ++b) {
+      const double d = std::abs(lidar.elevation_deg[static_cast<std::size_t>(b)] - elevation_deg);
+      if (d < best_d) {
+        best_d = d;
+        best = b;
+      }
+    }
+    return best_d < 1.0 ? best : -1;
+  };
+  RasterImage img(columns, 2 * rows + 2, {0, 0, 0});
+  std::vector<float> depth(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), std::numeric_limits<float>::infinity());
+  for (std::size_t k = 0; k < cloud.size(); ++k) {
+    const Eigen::Vector3f& p = cloud.points[k];
+    const double r = p.norm();
+    if (r < 1e-3) continue;
+    const double el = std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / kPi;
+    const int row = row_of(el);
+    if (row < 0) continue;
+    // Front in the middle, left of the car on the left of the picture.
+    const double az = std::atan2(p.y(), p.x());
+    int col = static_cast<int>((0.5 - az / (2 * kPi)) * columns);
+    col = std::clamp(col, 0, columns - 1);
+    const std::size_t idx = static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(col);
+    if (r >= depth[idx]) continue;
+    depth[idx] = static_cast<float>(r);
+    const std::uint16_t lab = cloud.has_labels ? cloud.label[k] : 0;
+    img.set(col, row, lab == 0 ? Rgb{160, 160, 160} : class_color(lab));
+    img.set(col, rows + 2 + row, viridis(1.0 - std::min(1.0, std::log1p(r) / std::log1p(80.0))));
+  }
+  img.save_png(png, 1, 4);
+}
+
+}  // namespace saloam::sim

@@ -1,0 +1,38 @@
+#pragma once
+// Pictures of a (simulated or real) SemanticKITTI sequence for judging it by
+// eye: a top-down map of all scans accumulated with the ground-truth poses,
+// coloured by class with the trajectory drawn, and a range image of one scan.
+
+#include <cstddef>
+#include <filesystem>
+
+#include "saloam/core/types.hpp"
+
+namespace saloam::sim {
+
+struct MapRenderOptions {
+  double metres_per_pixel = 0.25;  ///< widened automatically to respect max_pixels
+  int max_pixels = 3200;           ///< longest image side
+  std::size_t frame_step = 0;      ///< use every n-th scan (0 = automatic, about 300 scans)
+  double max_range = 60.0;         ///< ignore points further than this from the sensor
+  bool show_progress = true;
+};
+
+struct MapRenderStats {
+  std::size_t scans_used = 0;
+  std::size_t points_drawn = 0;
+  int width = 0, height = 0;
+  double metres_per_pixel = 0;
+};
+
+/// Top-down map of the sequence at `sequence_dir` (needs poses.txt and
+/// calib.txt) written to `png`; the highest point per pixel wins, so
+/// buildings and trees show over the ground as in an aerial view.
+MapRenderStats render_map(const std::filesystem::path& sequence_dir, const std::filesystem::path& png,
+                          const MapRenderOptions& options = {});
+
+/// Range image of one scan (rows = HDL-64E beams by elevation, columns =
+/// azimuth, front in the middle): class colours on top, range below.
+void render_range_image(const LabelledCloud& cloud, const std::filesystem::path& png, int columns = 1040);
+
+}  // namespace saloam::sim

@@ -1,0 +1,134 @@
+#include "saloam/sim/simulator.hpp"
+
+#include <chrono>
+
+#include <fmt/format.h>
+
+#include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/core/progress.hpp"
+#include "saloam/io/calibration.hpp"
+#include "saloam/io/scan_io.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/io/trajectory_io.hpp"
+#include "saloam/sim/trajectories.hpp"
+
+namespace fs = std::filesystem;
+
+namespace saloam::sim {
+
+Pose output_velo_to_cam(const SimulationOptions& options) {
+  return options.velo_to_cam_given ? options.velo_to_cam : kitti_velo_to_cam();
+}
+
+std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options) {
+  if (!options.camera_poses.empty()) {
+    if (!options.velo_to_cam_given) throw ConfigError("a camera-frame trajectory needs its velodyne-to-camera Tr");
+    return camera_to_lidar_poses(options.camera_poses, options.velo_to_cam);
+  }
+  return preset_trajectory(options.preset, options.frame_period);
+}
+
+std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::size_t trajectory_size) {
+  if (options.stride == 0) throw ConfigError("stride must be at least 1");
+  const std::size_t end = std::min(options.end_frame, trajectory_size);
+  if (options.first_frame >= end) {
+    throw ConfigError(fmt::format("frame range {}:{} selects nothing (the trajectory has {} poses)", options.first_frame,
+                                  options.end_frame == std::numeric_limits<std::size_t>::max() ? std::string{}
+                                                                                                : std::to_string(options.end_frame),
+                                  trajectory_size));
+  }
+  std::vector<std::size_t> frames;
+  for (std::size_t i = options.first_frame; i < end; i += options.stride) frames.push_back(i);
+  return frames;
+}
+
+SweepSpec sweep_for_frame(const std::vector<Pose>& traj, std::size_t i, std::size_t stride,
+                          const SimulationOptions& options) {
+  SweepSpec s;
+  s.start = traj.at(i);
+  const double period = options.frame_period;
+  if (i + stride < traj.size()) {
+    s.end = traj[i + stride];
+  } else if (i >= stride) {  // last frame: continue the previous motion
+    s.end = orthonormalized(traj[i] * (traj[i - stride].inverse() * traj[i]));
+  } else {
+    s.end = traj[i];
+  }
+  s.time_start = static_cast<double>(i) * period;
+  s.time_end = static_cast<double>(i + stride) * period;
+  s.seed = hash3(options.seed, 0xf7a3ull, i);
+  s.skew = options.skew;
+  return s;
+}
+
+SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::path& out_dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::vector<Pose> trajectory = source_lidar_trajectory(options);
+  const std::vector<std::size_t> frames = selected_frames(options, trajectory.size());
+  LidarModel lidar = LidarModel::hdl64e(options.beams);
+  if (options.azimuth_steps < 16) throw ConfigError("azimuth steps must be at least 16");
+  lidar.azimuth_steps = options.azimuth_steps;
+  lidar.sweep_period = options.frame_period;
+
+  WorldOptions world_options = options.world;
+  world_options.frame_period = options.frame_period;
+  const World world = build_world(trajectory, options.seed, world_options);
+
+  // Output poses: re-based so that the first written frame is the origin.
+  const Pose tr = output_velo_to_cam(options);
+  const Pose base_inv = trajectory[frames.front()].inverse();
+  std::vector<Pose> lidar_out;
+  std::vector<double> times;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    lidar_out.push_back(orthonormalized(base_inv * trajectory[frames[k]]));
+    times.push_back(static_cast<double>(k) * options.frame_period);
+  }
+  const std::vector<Pose> camera_out = lidar_to_camera_poses(lidar_out, tr);
+
+  SequenceWriter writer(out_dir);
+  writer.write_calib(tr);
+  // Written up front so that a crash mid-way still leaves a readable sequence
+  // (the reader accepts more poses than scans); trimmed on interruption.
+  writer.write_camera_poses(camera_out);
+  writer.write_times(times);
+  const bool noisy = options.labels == LabelMode::kNoisy;
+  if (noisy) fs::create_directories(out_dir / "labels_gt");
+
+  SimulationSummary summary;
+  ProgressBar progress(frames.size(), "simulate", options.show_progress);
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    if (stop_requested()) {
+      summary.interrupted = true;
+      break;
+    }
+    const SweepSpec sweep = sweep_for_frame(trajectory, frames[k], options.stride, options);
+    SimulatedScan scan = simulate_scan(world, lidar, sweep);
+    if (noisy) {
+      write_scan_labels(out_dir / "labels_gt" / (frame_name(k) + ".label"), scan.cloud);
+      const std::vector<std::uint16_t> predicted =
+          emulate_segmentation(scan, lidar.beams(), lidar.azimuth_steps, hash_combine(sweep.seed, 0x9e7ull), options.label_noise);
+      summary.score.add(scan.cloud.label, predicted);
+      scan.cloud.label = predicted;
+      std::fill(scan.cloud.instance.begin(), scan.cloud.instance.end(), 0);
+    }
+    writer.write_scan(k, scan.cloud);
+    summary.points += scan.cloud.size();
+    ++summary.frames;
+    progress.advance();
+  }
+  progress.finish();
+  if (summary.frames < frames.size()) {
+    writer.write_camera_poses(std::vector<Pose>(camera_out.begin(), camera_out.begin() + static_cast<std::ptrdiff_t>(summary.frames)));
+    writer.write_times(std::vector<double>(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(summary.frames)));
+  }
+  if (noisy && summary.frames > 0) {
+    summary.miou = summary.score.miou();
+    summary.label_accuracy = summary.score.accuracy();
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return summary;
+}
+
+}  // namespace saloam::sim

@@ -1,0 +1,71 @@
+#pragma once
+// Synthetic SemanticKITTI sequences: a trajectory (preset or KITTI poses),
+// a world built along it, one simulated HDL-64E sweep per frame, written in
+// the SemanticKITTI layout so every other command reads it like real data:
+//   velodyne/NNNNNN.bin  labels/NNNNNN.label  [labels_gt/NNNNNN.label]
+//   poses.txt (camera frame, P_i = Tr Q_i Tr^-1, P_0 = I)  calib.txt (Tr)  times.txt (10 Hz)
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "saloam/core/types.hpp"
+#include "saloam/sim/lidar.hpp"
+#include "saloam/sim/label_noise.hpp"
+#include "saloam/sim/world.hpp"
+
+namespace saloam::sim {
+
+enum class LabelMode { kGroundTruth, kNoisy };
+
+struct SimulationOptions {
+  /// Built-in route, used when `camera_poses` is empty (see preset_names()).
+  std::string preset = "urban-loop";
+  /// A KITTI ground-truth trajectory P_i (camera frame) with its Tr.
+  std::vector<Pose> camera_poses;
+  Pose velo_to_cam = Pose::Identity();  ///< Tr; presets use KITTI 00's when left identity
+  bool velo_to_cam_given = false;
+  /// Source frames [first_frame, end_frame) every `stride`-th; renumbered from 0.
+  std::size_t first_frame = 0;
+  std::size_t end_frame = std::numeric_limits<std::size_t>::max();
+  std::size_t stride = 1;
+  std::uint64_t seed = 1;
+  LabelMode labels = LabelMode::kGroundTruth;
+  int beams = 64;
+  int azimuth_steps = 2083;
+  bool skew = true;
+  bool show_progress = true;
+  double frame_period = 0.1;
+  WorldOptions world;
+  LabelNoiseOptions label_noise;
+};
+
+struct SimulationSummary {
+  std::size_t frames = 0;          ///< frames written
+  std::size_t points = 0;          ///< total points written
+  double seconds = 0;              ///< wall time of the ray casting and writing
+  double miou = std::numeric_limits<double>::quiet_NaN();  ///< noisy labels vs truth
+  double label_accuracy = std::numeric_limits<double>::quiet_NaN();
+  SegmentationScore score;         ///< per-class IoU of the noisy labels
+  bool interrupted = false;
+};
+
+/// The whole source trajectory in the LiDAR frame, Q_i = T_L0<-Li.
+std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options);
+/// Tr used for the output (KITTI 00's for presets unless given).
+Pose output_velo_to_cam(const SimulationOptions& options);
+/// Source indices of the frames to simulate. Throws ConfigError on an empty selection.
+std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::size_t trajectory_size);
+
+/// Sweep of output frame with source index `i` (pose i to pose i+stride).
+SweepSpec sweep_for_frame(const std::vector<Pose>& lidar_trajectory, std::size_t source_index, std::size_t stride,
+                          const SimulationOptions& options);
+
+/// Simulates and writes the sequence to `out_dir` (created). Stops cleanly on
+/// stop_requested(): the frames written so far form a valid sequence.
+SimulationSummary simulate_sequence(const SimulationOptions& options, const std::filesystem::path& out_dir);
+
+}  // namespace saloam::sim

@@ -1,0 +1,240 @@
+#include "saloam/sim/trajectories.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+
+namespace saloam::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kSpacing = 0.1;  // dense route sampling [m]
+
+using Route = std::vector<Eigen::Vector2d>;
+
+// Appends a parametric curve c(u), u in [u0, u1], resampled evenly.
+void append_curve(Route& route, const std::function<Eigen::Vector2d(double)>& c, double u0, double u1) {
+  const int fine = 20000;
+  Eigen::Vector2d prev = c(u0);
+  if (route.empty()) route.push_back(prev);
+  double acc = (route.back() - prev).norm();
+  for (int k = 1; k <= fine; ++k) {
+    const Eigen::Vector2d p = c(u0 + (u1 - u0) * k / fine);
+    acc += (p - prev).norm();
+    prev = p;
+    if (acc >= kSpacing) {
+      route.push_back(p);
+      acc = 0;
+    }
+  }
+}
+
+// Turtle pieces: straight and arc (positive angle = left turn).
+struct Turtle {
+  Eigen::Vector2d pos;
+  double heading;
+  void straight(Route& r, double length) {
+    const int n = static_cast<int>(std::ceil(length / kSpacing));
+    const Eigen::Vector2d dir(std::cos(heading), std::sin(heading));
+    const Eigen::Vector2d start = pos;
+    for (int k = 1; k <= n; ++k) r.push_back(start + dir * (length * k / n));
+    pos = start + dir * length;
+  }
+  void arc(Route& r, double radius, double angle) {
+    const double len = std::abs(angle) * radius;
+    const int n = std::max(1, static_cast<int>(std::ceil(len / kSpacing)));
+    const double sign = angle > 0 ? 1.0 : -1.0;
+    const Eigen::Vector2d center = pos + sign * radius * Eigen::Vector2d(-std::sin(heading), std::cos(heading));
+    const double h0 = heading;
+    for (int k = 1; k <= n; ++k) {
+      const double h = h0 + angle * k / n;
+      r.push_back(center + sign * radius * Eigen::Vector2d(std::sin(h), -std::cos(h)));
+    }
+    heading = h0 + angle;
+    pos = r.back();
+  }
+};
+
+// Moving-average smoothing (keeps the ends fixed) so curvature changes gradually.
+Route smooth(const Route& in, int half_window) {
+  Route out(in.size());
+  const int n = static_cast<int>(in.size());
+  for (int i = 0; i < n; ++i) {
+    const int w = std::min({half_window, i, n - 1 - i});
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+    for (int k = -w; k <= w; ++k) sum += in[static_cast<std::size_t>(i + k)];
+    out[static_cast<std::size_t>(i)] = sum / (2 * w + 1);
+  }
+  return out;
+}
+
+// Rolling hills; a function of position so that revisits agree.
+double terrain_height(const Eigen::Vector2d& p) {
+  return 1.6 * std::sin(p.x() / 95.0 + 0.4) + 1.1 * std::cos(p.y() / 70.0 - 0.3) + 0.4 * std::sin((p.x() + p.y()) / 40.0);
+}
+
+// Times the route with a curvature-limited speed profile and samples poses.
+std::vector<Pose> drive(const Route& route, double v_max, double frame_period) {
+  const std::size_t n = route.size();
+  std::vector<double> s(n, 0.0), kappa(n, 0.0), v(n, v_max);
+  for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (route[i] - route[i - 1]).norm();
+  const std::size_t w = 30;  // curvature from points 3 m apart
+  for (std::size_t i = w; i + w < n; ++i) {
+    const Eigen::Vector2d a = route[i] - route[i - w], b = route[i + w] - route[i];
+    const double cross = a.x() * b.y() - a.y() * b.x();
+    kappa[i] = std::abs(2.0 * cross / (a.norm() * b.norm() * (route[i + w] - route[i - w]).norm() + 1e-9));
+  }
+  const double lateral_acc = 1.8, accel = 1.0, decel = 1.6;
+  for (std::size_t i = 0; i < n; ++i) v[i] = std::min(v_max, std::sqrt(lateral_acc / std::max(kappa[i], 1e-6)));
+  v[0] = std::min(v[0], 7.0);
+  for (std::size_t i = 1; i < n; ++i) {
+    v[i] = std::min(v[i], std::sqrt(v[i - 1] * v[i - 1] + 2 * accel * (s[i] - s[i - 1])));
+  }
+  for (std::size_t i = n - 1; i-- > 0;) {
+    v[i] = std::min(v[i], std::sqrt(v[i + 1] * v[i + 1] + 2 * decel * (s[i + 1] - s[i])));
+  }
+  // Time at each route sample, then poses every frame_period.
+  std::vector<double> t(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i) t[i] = t[i - 1] + (s[i] - s[i - 1]) / std::max(0.5 * (v[i] + v[i - 1]), 0.3);
+  std::vector<Pose> poses;
+  std::size_t j = 0;
+  const double sensor_height = 1.73;
+  for (double time = 0.0; time <= t.back(); time += frame_period) {
+    while (j + 1 < n && t[j + 1] < time) ++j;
+    const std::size_t k = std::min(j + 1, n - 1);
+    const double a = t[k] > t[j] ? (time - t[j]) / (t[k] - t[j]) : 0.0;
+    const Eigen::Vector2d p = route[j] + a * (route[k] - route[j]);
+    const std::size_t i0 = j >= 20 ? j - 20 : 0, i1 = std::min(n - 1, j + 20);
+    Eigen::Vector2d dir = route[i1] - route[i0];
+    dir.normalize();
+    const double yaw = std::atan2(dir.y(), dir.x());
+    const Eigen::Vector2d left(-dir.y(), dir.x());
+    const double slope = (terrain_height(p + dir) - terrain_height(p - dir)) / 2.0;
+    const double cross = (terrain_height(p + left) - terrain_height(p - left)) / 2.0;
+    Pose T = Pose::Identity();
+    T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-std::atan(slope), Eigen::Vector3d::UnitY()) *
+                  Eigen::AngleAxisd(std::atan(cross), Eigen::Vector3d::UnitX()))
+                     .toRotationMatrix();
+    T.translation() = Eigen::Vector3d(p.x(), p.y(), terrain_height(p) + sensor_height);
+    poses.push_back(orthonormalized(T));
+  }
+  // World = first LiDAR frame.
+  const Pose first_inv = poses.front().inverse();
+  for (auto& P : poses) P = orthonormalized(first_inv * P);
+  return poses;
+}
+
+// Small lateral wander within the lane, a function of arc length.
+Route wander(const Route& r, double amplitude, double wavelength) {
+  Route out(r.size());
+  double s = 0;
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    if (i > 0) s += (r[i] - r[i - 1]).norm();
+    const std::size_t a = i > 0 ? i - 1 : i, b = std::min(r.size() - 1, i + 1);
+    Eigen::Vector2d dir = r[b] - r[a];
+    if (dir.norm() < 1e-9) dir = {1, 0};
+    dir.normalize();
+    out[i] = r[i] + amplitude * std::sin(2 * kPi * s / wavelength) * Eigen::Vector2d(-dir.y(), dir.x());
+  }
+  return out;
+}
+
+Route urban_loop() {
+  // A rounded block (superellipse) with gently bent sides, driven 1.2 times.
+  const double a = 150, b = 85, e = 2.0 / 6.0;
+  auto c = [&](double u) {
+    const double cu = std::cos(u), su = std::sin(u);
+    const double r = 1.0 + 0.05 * std::sin(3 * u + 0.5);
+    return Eigen::Vector2d(a * r * std::copysign(std::pow(std::abs(cu), e), cu),
+                           b * r * std::copysign(std::pow(std::abs(su), e), su));
+  };
+  Route route;
+  // Start on the south side heading east (u = -pi/2 + ...), go round counter-clockwise.
+  const double u0 = -kPi / 2 - 0.35;
+  append_curve(route, c, u0, u0 + 2 * kPi + 1.05);
+  return wander(smooth(route, 30), 0.35, 170.0);
+}
+
+Route figure_eight() {
+  // Lemniscate of Gerono; the two lobes cross in the middle at about 80 deg.
+  const double A = 190, B = 150;
+  auto c = [&](double u) { return Eigen::Vector2d(A * std::sin(u), 0.5 * B * std::sin(2 * u)); };
+  Route route;
+  append_curve(route, c, -0.25, 2 * kPi);
+  // U-turn (a "light bulb" turn at a roundabout), ending in the opposite lane.
+  const Eigen::Vector2d end_dir = (route.back() - route[route.size() - 2]).normalized();
+  const double lane = 3.2;
+  auto bulb = [&](double alpha, Route* out) {
+    Turtle t{route.back(), std::atan2(end_dir.y(), end_dir.x())};
+    Route tmp;
+    t.straight(tmp, 25);
+    t.arc(tmp, 12, -alpha);
+    t.arc(tmp, 14, kPi + 2 * alpha);
+    t.arc(tmp, 12, -alpha);
+    if (out) *out = tmp;
+    const Eigen::Vector2d rel = t.pos - route.back();
+    return rel.dot(Eigen::Vector2d(-end_dir.y(), end_dir.x()));  // lateral offset to the left
+  };
+  double lo = 0.05, hi = 1.5;  // find alpha giving the lane offset
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (bulb(mid, nullptr) > lane ? lo : hi) = mid;
+  }
+  Route turn;
+  bulb(0.5 * (lo + hi), &turn);
+  route.insert(route.end(), turn.begin(), turn.end());
+  // Back along the route in the opposite lane: the first lobe in reverse.
+  Turtle t{route.back(), 0};
+  Route back;
+  const Eigen::Vector2d left(-end_dir.y(), end_dir.x());
+  const Eigen::Vector2d shift = route.back() - (c(2 * kPi) + 25 * end_dir) ;
+  (void)t;
+  Route reverse_part;
+  append_curve(reverse_part, [&](double u) {
+    const Eigen::Vector2d p = c(u);
+    const double h = 1e-4;
+    Eigen::Vector2d d = c(u + h) - c(u - h);
+    d.normalize();
+    return Eigen::Vector2d(p + lane * Eigen::Vector2d(-d.y(), d.x()));
+  }, 2 * kPi + 0.0, 2 * kPi - 2.6);
+  // Connect the bulb's exit to the reversed route with a straight piece.
+  const Eigen::Vector2d from = route.back(), to = reverse_part.front();
+  const int n = static_cast<int>(std::ceil((to - from).norm() / kSpacing));
+  for (int k = 1; k <= n; ++k) route.push_back(from + (to - from) * (static_cast<double>(k) / n));
+  (void)shift;
+  (void)left;
+  route.insert(route.end(), reverse_part.begin() + 1, reverse_part.end());
+  return wander(smooth(route, 30), 0.25, 140.0);
+}
+
+Route straight_road() {
+  Route route;
+  append_curve(route, [](double u) { return Eigen::Vector2d(u, 25.0 * std::sin(u / 90.0)); }, 0.0, 400.0);
+  return smooth(route, 30);
+}
+
+}  // namespace
+
+std::vector<std::string> preset_names() { return {"urban-loop", "figure-eight", "straight"}; }
+
+std::vector<Pose> preset_trajectory(const std::string& name, double frame_period) {
+  if (frame_period <= 0) throw ConfigError("frame period must be positive");
+  if (name == "urban-loop") return drive(urban_loop(), 11.0, frame_period);
+  if (name == "figure-eight") return drive(figure_eight(), 11.5, frame_period);
+  if (name == "straight") return drive(straight_road(), 10.0, frame_period);
+  throw ConfigError(fmt::format("unknown preset '{}' (choose one of: {})", name, fmt::join(preset_names(), ", ")));
+}
+
+Pose kitti_velo_to_cam() {
+  const double v[12] = {4.276802385584e-04,  -9.999672484946e-01, -8.084491683471e-03, -1.198459927713e-02,
+                        -7.210626507497e-03, 8.081198471645e-03,  -9.999413164504e-01, -5.403984729748e-02,
+                        9.999738645903e-01,  4.859485810390e-04,  -7.206933692422e-03, -2.921968648686e-01};
+  return orthonormalized(pose_from_3x4(v));
+}
+
+}  // namespace saloam::sim

@@ -1,0 +1,477 @@
+#include "saloam/sim/world.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/semantic_classes.hpp"
+
+namespace saloam::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Independent noise channels (seed salts) for the layout fields.
+enum Salt : std::uint64_t {
+  kSaltRoad = 11, kSaltParking, kSaltSidewalk, kSaltVerge, kSaltRural, kSaltBump, kSaltBuildings, kSaltTrees,
+  kSaltPoles, kSaltCars, kSaltAgents, kSaltFences, kSaltRemission, kSaltLot
+};
+
+struct Interval {
+  double t0 = kInf, t1 = -kInf;
+  Eigen::Vector3d normal{0, 0, 1};
+  int face = -1;  // box: 0/1 = local x faces, 2/3 = local y faces, 4 = top/bottom
+  double u = 0;   // box face coordinate along the face (for facades)
+};
+
+// Ray against a vertical box in its local frame. Returns entry/exit.
+bool intersect_box(const Primitive& p, const Eigen::Vector3d& o, const Eigen::Vector3d& d, Interval& out) {
+  const double px = o.x() - p.center.x(), py = o.y() - p.center.y();
+  const double c = p.cos_yaw, s = p.sin_yaw;
+  const double lx = c * px + s * py, ly = -s * px + c * py;
+  const double dx = c * d.x() + s * d.y(), dy = -s * d.x() + c * d.y();
+  double t0 = -kInf, t1 = kInf;
+  int face = -1;
+  auto slab = [&](double pos, double dir, double lo, double hi, int face_lo) {
+    if (std::abs(dir) < 1e-12) return pos >= lo && pos <= hi;
+    double a = (lo - pos) / dir, b = (hi - pos) / dir;
+    int f = face_lo;
+    if (a > b) {
+      std::swap(a, b);
+      f = face_lo + 1;
+    }
+    if (a > t0) {
+      t0 = a;
+      face = f;
+    }
+    t1 = std::min(t1, b);
+    return t0 <= t1;
+  };
+  if (!slab(lx, dx, -p.half_x, p.half_x, 0)) return false;
+  if (!slab(ly, dy, -p.half_y, p.half_y, 2)) return false;
+  if (!slab(o.z(), d.z(), p.z_min, p.z_max, 4)) return false;
+  if (t1 < 0 || t0 < 0) return false;  // behind, or the origin is inside
+  out.t0 = t0;
+  out.t1 = t1;
+  out.face = face;
+  Eigen::Vector2d n_local(0, 0);
+  const double hx = lx + t0 * dx, hy = ly + t0 * dy;
+  switch (face) {
+    case 0: n_local = {-1, 0}; out.u = hy; break;
+    case 1: n_local = {1, 0}; out.u = hy; break;
+    case 2: n_local = {0, -1}; out.u = hx; break;
+    case 3: n_local = {0, 1}; out.u = hx; break;
+    default: break;
+  }
+  if (face >= 4) {
+    out.normal = {0, 0, face == 4 ? -1.0 : 1.0};
+  } else {
+    out.normal = {c * n_local.x() - s * n_local.y(), s * n_local.x() + c * n_local.y(), 0};
+  }
+  return true;
+}
+
+bool intersect_cylinder(const Primitive& p, const Eigen::Vector3d& o, const Eigen::Vector3d& d, Interval& out) {
+  const double px = o.x() - p.center.x(), py = o.y() - p.center.y();
+  const double r = p.half_x;
+  const double a = d.x() * d.x() + d.y() * d.y();
+  double t0, t1;
+  if (a < 1e-12) {
+    if (px * px + py * py > r * r) return false;
+    t0 = -kInf;
+    t1 = kInf;
+  } else {
+    const double b = px * d.x() + py * d.y();
+    const double cc = px * px + py * py - r * r;
+    const double disc = b * b - a * cc;
+    if (disc < 0) return false;
+    const double sq = std::sqrt(disc);
+    t0 = (-b - sq) / a;
+    t1 = (-b + sq) / a;
+  }
+  Eigen::Vector3d normal;
+  const double zt0 = o.z() + t0 * d.z();
+  if (zt0 >= p.z_min && zt0 <= p.z_max) {
+    normal = Eigen::Vector3d(px + t0 * d.x(), py + t0 * d.y(), 0).normalized();
+  } else {
+    // Enter through a cap (or miss).
+    if (std::abs(d.z()) < 1e-12) return false;
+    const double cap = zt0 > p.z_max ? p.z_max : p.z_min;
+    const double tc = (cap - o.z()) / d.z();
+    if (tc < t0 || tc > t1) return false;
+    t0 = tc;
+    normal = {0, 0, zt0 > p.z_max ? 1.0 : -1.0};
+  }
+  if (t0 < 0) return false;
+  out.t0 = t0;
+  out.t1 = t1;
+  out.normal = normal;
+  return true;
+}
+
+bool intersect_ellipsoid(const Primitive& p, const Eigen::Vector3d& o, const Eigen::Vector3d& d, Interval& out) {
+  const double cz = 0.5 * (p.z_min + p.z_max), rz = 0.5 * (p.z_max - p.z_min);
+  const double px = o.x() - p.center.x(), py = o.y() - p.center.y();
+  const double c = p.cos_yaw, s = p.sin_yaw;
+  const Eigen::Vector3d lo((c * px + s * py) / p.half_x, (-s * px + c * py) / p.half_y, (o.z() - cz) / rz);
+  const Eigen::Vector3d ld((c * d.x() + s * d.y()) / p.half_x, (-s * d.x() + c * d.y()) / p.half_y, d.z() / rz);
+  const double a = ld.squaredNorm(), b = lo.dot(ld), cc = lo.squaredNorm() - 1.0;
+  const double disc = b * b - a * cc;
+  if (disc < 0) return false;
+  const double sq = std::sqrt(disc);
+  const double t0 = (-b - sq) / a, t1 = (-b + sq) / a;
+  if (t0 < 0) return false;
+  out.t0 = t0;
+  out.t1 = t1;
+  const Eigen::Vector3d q = lo + t0 * ld;
+  const Eigen::Vector3d nl(q.x() / p.half_x, q.y() / p.half_y, q.z() / rz);
+  out.normal = Eigen::Vector3d(c * nl.x() - s * nl.y(), s * nl.x() + c * nl.y(), nl.z()).normalized();
+  return true;
+}
+
+bool intersect(const Primitive& p, const Eigen::Vector3d& o, const Eigen::Vector3d& d, Interval& out) {
+  switch (p.shape) {
+    case Shape::kBox: return intersect_box(p, o, d, out);
+    case Shape::kCylinder: return intersect_cylinder(p, o, d, out);
+    case Shape::kEllipsoid: return intersect_ellipsoid(p, o, d, out);
+  }
+  return false;
+}
+
+// Resolves the actual return inside an interval: porous media, facades.
+// Returns the range or +inf when the ray passes (or the glass eats it).
+double surface_range(const Primitive& p, const Interval& iv, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                     Rng& rng) {
+  if (p.mean_free_path > 0) {
+    const double depth = rng.exponential(p.mean_free_path);
+    return iv.t0 + depth < iv.t1 ? iv.t0 + depth : kInf;
+  }
+  const FacadePattern& f = p.facade;
+  if (f.floor_height > 0 && iv.face >= 0 && iv.face < 4) {
+    const double z = o.z() + iv.t0 * d.z() - p.z_min;
+    const double floor_pos = std::fmod(z, static_cast<double>(f.floor_height));
+    const double u = iv.u + 1000.0;  // keep fmod's argument positive
+    const double u_pos = std::fmod(u, static_cast<double>(f.window_spacing));
+    const double sill = 0.5 * (f.floor_height - f.window_height);
+    const bool window = z > 1.0 && z < p.z_max - p.z_min - 0.8 && floor_pos > sill &&
+                        floor_pos < sill + f.window_height && u_pos < f.window_width;
+    if (window) {
+      if (rng.chance(f.glass_dropout)) return -kInf;  // glass: no return at all
+      const double cos_inc = std::max(0.2, std::abs(iv.normal.dot(d)));
+      return iv.t0 + f.recess / cos_inc;
+    }
+  }
+  return iv.t0;
+}
+
+}  // namespace
+
+float Primitive::footprint_radius() const {
+  if (shape == Shape::kCylinder) return half_x;
+  if (shape == Shape::kEllipsoid) return std::max(half_x, half_y);
+  return std::hypot(half_x, half_y);
+}
+
+// ---------------------------------------------------------------- ground
+
+std::size_t World::cell_index(double x, double y) const {
+  const int ix = std::clamp(static_cast<int>((x - origin_.x()) / options_.ground_cell), 0, nx_ - 1);
+  const int iy = std::clamp(static_cast<int>((y - origin_.y()) / options_.ground_cell), 0, ny_ - 1);
+  return static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+}
+
+double World::bilinear(const std::vector<float>& field, double x, double y) const {
+  const double gx = (x - origin_.x()) / options_.ground_cell - 0.5;
+  const double gy = (y - origin_.y()) / options_.ground_cell - 0.5;
+  const double fx = std::clamp(gx, 0.0, nx_ - 1.001), fy = std::clamp(gy, 0.0, ny_ - 1.001);
+  const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+  const double tx = fx - ix, ty = fy - iy;
+  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const double a = field[i], b = field[i + 1];
+  const double c = field[i + static_cast<std::size_t>(nx_)], e = field[i + static_cast<std::size_t>(nx_) + 1];
+  return (a + (b - a) * tx) * (1 - ty) + (c + (e - c) * tx) * ty;
+}
+
+double World::path_distance(double x, double y) const { return bilinear(distance_, x, y); }
+
+World::Zone World::zone_at(double x, double y) const { return zones_[cell_index(x, y)]; }
+
+double World::road_half_width(double x, double y) const { return zone_at(x, y).road; }
+
+GroundInfo World::ground_at(double x, double y) const {
+  const double d = path_distance(x, y);
+  const Zone z = zone_at(x, y);
+  const double base = bilinear(height_, x, y);
+  GroundInfo g;
+  const double road = z.road, park = road + z.parking, walk = park + z.sidewalk;
+  if (d < road) {
+    g.height = base;
+    g.label = cls::kRoad;
+    // Lane lines: a centre line left of the ego lane and the road edges.
+    const bool marking = (d > 1.65 && d < 1.8) || (d > road - 0.45 && d < road - 0.3);
+    g.remission = marking ? 0.62f : 0.22f;
+    return g;
+  }
+  if (d < park) {
+    g.height = base + 0.02;
+    g.label = cls::kParking;
+    g.remission = 0.26f;
+    return g;
+  }
+  const double curb = z.sidewalk > 0 ? 0.13 : 0.0;
+  if (d < walk) {
+    g.height = base + curb;
+    g.label = cls::kSidewalk;
+    g.remission = 0.3f;
+    return g;
+  }
+  // Verge: gently undulating, rising away from the street.
+  const double fade = std::min(1.0, (d - walk) / 12.0);
+  g.height = base + curb + fade * bilinear(bump_, x, y);
+  switch (z.verge) {
+    case 1: g.label = cls::kSidewalk; g.remission = 0.3f; break;
+    case 2: g.label = cls::kOtherGround; g.remission = 0.24f; break;
+    default: g.label = cls::kTerrain; g.remission = 0.42f; break;
+  }
+  return g;
+}
+
+double World::ground_height(double x, double y) const { return ground_at(x, y).height; }
+
+double World::ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const {
+  // March along the ray with steps that grow with range and shrink near the
+  // ground, then bisect the crossing (the ground has curbs: no closed form).
+  auto above = [&](double t) {
+    const Eigen::Vector3d p = o + t * d;
+    return p.z() - ground_height(p.x(), p.y());
+  };
+  double t_prev = 0.0;
+  if (above(0.0) <= 0) return 0.0;
+  double t = 1.0;
+  while (t_prev < max_t) {
+    t = std::min(t, max_t);
+    const double f = above(t);
+    if (f <= 0) {
+      double lo = t_prev, hi = t;
+      for (int i = 0; i < 14 && hi - lo > 0.002; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (above(mid) > 0 ? lo : hi) = mid;
+      }
+      return hi;
+    }
+    // Rays going up and well above the ground never come back.
+    if (d.z() > 0.0 && f > 2.5) return kInf;
+    t_prev = t;
+    double step = std::max(0.2, 0.04 * t);
+    if (d.z() < -1e-3) step = std::max(step, 0.7 * f / -d.z());
+    t += std::min(step, std::max(0.5, 0.2 * t));
+  }
+  return kInf;
+}
+
+// ---------------------------------------------------------------- ray casting
+
+RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_range, double t,
+                       std::span<const Primitive> dynamic, Rng& rng) const {
+  RayHit best;
+  const double t_ground = ground_intersection(o, d, max_range);
+  double best_t = std::min(t_ground, max_range + 1e-9);
+  const Primitive* best_p = nullptr;
+  Interval best_iv;
+  bool blocked = false;  // a glass pane ate the return
+
+  auto consider = [&](const Primitive& p) {
+    if (!p.present(t)) return;
+    Interval iv;
+    if (!intersect(p, o, d, iv) || iv.t0 >= best_t) return;
+    const double r = surface_range(p, iv, o, d, rng);
+    if (r == -kInf) {  // window glass: nothing behind it comes back either
+      best_t = iv.t0;
+      best_p = nullptr;
+      blocked = true;
+      return;
+    }
+    if (r < best_t) {
+      best_t = r;
+      best_p = &p;
+      best_iv = iv;
+      blocked = false;
+    }
+  };
+  for (const auto& p : dynamic) consider(p);
+
+  // 2D DDA over the object grid (Amanatides & Woo), mailboxing repeated primitives.
+  const double cell = options_.object_cell;
+  double gxf = (o.x() - origin_.x()) / cell, gyf = (o.y() - origin_.y()) / cell;
+  int ix = static_cast<int>(std::floor(gxf)), iy = static_cast<int>(std::floor(gyf));
+  const int step_x = d.x() >= 0 ? 1 : -1, step_y = d.y() >= 0 ? 1 : -1;
+  const double inv_x = std::abs(d.x()) > 1e-12 ? 1.0 / std::abs(d.x()) : kInf;
+  const double inv_y = std::abs(d.y()) > 1e-12 ? 1.0 / std::abs(d.y()) : kInf;
+  double t_max_x = (d.x() >= 0 ? (ix + 1 - gxf) : (gxf - ix)) * cell * inv_x;
+  double t_max_y = (d.y() >= 0 ? (iy + 1 - gyf) : (gyf - iy)) * cell * inv_y;
+  const double t_delta_x = cell * inv_x, t_delta_y = cell * inv_y;
+  std::array<std::uint32_t, 48> tested{};
+  std::size_t n_tested = 0;
+  double t_cell_start = 0.0;
+  while (t_cell_start < best_t) {
+    if (ix < 0 || iy < 0 || ix >= gx_ || iy >= gy_) break;
+    const std::size_t c = static_cast<std::size_t>(iy) * static_cast<std::size_t>(gx_) + static_cast<std::size_t>(ix);
+    for (std::uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
+      const std::uint32_t id = cell_items_[k];
+      if (std::find(tested.begin(), tested.begin() + static_cast<std::ptrdiff_t>(n_tested), id) !=
+          tested.begin() + static_cast<std::ptrdiff_t>(n_tested)) {
+        continue;
+      }
+      if (n_tested < tested.size()) tested[n_tested++] = id;
+      consider(primitives_[id]);
+    }
+    const double t_exit = std::min(t_max_x, t_max_y);
+    if (best_t <= t_exit) break;
+    t_cell_start = t_exit;
+    if (t_max_x < t_max_y) {
+      ix += step_x;
+      t_max_x += t_delta_x;
+    } else {
+      iy += step_y;
+      t_max_y += t_delta_y;
+    }
+  }
+
+  if (blocked || best_t > max_range) return best;
+  best.hit = true;
+  best.range = best_t;
+  if (best_p != nullptr) {
+    best.label = best_p->label;
+    best.instance = best_p->instance;
+    const double cos_inc = std::abs(best_iv.normal.dot(d));
+    best.remission = static_cast<float>(best_p->remission * (0.55 + 0.45 * cos_inc));
+  } else {
+    const Eigen::Vector3d p = o + best_t * d;
+    const GroundInfo g = ground_at(p.x(), p.y());
+    best.label = g.label;
+    best.remission = static_cast<float>(g.remission * (0.6 + 0.4 * std::min(1.0, std::abs(d.z()) * 4.0)));
+  }
+  return best;
+}
+
+// ---------------------------------------------------------------- path & agents
+
+double World::ego_arc_length(double t) const {
+  if (ego_s_.empty()) return 0.0;
+  const double f = t / options_.frame_period;
+  if (f <= 0) return ego_s_.front();
+  const auto i = static_cast<std::size_t>(f);
+  if (i + 1 >= ego_s_.size()) return ego_s_.back();
+  const double a = f - static_cast<double>(i);
+  return ego_s_[i] + a * (ego_s_[i + 1] - ego_s_[i]);
+}
+
+void World::path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const {
+  if (path_.size() < 2) {
+    position = path_.empty() ? Eigen::Vector3d::Zero() : path_.front();
+    direction = {1, 0};
+    return;
+  }
+  s = std::clamp(s, 0.0, path_s_.back());
+  auto it = std::upper_bound(path_s_.begin(), path_s_.end(), s);
+  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, it - path_s_.begin())) - 1;
+  i = std::min(i, path_.size() - 2);
+  const double len = path_s_[i + 1] - path_s_[i];
+  const double a = len > 1e-9 ? (s - path_s_[i]) / len : 0.0;
+  position = path_[i] + a * (path_[i + 1] - path_[i]);
+  // Direction smoothed over a few metres so cars do not jitter at kinks.
+  const std::size_t i0 = i >= 3 ? i - 3 : 0, i1 = std::min(path_.size() - 1, i + 4);
+  direction = (path_[i1] - path_[i0]).head<2>();
+  if (direction.norm() < 1e-9) direction = {1, 0};
+  direction.normalize();
+}
+
+void World::agents_at(double t, const Eigen::Vector2d& near, double radius, std::vector<Primitive>& out) const {
+  out.clear();
+  for (const Agent& a : agents_) {
+    if (t < a.t_begin || t >= a.t_end) continue;
+    double s = 0;
+    if (a.motion == Agent::Motion::kLeadsEgo) {
+      s = ego_arc_length(t) + a.gap + a.gap_amplitude * std::sin(2 * kPi * t / a.gap_period + a.gap_phase);
+    } else {
+      s = a.s_ref + a.speed * (t - a.t_ref);
+    }
+    if (s < 0 || s > path_length()) continue;
+    Eigen::Vector3d pos;
+    Eigen::Vector2d dir;
+    path_point(s, pos, dir);
+    const Eigen::Vector2d left(-dir.y(), dir.x());
+    double lateral = a.lateral;
+    const Zone z = zone_at(pos.x(), pos.y());
+    if (a.sidewalk_side != 0) {
+      // Rural roads have no sidewalk: walk on the verge beside the road.
+      lateral = a.sidewalk_side * (z.road + z.parking + (z.sidewalk > 0 ? 0.5 * z.sidewalk : 1.2));
+    } else if (lateral > 0) {
+      lateral = std::min(lateral, z.road - 0.5 * a.width - 0.2);  // stay on narrow roads
+    }
+    const Eigen::Vector2d xy = pos.head<2>() + lateral * left;
+    if ((xy - near).norm() > radius) continue;
+    const Eigen::Vector2d heading = a.speed < 0 ? Eigen::Vector2d(-dir) : dir;
+    Primitive p;
+    p.label = a.label;
+    p.instance = a.instance;
+    p.center = xy.cast<float>();
+    p.cos_yaw = static_cast<float>(heading.x());
+    p.sin_yaw = static_cast<float>(heading.y());
+    p.remission = a.remission;
+    const double ground = ground_height(xy.x(), xy.y());
+    if (a.label == cls::kMovingPerson) {
+      // Body and head; legs swing with the gait.
+      p.shape = Shape::kCylinder;
+      p.half_x = 0.5f * a.width;
+      p.z_min = static_cast<float>(ground + 0.75);
+      p.z_max = static_cast<float>(ground + a.height - 0.25);
+      out.push_back(p);
+      Primitive head = p;
+      head.shape = Shape::kEllipsoid;
+      head.half_x = head.half_y = 0.11f;
+      head.z_min = static_cast<float>(ground + a.height - 0.24);
+      head.z_max = static_cast<float>(ground + a.height);
+      out.push_back(head);
+      const double swing = 0.25 * std::sin(2 * kPi * 1.8 * t + a.gap_phase);
+      for (int leg = -1; leg <= 1; leg += 2) {
+        Primitive l = p;
+        l.half_x = 0.08f;
+        l.center = (xy + leg * swing * heading + leg * 0.1 * Eigen::Vector2d(-heading.y(), heading.x())).cast<float>();
+        l.z_min = static_cast<float>(ground);
+        l.z_max = static_cast<float>(ground + 0.8);
+        out.push_back(l);
+      }
+    } else {
+      p.shape = Shape::kBox;
+      p.half_x = 0.5f * a.length;
+      p.half_y = 0.5f * a.width;
+      p.z_min = static_cast<float>(ground + 0.3);
+      p.z_max = static_cast<float>(ground + 0.55 * a.height);
+      out.push_back(p);
+      Primitive cabin = p;  // greenhouse, set back a little
+      cabin.half_x = 0.28f * a.length;
+      cabin.half_y = 0.45f * a.width;
+      cabin.center = (xy - 0.08 * a.length * heading).cast<float>();
+      cabin.z_min = p.z_max;
+      cabin.z_max = static_cast<float>(ground + a.height);
+      out.push_back(cabin);
+      for (int w = 0; w < 4; ++w) {  // wheels below the body
+        Primitive wheel = p;
+        wheel.shape = Shape::kBox;
+        wheel.half_x = 0.32f;
+        wheel.half_y = 0.12f;
+        const double fx = (w < 2 ? 0.33 : -0.33) * a.length, fy = (w % 2 == 0 ? 0.42 : -0.42) * a.width;
+        wheel.center = (xy + fx * heading + fy * Eigen::Vector2d(-heading.y(), heading.x())).cast<float>();
+        wheel.z_min = static_cast<float>(ground);
+        wheel.z_max = static_cast<float>(ground + 0.3);
+        wheel.remission = 0.08f;
+        out.push_back(wheel);
+      }
+    }
+  }
+}
+
+}  // namespace saloam::sim

@@ -1,0 +1,166 @@
+#pragma once
+// A procedural street world built along a whole trajectory, for ray casting
+// synthetic LiDAR scans. Everything is a function of the world position (and
+// of time for the dynamic objects), never of the pass, so a place driven
+// twice is the same place: loop closures in simulated data are real.
+//
+// World frame: the trajectory's frame (first LiDAR frame), z up. The ground
+// sits `sensor_height` below the driven path.
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "saloam/core/types.hpp"
+#include "saloam/sim/random.hpp"
+
+namespace saloam::sim {
+
+enum class Shape : std::uint8_t { kBox, kCylinder, kEllipsoid };
+
+/// Facade relief of a building side: recessed windows on a floor grid.
+struct FacadePattern {
+  float floor_height = 0;   ///< 0 = plain surface
+  float window_spacing = 3;
+  float window_width = 1.4f;
+  float window_height = 1.5f;
+  float recess = 0.25f;
+  float glass_dropout = 0.5f;  ///< probability that a window returns nothing
+};
+
+/// One solid (or porous) object: a vertical prism/cylinder or an ellipsoid.
+struct Primitive {
+  Shape shape = Shape::kBox;
+  std::uint16_t label = 0;
+  std::uint16_t instance = 0;
+  Eigen::Vector2f center{0, 0};
+  float z_min = 0, z_max = 0;      ///< vertical extent (ellipsoid: its bounding slab)
+  float cos_yaw = 1, sin_yaw = 0;  ///< box/ellipsoid orientation about z
+  float half_x = 0, half_y = 0;    ///< box half extents; cylinder radius = half_x; ellipsoid semi-axes
+  float remission = 0.3f;
+  /// > 0: porous (foliage, chain-link): mean free path inside [m]; rays pass through sometimes.
+  float mean_free_path = 0;
+  float time_on = -std::numeric_limits<float>::infinity();  ///< present during [time_on, time_off)
+  float time_off = std::numeric_limits<float>::infinity();
+  FacadePattern facade;
+
+  [[nodiscard]] bool present(double t) const { return t >= time_on && t < time_off; }
+  /// Conservative 2D bounding radius around `center`.
+  [[nodiscard]] float footprint_radius() const;
+};
+
+/// An object moving along the driven path: position is a function of time.
+struct Agent {
+  enum class Motion : std::uint8_t { kConstantSpeed, kLeadsEgo };
+  Motion motion = Motion::kConstantSpeed;
+  std::uint16_t label = 0;
+  std::uint16_t instance = 0;
+  double s_ref = 0;        ///< path arc length at t_ref (kConstantSpeed)
+  double t_ref = 0;
+  double speed = 0;        ///< signed speed along the path [m/s]
+  double gap = 15;         ///< kLeadsEgo: mean distance ahead of the ego [m]
+  double gap_amplitude = 5;
+  double gap_period = 30;
+  double gap_phase = 0;
+  double lateral = 0;      ///< offset to the left of the path direction [m]; 0 = sidewalk (computed)
+  int sidewalk_side = 0;   ///< persons: -1 right, +1 left sidewalk
+  double t_begin = 0, t_end = 0;  ///< active time window
+  float length = 4.4f, width = 1.8f, height = 1.5f;
+  float remission = 0.3f;
+};
+
+/// Result of a ray cast.
+struct RayHit {
+  double range = std::numeric_limits<double>::infinity();
+  std::uint16_t label = 0;
+  std::uint16_t instance = 0;
+  float remission = 0;
+  bool hit = false;
+};
+
+struct WorldOptions {
+  double sensor_height = 1.73;  ///< LiDAR above the road [m] (KITTI)
+  double ground_cell = 1.0;     ///< ground raster resolution [m]
+  double object_cell = 2.0;     ///< ray-casting grid resolution [m]
+  double margin = 140.0;        ///< world extent beyond the path [m]
+  double frame_period = 0.1;    ///< time between trajectory poses [s]
+  bool dynamic_objects = true;
+};
+
+/// Ground layout at one place, derived from the distance to the driven path.
+struct GroundInfo {
+  double height = 0;
+  std::uint16_t label = 0;
+  float remission = 0;
+};
+
+class WorldBuilder;
+
+class World {
+ public:
+  [[nodiscard]] const WorldOptions& options() const { return options_; }
+  [[nodiscard]] std::uint64_t seed() const { return seed_; }
+
+  /// Distance from (x, y) to the driven path (bilinear on the raster) [m].
+  [[nodiscard]] double path_distance(double x, double y) const;
+  /// Half width of the road corridor (road class) around the path at (x, y).
+  [[nodiscard]] double road_half_width(double x, double y) const;
+  /// Ground surface height and class at (x, y).
+  [[nodiscard]] GroundInfo ground_at(double x, double y) const;
+  [[nodiscard]] double ground_height(double x, double y) const;
+
+  [[nodiscard]] const std::vector<Primitive>& primitives() const { return primitives_; }
+  [[nodiscard]] const std::vector<Agent>& agents() const { return agents_; }
+
+  /// Dynamic objects as primitives at time t, those within `radius` of `near`.
+  void agents_at(double t, const Eigen::Vector2d& near, double radius, std::vector<Primitive>& out) const;
+  /// Pose of the point on the path at arc length s: position (on the ground) and heading.
+  void path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const;
+  /// Ego arc length at time t.
+  [[nodiscard]] double ego_arc_length(double t) const;
+  [[nodiscard]] double path_length() const { return path_s_.empty() ? 0.0 : path_s_.back(); }
+
+  /// Casts one ray (unit direction) against ground, static objects present at
+  /// time t and the given dynamic primitives. `rng` drives porous surfaces.
+  [[nodiscard]] RayHit cast_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double max_range,
+                                double t, std::span<const Primitive> dynamic, Rng& rng) const;
+
+ private:
+  friend class WorldBuilder;
+  friend World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options);
+  struct Zone {
+    float road = 6;      ///< road half width
+    float parking = 0;   ///< parking width beyond the road
+    float sidewalk = 3;  ///< sidewalk width (0 = rural, no curb)
+    std::uint8_t verge = 0;  ///< 0 terrain, 1 paved (sidewalk), 2 other-ground
+  };
+  [[nodiscard]] Zone zone_at(double x, double y) const;
+  [[nodiscard]] double bilinear(const std::vector<float>& field, double x, double y) const;
+  [[nodiscard]] std::size_t cell_index(double x, double y) const;
+  [[nodiscard]] double ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const;
+
+  WorldOptions options_;
+  std::uint64_t seed_ = 0;
+  // Ground raster.
+  Eigen::Vector2d origin_{0, 0};
+  int nx_ = 0, ny_ = 0;
+  std::vector<float> distance_, height_, bump_;
+  std::vector<Zone> zones_;
+  // Static objects and their 2D grid (CSR).
+  std::vector<Primitive> primitives_;
+  int gx_ = 0, gy_ = 0;
+  std::vector<std::uint32_t> cell_start_, cell_items_;
+  // The driven path (ground points) with arc length, and the ego timeline.
+  std::vector<Eigen::Vector3d> path_;
+  std::vector<double> path_s_;
+  std::vector<double> ego_s_;  ///< arc length of trajectory pose i
+  std::vector<Agent> agents_;
+};
+
+/// Builds the world along the whole LiDAR trajectory (T_W<-L_i, 10 Hz).
+World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options = {});
+
+}  // namespace saloam::sim

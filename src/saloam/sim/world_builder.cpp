@@ -1,0 +1,741 @@
+// Procedural construction of the street world along a trajectory: ground
+// raster (distance to the path, height, street layout), static objects
+// placed greedily with collision checks (so a revisited street is filled
+// once, not twice), moving agents, and the ray-casting grid.
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/sim/world.hpp"
+
+namespace saloam::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+enum Salt : std::uint64_t {
+  kSaltRoad = 101, kSaltParking, kSaltLot, kSaltSidewalk, kSaltVerge, kSaltRural, kSaltBump, kSaltBump2,
+  kSaltBuildings, kSaltFences, kSaltTrees, kSaltPoles, kSaltCars, kSaltAgents, kSaltStructures
+};
+
+}  // namespace
+
+// Access to World's private members for the builder.
+class WorldBuilder {
+ public:
+  WorldBuilder(World& w, std::uint64_t seed) : w_(w), seed_(seed) {}
+
+  void build_path(const std::vector<Pose>& trajectory) {
+    const double h = w_.options_.sensor_height;
+    w_.ego_s_.reserve(trajectory.size());
+    double s = 0;
+    Eigen::Vector3d prev = trajectory.front().translation() - Eigen::Vector3d(0, 0, h);
+    w_.path_.push_back(prev);
+    w_.path_s_.push_back(0);
+    w_.ego_s_.push_back(0);
+    for (std::size_t i = 1; i < trajectory.size(); ++i) {
+      const Eigen::Vector3d p = trajectory[i].translation() - Eigen::Vector3d(0, 0, h);
+      const double len = (p - prev).norm();
+      const int pieces = std::max(1, static_cast<int>(std::ceil(len / 0.5)));
+      if (len > 1e-6) {
+        for (int k = 1; k <= pieces; ++k) {
+          const double a = static_cast<double>(k) / pieces;
+          w_.path_.push_back(prev + a * (p - prev));
+          w_.path_s_.push_back(s + a * len);
+        }
+      }
+      s += len;
+      w_.ego_s_.push_back(s);
+      prev = p;
+    }
+  }
+
+  void build_ground() {
+    const auto& opt = w_.options_;
+    Eigen::Vector2d lo = w_.path_.front().head<2>(), hi = lo;
+    for (const auto& p : w_.path_) {
+      lo = lo.cwiseMin(p.head<2>());
+      hi = hi.cwiseMax(p.head<2>());
+    }
+    lo.array() -= opt.margin;
+    hi.array() += opt.margin;
+    w_.origin_ = lo;
+    const double cell = opt.ground_cell;
+    w_.nx_ = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell)) + 1;
+    w_.ny_ = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell)) + 1;
+    const std::size_t n = static_cast<std::size_t>(w_.nx_) * static_cast<std::size_t>(w_.ny_);
+    if (n > 200'000'000ull) throw ConfigError("trajectory spans too large an area for the simulator's ground raster");
+
+    // Nearest path sample per cell: seed the cells on the path, then a
+    // two-pass propagation (a feature transform, close to the exact Euclidean one).
+    std::vector<std::int32_t> source(n, -1);
+    w_.distance_.assign(n, std::numeric_limits<float>::infinity());
+    auto center = [&](int ix, int iy) {
+      return Eigen::Vector2d(lo.x() + (ix + 0.5) * cell, lo.y() + (iy + 0.5) * cell);
+    };
+    auto idx = [&](int ix, int iy) {
+      return static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.nx_) + static_cast<std::size_t>(ix);
+    };
+    for (std::size_t k = 0; k < w_.path_.size(); ++k) {
+      const int ix = static_cast<int>((w_.path_[k].x() - lo.x()) / cell);
+      const int iy = static_cast<int>((w_.path_[k].y() - lo.y()) / cell);
+      const double dist = (center(ix, iy) - w_.path_[k].head<2>()).norm();
+      const std::size_t i = idx(ix, iy);
+      if (dist < w_.distance_[i]) {
+        w_.distance_[i] = static_cast<float>(dist);
+        source[i] = static_cast<std::int32_t>(k);
+      }
+    }
+    auto relax = [&](int ix, int iy, int jx, int jy) {
+      if (jx < 0 || jy < 0 || jx >= w_.nx_ || jy >= w_.ny_) return;
+      const std::int32_t src = source[idx(jx, jy)];
+      if (src < 0) return;
+      const double dist = (center(ix, iy) - w_.path_[static_cast<std::size_t>(src)].head<2>()).norm();
+      const std::size_t i = idx(ix, iy);
+      if (dist < w_.distance_[i]) {
+        w_.distance_[i] = static_cast<float>(dist);
+        source[i] = src;
+      }
+    };
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int iy = 0; iy < w_.ny_; ++iy) {
+        for (int ix = 0; ix < w_.nx_; ++ix) {
+          relax(ix, iy, ix - 1, iy);
+          relax(ix, iy, ix - 1, iy - 1);
+          relax(ix, iy, ix, iy - 1);
+          relax(ix, iy, ix + 1, iy - 1);
+        }
+        for (int ix = w_.nx_ - 1; ix >= 0; --ix) relax(ix, iy, ix + 1, iy);
+      }
+      for (int iy = w_.ny_ - 1; iy >= 0; --iy) {
+        for (int ix = w_.nx_ - 1; ix >= 0; --ix) {
+          relax(ix, iy, ix + 1, iy);
+          relax(ix, iy, ix + 1, iy + 1);
+          relax(ix, iy, ix, iy + 1);
+          relax(ix, iy, ix - 1, iy + 1);
+        }
+        for (int ix = 0; ix < w_.nx_; ++ix) relax(ix, iy, ix - 1, iy);
+      }
+    }
+
+    // Height of the nearest path point, smoothed so that two passes at
+    // slightly different heights meet without a step.
+    w_.height_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) w_.height_[i] = static_cast<float>(w_.path_[static_cast<std::size_t>(source[i])].z());
+    box_blur(w_.height_, 4);
+    box_blur(w_.height_, 4);
+
+    w_.zones_.resize(n);
+    w_.bump_.resize(n);
+    for (int iy = 0; iy < w_.ny_; ++iy) {
+      for (int ix = 0; ix < w_.nx_; ++ix) {
+        const Eigen::Vector2d c = center(ix, iy);
+        World::Zone z;
+        const bool rural = noise_at(hash_combine(seed_, kSaltRural), c.x(), c.y(), 260.0) > 0.7;
+        z.road = static_cast<float>(4.0 + 2.4 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
+        const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 110.0);
+        const double lot = noise_at(hash_combine(seed_, kSaltLot), c.x(), c.y(), 70.0);
+        z.parking = 0.0f;
+        if (!rural && park > 0.55) z.parking = 2.4f;
+        if (!rural && lot > 0.8) z.parking = 15.0f;
+        z.sidewalk = rural ? 0.0f
+                           : static_cast<float>(1.8 + 2.4 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
+        const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
+        z.verge = rural || verge < 0.6 ? 0 : (verge < 0.8 ? 1 : 2);
+        const std::size_t i = idx(ix, iy);
+        w_.zones_[i] = z;
+        w_.bump_[i] = static_cast<float>(0.7 * noise_at(hash_combine(seed_, kSaltBump), c.x(), c.y(), 14.0) +
+                                         0.8 * noise_at(hash_combine(seed_, kSaltBump2), c.x(), c.y(), 55.0) - 0.6);
+      }
+    }
+    occupied_.assign(n, 0);
+  }
+
+  void box_blur(std::vector<float>& f, int radius) const {
+    std::vector<float> tmp(f.size());
+    const int nx = w_.nx_, ny = w_.ny_;
+    for (int iy = 0; iy < ny; ++iy) {
+      for (int ix = 0; ix < nx; ++ix) {
+        double sum = 0;
+        int cnt = 0;
+        for (int k = std::max(0, ix - radius); k <= std::min(nx - 1, ix + radius); ++k, ++cnt) {
+          sum += f[static_cast<std::size_t>(iy) * nx + k];
+        }
+        tmp[static_cast<std::size_t>(iy) * nx + ix] = static_cast<float>(sum / cnt);
+      }
+    }
+    for (int iy = 0; iy < ny; ++iy) {
+      for (int ix = 0; ix < nx; ++ix) {
+        double sum = 0;
+        int cnt = 0;
+        for (int k = std::max(0, iy - radius); k <= std::min(ny - 1, iy + radius); ++k, ++cnt) {
+          sum += tmp[static_cast<std::size_t>(k) * nx + ix];
+        }
+        f[static_cast<std::size_t>(iy) * nx + ix] = static_cast<float>(sum / cnt);
+      }
+    }
+  }
+
+  // ------------------------------------------------------------ placement helpers
+
+  [[nodiscard]] double street_edge(const Eigen::Vector2d& p) const {
+    const World::Zone z = w_.zone_at(p.x(), p.y());
+    return z.road + z.parking + z.sidewalk;
+  }
+  [[nodiscard]] bool inside_grid(const Eigen::Vector2d& p) const {
+    return p.x() > w_.origin_.x() + 1 && p.y() > w_.origin_.y() + 1 &&
+           p.x() < w_.origin_.x() + (w_.nx_ - 1) * w_.options_.ground_cell &&
+           p.y() < w_.origin_.y() + (w_.ny_ - 1) * w_.options_.ground_cell;
+  }
+
+  // Samples of an oriented rectangle (centre, axis, half extents), 0.5 m apart.
+  template <class F>
+  bool for_rect(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy, F&& f) const {
+    const Eigen::Vector2d side(-axis.y(), axis.x());
+    const int nx = std::max(1, static_cast<int>(std::ceil(2 * hx / 0.5))), ny = std::max(1, static_cast<int>(std::ceil(2 * hy / 0.5)));
+    for (int i = 0; i <= nx; ++i) {
+      for (int j = 0; j <= ny; ++j) {
+        const Eigen::Vector2d p = c + (-hx + 2 * hx * i / nx) * axis + (-hy + 2 * hy * j / ny) * side;
+        if (!f(p)) return false;
+      }
+    }
+    return true;
+  }
+
+  /// Rectangle clear of the street (up to `street_clearance` beyond the
+  /// street edge, or beyond the road when `road_only`) and of other objects.
+  bool rect_free(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy, double clearance,
+                 bool road_only) const {
+    return for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
+      if (!inside_grid(p)) return false;
+      const double d = w_.path_distance(p.x(), p.y());
+      const double limit = road_only ? w_.road_half_width(p.x(), p.y()) : street_edge(p);
+      return d >= limit + clearance && occupied_[w_.cell_index(p.x(), p.y())] == 0;
+    });
+  }
+  void mark_rect(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy) {
+    for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
+      if (inside_grid(p)) occupied_[w_.cell_index(p.x(), p.y())] = 1;
+      return true;
+    });
+  }
+  bool disc_free(const Eigen::Vector2d& c, double r, double road_clearance) const {
+    return rect_free(c, {1, 0}, r, r, road_clearance, true);
+  }
+
+  Primitive box(std::uint16_t label, const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy,
+                double z0, double z1, double remission) const {
+    Primitive p;
+    p.shape = Shape::kBox;
+    p.label = label;
+    p.center = c.cast<float>();
+    p.cos_yaw = static_cast<float>(axis.x());
+    p.sin_yaw = static_cast<float>(axis.y());
+    p.half_x = static_cast<float>(hx);
+    p.half_y = static_cast<float>(hy);
+    p.z_min = static_cast<float>(z0);
+    p.z_max = static_cast<float>(z1);
+    p.remission = static_cast<float>(remission);
+    return p;
+  }
+  [[nodiscard]] double ground(const Eigen::Vector2d& p) const { return w_.ground_height(p.x(), p.y()); }
+
+  // Walks the path in steps, calling f(position, direction, s).
+  template <class F>
+  void walk(double start, F&& f) const {
+    double s = start;
+    const double len = w_.path_length();
+    while (s < len) {
+      Eigen::Vector3d pos;
+      Eigen::Vector2d dir;
+      w_.path_point(s, pos, dir);
+      const double advance = f(pos.head<2>(), dir, s);
+      s += std::max(0.5, advance);
+    }
+  }
+
+  // ------------------------------------------------------------ objects
+
+  void place_buildings() {
+    for (int side = -1; side <= 1; side += 2) {
+      Rng rng(hash3(seed_, kSaltBuildings, static_cast<std::uint64_t>(side + 5)));
+      walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const Eigen::Vector2d probe = p + side * left * 8.0;
+        const World::Zone z = w_.zone_at(probe.x(), probe.y());
+        if (z.sidewalk == 0 && !rng.chance(0.12)) return rng.uniform(15, 40);  // rural: mostly open land
+        double length = rng.chance(0.25) ? rng.uniform(25, 45) : rng.uniform(9, 25);
+        const double depth = rng.uniform(8, 18);
+        const double pick = rng.uniform();
+        const double height = pick < 0.12 ? rng.uniform(5, 8) : (pick < 0.75 ? rng.uniform(8, 16) : rng.uniform(16, 25));
+        const double setback = rng.chance(0.25) ? rng.uniform(6, 15) : rng.uniform(0.5, 4);
+        const double yaw = rng.uniform(-0.035, 0.035);
+        const double edge = street_edge(probe);
+        for (int attempt = 0; attempt < 2; ++attempt, length *= 0.55) {
+          Eigen::Vector3d mid3;
+          Eigen::Vector2d mdir;
+          double s_mid = 0;
+          (void)s_mid;
+          const Eigen::Vector2d axis = Eigen::Rotation2Dd(yaw) * dir;
+          const Eigen::Vector2d mleft(-axis.y(), axis.x());
+          const Eigen::Vector2d c = p + 0.5 * length * axis + side * mleft * (edge + setback + 0.5 * depth);
+          if (!rect_free(c, axis, 0.5 * length + 0.5, 0.5 * depth + 0.5, 0.8, false)) continue;
+          add_building(c, axis, 0.5 * length, 0.5 * depth, height, rng);
+          mark_rect(c, axis, 0.5 * length + 0.8, 0.5 * depth + 0.8);
+          // Front yard: hedge or fence along the property line, sometimes a tree.
+          const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * (edge + 0.4);
+          if (setback > 2.0) property_line(yard, axis, 0.5 * length, rng);
+          const double gap = rng.chance(0.35) ? rng.uniform(0.0, 1.0) : rng.uniform(3, 16);
+          return length + gap;
+        }
+        return 4.0;
+      });
+    }
+  }
+
+  void add_building(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy, double height, Rng& rng) {
+    const double g = lowest_ground(c, axis, hx, hy);
+    Primitive b = box(cls::kBuilding, c, axis, hx, hy, g - 0.5, g + height, rng.uniform(0.12, 0.42));
+    b.facade.floor_height = static_cast<float>(rng.uniform(2.8, 3.6));
+    b.facade.window_spacing = static_cast<float>(rng.uniform(2.4, 3.8));
+    b.facade.window_width = static_cast<float>(std::min(b.facade.window_spacing - 0.6, rng.uniform(0.9, 1.8)));
+    b.facade.window_height = static_cast<float>(rng.uniform(1.1, 1.8));
+    b.facade.recess = static_cast<float>(rng.uniform(0.12, 0.35));
+    b.facade.glass_dropout = static_cast<float>(rng.uniform(0.25, 0.7));
+    if (rng.chance(0.15)) b.facade.floor_height = 0;  // plain wall (warehouse, garage)
+    w_.primitives_.push_back(b);
+    // A plinth that sticks out a little: facades are not perfect planes.
+    if (rng.chance(0.5)) {
+      w_.primitives_.push_back(box(cls::kBuilding, c, axis, hx + 0.12, hy + 0.12, g - 0.5, g + rng.uniform(0.4, 1.0),
+                                   b.remission * 0.8));
+    }
+    // Pilasters or balconies every few metres on some buildings.
+    if (rng.chance(0.35) && height > 7) {
+      const Eigen::Vector2d side(-axis.y(), axis.x());
+      const double spacing = rng.uniform(4, 8);
+      for (double u = -hx + 1; u < hx - 1; u += spacing) {
+        for (int s = -1; s <= 1; s += 2) {
+          const Eigen::Vector2d pc = c + u * axis + s * (hy + 0.2) * side;
+          w_.primitives_.push_back(box(cls::kBuilding, pc, axis, 0.25, 0.2, g, g + height, b.remission));
+        }
+      }
+    }
+    // Stepped upper storey.
+    if (rng.chance(0.3) && hx > 4 && hy > 4) {
+      Primitive top = b;
+      top.half_x = static_cast<float>(hx - rng.uniform(1, 3));
+      top.half_y = static_cast<float>(hy - rng.uniform(1, 3));
+      top.z_min = static_cast<float>(g + height);
+      top.z_max = static_cast<float>(g + height + rng.uniform(3, 6));
+      w_.primitives_.push_back(top);
+    }
+  }
+
+  double lowest_ground(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy) const {
+    double g = std::numeric_limits<double>::infinity();
+    for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
+      g = std::min(g, ground(p));
+      return true;
+    });
+    return g;
+  }
+
+  void property_line(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, Rng& rng) {
+    const double pick = rng.uniform();
+    if (pick < 0.3) return;
+    const double g = ground(c);
+    if (!rect_free(c, axis, half_length, 0.4, 0.1, false)) return;
+    if (pick < 0.65) {  // hedge
+      Primitive h = box(cls::kVegetation, c, axis, half_length, rng.uniform(0.3, 0.55), g - 0.1, g + rng.uniform(0.8, 1.8), 0.45);
+      h.mean_free_path = 0.35f;
+      w_.primitives_.push_back(h);
+    } else {  // fence: solid boards or chain-link the beam partly passes
+      Primitive f = box(cls::kFence, c, axis, half_length, 0.04, g, g + rng.uniform(1.0, 1.9), rng.uniform(0.2, 0.5));
+      if (rng.chance(0.5)) {
+        f.half_y = 0.25f;
+        f.mean_free_path = 1.2f;
+      }
+      w_.primitives_.push_back(f);
+    }
+    mark_rect(c, axis, half_length, 0.5);
+  }
+
+  void place_street_furniture() {
+    // Street lights and signs near the curb, trees in the verge.
+    for (int side = -1; side <= 1; side += 2) {
+      Rng rng(hash3(seed_, kSaltPoles, static_cast<std::uint64_t>(side + 5)));
+      walk(rng.uniform(0, 20), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
+        const double off = z.road + z.parking + (z.sidewalk > 0 ? 0.45 : 1.2);
+        const Eigen::Vector2d c = p + side * left * off;
+        if (!far_from(poles_, c, 15.0) || !disc_free(c, 0.3, 0.25)) return 3.0;
+        const double g = ground(c);
+        if (rng.chance(0.7)) {  // street light with an arm over the road
+          Primitive pole;
+          pole.shape = Shape::kCylinder;
+          pole.label = cls::kPole;
+          pole.center = c.cast<float>();
+          pole.half_x = static_cast<float>(rng.uniform(0.09, 0.14));
+          pole.z_min = static_cast<float>(g);
+          const double h = rng.uniform(6, 9);
+          pole.z_max = static_cast<float>(g + h);
+          pole.remission = static_cast<float>(rng.uniform(0.25, 0.45));
+          w_.primitives_.push_back(pole);
+          const Eigen::Vector2d arm_c = c - side * left * 0.9;
+          w_.primitives_.push_back(box(cls::kPole, arm_c, left, 0.9, 0.07, g + h - 0.15, g + h, pole.remission));
+        } else {  // traffic sign on a thin post, the plate facing traffic
+          Primitive post;
+          post.shape = Shape::kCylinder;
+          post.label = cls::kPole;
+          post.center = c.cast<float>();
+          post.half_x = 0.04f;
+          post.z_min = static_cast<float>(g);
+          const double h = rng.uniform(2.0, 2.8);
+          post.z_max = static_cast<float>(g + h);
+          post.remission = 0.35f;
+          w_.primitives_.push_back(post);
+          const double plate = rng.uniform(0.3, 0.45);
+          Primitive sign = box(cls::kTrafficSign, c, dir, 0.025, plate, g + h, g + h + 2 * plate, rng.uniform(0.75, 0.95));
+          w_.primitives_.push_back(sign);
+        }
+        poles_.push_back(c);
+        mark_rect(c, dir, 0.3, 0.3);
+        return rng.uniform(20, 40);
+      });
+    }
+    for (int side = -1; side <= 1; side += 2) {
+      Rng rng(hash3(seed_, kSaltTrees, static_cast<std::uint64_t>(side + 5)));
+      walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const Eigen::Vector2d probe = p + side * left * 7.0;
+        const World::Zone z = w_.zone_at(probe.x(), probe.y());
+        const double edge = z.road + z.parking + z.sidewalk;
+        const bool rural = z.sidewalk == 0;
+        // Tree rows along the verge; rural land gets more and bigger trees, further out too.
+        const double offset = edge + rng.uniform(1.0, rural ? 12.0 : 3.0);
+        const Eigen::Vector2d c = p + side * left * offset;
+        const double crown = std::min(rng.uniform(1.5, rural ? 3.8 : 3.0), offset - z.road - 0.6);
+        if (crown < 1.0 || !far_from(trees_, c, 5.0) || !disc_free(c, crown, 0.5) || !disc_free(c, 0.6, 0.3)) {
+          return 2.0;
+        }
+        if (rng.chance(rural ? 0.85 : 0.7)) {
+          add_tree(c, crown, rng);
+        } else {
+          add_bush(c, rng.uniform(0.5, 1.3), rng);
+        }
+        trees_.push_back(c);
+        mark_rect(c, dir, 0.6, 0.6);
+        return rng.uniform(rural ? 5 : 7, rural ? 12 : 16);
+      });
+    }
+    // Scattered trees and bushes further from the street (parks, fields, yards).
+    Rng rng(hash_combine(seed_, kSaltTrees + 50));
+    walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+      const Eigen::Vector2d left(-dir.y(), dir.x());
+      for (int k = 0; k < 3; ++k) {
+        const int side = rng.chance(0.5) ? -1 : 1;
+        const Eigen::Vector2d c = p + side * left * rng.uniform(12, 60) + dir * rng.uniform(-5, 5);
+        if (!inside_grid(c)) continue;
+        const double edge = street_edge(c);
+        if (w_.path_distance(c.x(), c.y()) < edge + 3) continue;
+        const double crown = rng.uniform(1.5, 4.0);
+        if (!far_from(trees_, c, 4.0) || !rect_free(c, {1, 0}, crown, crown, 0.8, false)) continue;
+        if (rng.chance(0.75)) add_tree(c, crown, rng); else add_bush(c, rng.uniform(0.7, 2.0), rng);
+        trees_.push_back(c);
+        mark_rect(c, {1, 0}, 0.8, 0.8);
+      }
+      return 6.0;
+    });
+  }
+
+  void add_tree(const Eigen::Vector2d& c, double crown, Rng& rng) {
+    const double g = ground(c);
+    const double trunk_h = rng.uniform(1.8, 3.2);
+    Primitive trunk;
+    trunk.shape = Shape::kCylinder;
+    trunk.label = cls::kTrunk;
+    trunk.center = c.cast<float>();
+    trunk.half_x = static_cast<float>(rng.uniform(0.12, 0.3));
+    trunk.z_min = static_cast<float>(g);
+    trunk.z_max = static_cast<float>(g + trunk_h + crown * 0.8);
+    trunk.remission = static_cast<float>(rng.uniform(0.25, 0.4));
+    w_.primitives_.push_back(trunk);
+    const double rz = crown * rng.uniform(0.8, 1.4);
+    Primitive leaves;
+    leaves.shape = Shape::kEllipsoid;
+    leaves.label = cls::kVegetation;
+    leaves.center = c.cast<float>();
+    leaves.half_x = static_cast<float>(crown);
+    leaves.half_y = static_cast<float>(crown * rng.uniform(0.85, 1.0));
+    const double yaw = rng.uniform(0, kPi);
+    leaves.cos_yaw = static_cast<float>(std::cos(yaw));
+    leaves.sin_yaw = static_cast<float>(std::sin(yaw));
+    leaves.z_min = static_cast<float>(g + trunk_h);
+    leaves.z_max = static_cast<float>(g + trunk_h + 2 * rz);
+    leaves.remission = static_cast<float>(rng.uniform(0.35, 0.55));
+    leaves.mean_free_path = static_cast<float>(rng.uniform(0.4, 0.9));
+    w_.primitives_.push_back(leaves);
+  }
+
+  void add_bush(const Eigen::Vector2d& c, double r, Rng& rng) {
+    const double g = ground(c);
+    Primitive b;
+    b.shape = Shape::kEllipsoid;
+    b.label = cls::kVegetation;
+    b.center = c.cast<float>();
+    b.half_x = static_cast<float>(r);
+    b.half_y = static_cast<float>(r * rng.uniform(0.7, 1.0));
+    b.z_min = static_cast<float>(g - 0.3 * r);
+    b.z_max = static_cast<float>(g + r * rng.uniform(1.0, 1.6));
+    b.remission = static_cast<float>(rng.uniform(0.35, 0.55));
+    b.mean_free_path = 0.3f;
+    w_.primitives_.push_back(b);
+  }
+
+  void place_structures() {
+    Rng rng(hash_combine(seed_, kSaltStructures));
+    walk(rng.uniform(30, 120), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+      const int side = rng.chance(0.5) ? -1 : 1;
+      const Eigen::Vector2d left(-dir.y(), dir.x());
+      const double edge = street_edge(p + side * left * 7.0);
+      const Eigen::Vector2d c = p + side * left * (edge + 1.2);
+      const double g = ground(c);
+      if (rng.chance(0.5)) {  // bus shelter / kiosk
+        if (!rect_free(c, dir, 2.0, 1.0, 0.1, false)) return 10.0;
+        Primitive shelter = box(cls::kOtherStructure, c, dir, 1.8, 0.8, g + 2.1, g + 2.4, 0.3);
+        w_.primitives_.push_back(shelter);
+        w_.primitives_.push_back(box(cls::kOtherStructure, c + side * left * 0.75, dir, 1.8, 0.05, g, g + 2.1, 0.5));
+        mark_rect(c, dir, 2.0, 1.0);
+      } else {  // low wall
+        const double half = rng.uniform(3, 10);
+        if (!rect_free(c, dir, half, 0.3, 0.1, false)) return 10.0;
+        w_.primitives_.push_back(box(cls::kOtherStructure, c, dir, half, 0.15, g - 0.1, g + rng.uniform(0.5, 1.2), 0.35));
+        mark_rect(c, dir, half, 0.3);
+      }
+      return rng.uniform(120, 300);
+    });
+  }
+
+  void place_parked_vehicles(double total_time) {
+    for (int side = -1; side <= 1; side += 2) {
+      Rng rng(hash3(seed_, kSaltCars, static_cast<std::uint64_t>(side + 5)));
+      walk(rng.uniform(0, 5), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
+        if (z.parking <= 0) return 3.0;
+        const double pick = rng.uniform();
+        std::uint16_t label = cls::kCar;
+        double length = rng.uniform(3.9, 4.9), width = rng.uniform(1.7, 1.9), height = rng.uniform(1.4, 1.65);
+        if (pick > 0.92) {
+          label = cls::kTruck;
+          length = rng.uniform(6.5, 9);
+          width = 2.4;
+          height = rng.uniform(3.0, 3.6);
+        } else if (pick > 0.84) {
+          label = cls::kOtherVehicle;
+          length = rng.uniform(5.0, 6.2);
+          width = rng.uniform(1.95, 2.1);
+          height = rng.uniform(2.1, 2.7);
+        }
+        const bool lot = z.parking > 5;
+        if (lot && label == cls::kTruck) label = cls::kCar, length = 4.5, width = 1.8, height = 1.5;
+        const bool present = rng.chance(lot ? 0.65 : 0.75);
+        double advance = lot ? 2.8 : length + rng.uniform(0.8, 2.5);
+        if (!present) return advance;
+        std::vector<Eigen::Vector2d> spots;
+        Eigen::Vector2d axis = dir;
+        if (lot) {  // two rows of perpendicular bays
+          axis = left;
+          spots.push_back(p + side * left * (z.road + 3.2));
+          if (rng.chance(0.8)) spots.push_back(p + side * left * (z.road + z.parking - 3.2));
+        } else {
+          spots.push_back(p + side * left * (z.road + 0.5 * z.parking + 0.1));
+        }
+        for (const auto& c : spots) {
+          const double hx = 0.5 * length + 0.15, hy = 0.5 * width + 0.1;
+          if (!rect_free(c, axis, hx, hy, 0.15, true)) continue;
+          add_vehicle(c, axis * (rng.chance(0.5) ? 1.0 : -1.0), label, length, width, height, rng, total_time);
+          mark_rect(c, axis, hx, hy);
+        }
+        return advance;
+      });
+    }
+  }
+
+  void add_vehicle(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, std::uint16_t label, double length,
+                   double width, double height, Rng& rng, double total_time) {
+    const double g = ground(c);
+    const std::uint16_t inst = next_instance_++;
+    const double rem = rng.uniform(0.08, 0.6);
+    Primitive body = box(label, c, axis, 0.5 * length, 0.5 * width, g + 0.25, g + (label == cls::kCar ? 0.55 : 0.75) * height, rem);
+    body.instance = inst;
+    Primitive cabin = box(label, c - (label == cls::kTruck ? -0.3 : 0.08) * length * axis, axis,
+                          (label == cls::kTruck ? 0.18 : 0.3) * length, 0.46 * width, body.z_max, g + height, rem * 0.7);
+    cabin.instance = inst;
+    if (label == cls::kTruck) {  // cargo box behind the cab
+      body.z_max = static_cast<float>(g + height);
+      body.half_x = static_cast<float>(0.33 * length);
+      body.center = (c - 0.17 * length * axis).cast<float>();
+      cabin.z_min = static_cast<float>(g + 0.4);
+      cabin.z_max = static_cast<float>(g + 0.8 * height);
+      cabin.center = (c + 0.35 * length * axis).cast<float>();
+      cabin.half_x = static_cast<float>(0.14 * length);
+    }
+    // Some parked vehicles are there on one pass and gone on another.
+    if (rng.chance(0.35) && total_time > 0) {
+      const float t_switch = static_cast<float>(rng.uniform(0, total_time));
+      if (rng.chance(0.5)) {
+        body.time_off = cabin.time_off = t_switch;
+      } else {
+        body.time_on = cabin.time_on = t_switch;
+      }
+    }
+    w_.primitives_.push_back(body);
+    w_.primitives_.push_back(cabin);
+  }
+
+  void place_agents(double total_time) {
+    if (!w_.options_.dynamic_objects) return;
+    Rng rng(hash_combine(seed_, kSaltAgents));
+    std::uint16_t inst = 1000;
+    // Oncoming cars in the left lane, each meeting the ego at some time.
+    for (double t = rng.uniform(1, 5); t < total_time; t += rng.uniform(4, 11)) {
+      Agent a;
+      a.label = cls::kMovingCar;
+      a.instance = inst++;
+      a.t_ref = t;
+      a.s_ref = w_.ego_arc_length(t);
+      a.speed = -rng.uniform(7, 13);
+      a.lateral = rng.uniform(3.2, 3.6);
+      a.t_begin = t - 15;
+      a.t_end = t + 15;
+      vehicle_dims(a, rng);
+      w_.agents_.push_back(a);
+    }
+    // A car ahead in the ego lane, now and then, plus one that overtakes on the left rarely.
+    for (double t = rng.uniform(0, 10); t < total_time; t += rng.uniform(30, 70)) {
+      Agent a;
+      a.motion = Agent::Motion::kLeadsEgo;
+      a.label = cls::kMovingCar;
+      a.instance = inst++;
+      a.gap = rng.uniform(14, 30);
+      a.gap_amplitude = rng.uniform(2, 6);
+      a.gap_period = rng.uniform(15, 40);
+      a.gap_phase = rng.uniform(0, 2 * kPi);
+      a.speed = 1;
+      a.t_begin = t;
+      a.t_end = t + rng.uniform(15, 35);
+      vehicle_dims(a, rng);
+      w_.agents_.push_back(a);
+    }
+    // Pedestrians on the sidewalks, walking either way.
+    for (double t = rng.uniform(0, 4); t < total_time; t += rng.uniform(2, 7)) {
+      Agent a;
+      a.label = cls::kMovingPerson;
+      a.instance = inst++;
+      a.t_ref = t;
+      a.s_ref = w_.ego_arc_length(t) + rng.uniform(-10, 30);
+      a.speed = (rng.chance(0.5) ? 1 : -1) * rng.uniform(1.0, 1.6);
+      a.sidewalk_side = rng.chance(0.5) ? 1 : -1;
+      a.t_begin = t - 25;
+      a.t_end = t + 25;
+      a.width = static_cast<float>(rng.uniform(0.38, 0.5));
+      a.height = static_cast<float>(rng.uniform(1.6, 1.9));
+      a.remission = static_cast<float>(rng.uniform(0.15, 0.4));
+      a.gap_phase = rng.uniform(0, 2 * kPi);
+      w_.agents_.push_back(a);
+    }
+  }
+
+  static void vehicle_dims(Agent& a, Rng& rng) {
+    a.length = static_cast<float>(rng.uniform(4.0, 4.9));
+    a.width = static_cast<float>(rng.uniform(1.72, 1.9));
+    a.height = static_cast<float>(rng.uniform(1.4, 1.65));
+    a.remission = static_cast<float>(rng.uniform(0.08, 0.6));
+  }
+
+  void build_grid() {
+    const double cell = w_.options_.object_cell;
+    w_.gx_ = static_cast<int>(std::ceil(w_.nx_ * w_.options_.ground_cell / cell));
+    w_.gy_ = static_cast<int>(std::ceil(w_.ny_ * w_.options_.ground_cell / cell));
+    const std::size_t n = static_cast<std::size_t>(w_.gx_) * static_cast<std::size_t>(w_.gy_);
+    std::vector<std::uint32_t> count(n + 1, 0);
+    auto cells = [&](const Primitive& p, auto&& f) {
+      const double r = p.footprint_radius();
+      const int x0 = std::max(0, static_cast<int>((p.center.x() - r - w_.origin_.x()) / cell));
+      const int x1 = std::min(w_.gx_ - 1, static_cast<int>((p.center.x() + r - w_.origin_.x()) / cell));
+      const int y0 = std::max(0, static_cast<int>((p.center.y() - r - w_.origin_.y()) / cell));
+      const int y1 = std::min(w_.gy_ - 1, static_cast<int>((p.center.y() + r - w_.origin_.y()) / cell));
+      for (int iy = y0; iy <= y1; ++iy) {
+        for (int ix = x0; ix <= x1; ++ix) f(static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.gx_) + static_cast<std::size_t>(ix));
+      }
+    };
+    for (const auto& p : w_.primitives_) cells(p, [&](std::size_t c) { ++count[c + 1]; });
+    for (std::size_t i = 1; i <= n; ++i) count[i] += count[i - 1];
+    w_.cell_start_ = count;
+    w_.cell_items_.assign(count[n], 0);
+    std::vector<std::uint32_t> fill(count.begin(), count.end() - 1);
+    for (std::size_t k = 0; k < w_.primitives_.size(); ++k) {
+      cells(w_.primitives_[k], [&](std::size_t c) { w_.cell_items_[fill[c]++] = static_cast<std::uint32_t>(k); });
+    }
+  }
+
+ private:
+  // Points on a coarse hash grid, to keep a minimum spacing between objects
+  // of one kind (a street driven twice gets one row of poles, not two).
+  struct PointSet {
+    static constexpr double kCell = 20.0;
+    std::unordered_map<std::uint64_t, std::vector<Eigen::Vector2d>> cells;
+    static std::uint64_t key(std::int64_t ix, std::int64_t iy) {
+      return (static_cast<std::uint64_t>(ix) << 32) ^ (static_cast<std::uint64_t>(iy) & 0xffffffffull);
+    }
+    void push_back(const Eigen::Vector2d& p) {
+      cells[key(static_cast<std::int64_t>(std::floor(p.x() / kCell)), static_cast<std::int64_t>(std::floor(p.y() / kCell)))]
+          .push_back(p);
+    }
+  };
+  static bool far_from(const PointSet& set, const Eigen::Vector2d& c, double min_dist) {
+    const auto cx = static_cast<std::int64_t>(std::floor(c.x() / PointSet::kCell));
+    const auto cy = static_cast<std::int64_t>(std::floor(c.y() / PointSet::kCell));
+    for (std::int64_t dy = -1; dy <= 1; ++dy) {
+      for (std::int64_t dx = -1; dx <= 1; ++dx) {
+        const auto it = set.cells.find(PointSet::key(cx + dx, cy + dy));
+        if (it == set.cells.end()) continue;
+        for (const auto& p : it->second) {
+          if ((p - c).squaredNorm() < min_dist * min_dist) return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  World& w_;
+  std::uint64_t seed_;
+  std::vector<std::uint8_t> occupied_;
+  PointSet poles_, trees_;
+  std::uint16_t next_instance_ = 1;
+};
+
+World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options) {
+  if (lidar_trajectory.empty()) throw ConfigError("cannot build a world along an empty trajectory");
+  World world;
+  world.options_ = options;
+  world.seed_ = seed;
+  WorldBuilder builder(world, seed);
+  builder.build_path(lidar_trajectory);
+  builder.build_ground();
+  const double total_time = static_cast<double>(lidar_trajectory.size() - 1) * options.frame_period;
+  builder.place_buildings();
+  builder.place_parked_vehicles(total_time);
+  builder.place_street_furniture();
+  builder.place_structures();
+  builder.place_agents(total_time);
+  builder.build_grid();
+  return world;
+}
+
+}  // namespace saloam::sim
