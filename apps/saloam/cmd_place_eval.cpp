@@ -1,0 +1,234 @@
+// `saloam place-eval`: place-recognition evaluation of SGPR or Scan Context on
+// a sequence with ground-truth poses (SGPR's protocol: every frame against
+// the earlier frames except the last 50; match within 3 m, non-match beyond
+// 20 m). Prints max F1, precision at 100 % recall and recall at 100 %
+// precision; writes the precision-recall curve (CSV, PNG) and a summary.
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+#include <tbb/parallel_for.h>
+
+#include "command.hpp"
+#include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/progress.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/loop/graph_json.hpp"
+#include "saloam/loop/place_recognition.hpp"
+#include "saloam/loop/scan_context.hpp"
+#include "saloam/loop/semantic_graph.hpp"
+#include "saloam/loop/sgpr_network.hpp"
+#include "saloam/viz/canvas.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct PlaceEvalArgs {
+  ConfigOptions config;
+  std::string sequence;
+  std::string method = "sgpr";
+  std::string model;
+  std::string labels;
+  std::string out;
+  PlaceEvalConfig protocol;
+  bool no_instances = false;
+  bool save_graphs = false;
+};
+
+/// Runs `work(i)` for every frame in parallel with a progress bar; stops early on Ctrl-C.
+template <class Work>
+void for_each_frame(std::size_t count, const std::string& label, Work&& work) {
+  ProgressBar progress(count, label);
+  std::mutex progress_mutex;
+  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
+    if (stop_requested()) return;
+    work(i);
+    const std::lock_guard lock(progress_mutex);
+    progress.advance();
+  });
+  progress.finish();
+}
+
+void write_outputs(const std::filesystem::path& out, const std::string& method, const PrSummary& summary,
+                   const nlohmann::json& info) {
+  {
+    std::ofstream csv(out / "pr_curve.csv");
+    if (!csv) throw InputError(out / "pr_curve.csv", "cannot create file");
+    csv << "threshold,precision,recall\n";
+    for (const auto& p : thin_curve(summary, 2000)) csv << fmt::format("{:.9g},{:.6f},{:.6f}\n", p.threshold, p.precision, p.recall);
+  }
+  {
+    nlohmann::json j = info;
+    j["max_f1"] = summary.max_f1;
+    j["max_f1_threshold"] = summary.max_f1_threshold;
+    j["max_f1_precision"] = summary.max_f1_precision;
+    j["max_f1_recall"] = summary.max_f1_recall;
+    j["precision_at_full_recall"] = summary.precision_at_full_recall;
+    j["recall_at_full_precision"] = summary.recall_at_full_precision;
+    j["positive_pairs"] = summary.positives;
+    j["negative_pairs"] = summary.negatives;
+    std::ofstream(out / "summary.json") << j.dump(2) << '\n';
+  }
+  Plot plot(800, 640);
+  plot.set_range(0, 1, 0, 1.02, false);
+  plot.set_title(fmt::format("{}: max F1 {:.3f}", method, summary.max_f1));
+  plot.set_labels("recall", "precision");
+  std::vector<Eigen::Vector2d> line;
+  for (const auto& p : thin_curve(summary, 4000)) line.emplace_back(p.recall, p.precision);
+  plot.line(line, Rgb{31, 119, 180}, 2.0);
+  plot.marker({summary.max_f1_recall, summary.max_f1_precision}, Rgb{214, 39, 40}, 5.0,
+              fmt::format("max F1 {:.3f}", summary.max_f1));
+  plot.save_png(out / "pr_curve.png");
+}
+
+int run_place_eval(const PlaceEvalArgs& args) {
+  const SaloamConfig config = args.config.resolve();
+  if (args.method != "sgpr" && args.method != "scancontext")
+    throw ConfigError(fmt::format("--method '{}': use sgpr or scancontext", args.method));
+  const bool sgpr = args.method == "sgpr";
+  SequenceOptions options;
+  if (!args.labels.empty()) options.labels_dir = args.labels;
+  options.ignore_labels = !sgpr;
+  const SequenceReader reader(args.sequence, options);
+  if (!reader.has_poses()) throw InputError(args.sequence, "no poses.txt: place-eval needs ground-truth poses");
+  if (sgpr && !reader.has_labels())
+    throw InputError(args.sequence, "no labels/ folder (give --labels DIR): SGPR needs semantic labels");
+  const std::vector<Pose> poses = reader.has_calib() ? reader.lidar_poses() : reader.camera_poses();
+  std::vector<Eigen::Vector3d> positions;
+  for (const auto& p : poses) positions.push_back(p.translation());
+  const std::size_t n = reader.size();
+
+  const std::filesystem::path out = args.out.empty() ? std::filesystem::path("place_eval_" + args.method) : std::filesystem::path(args.out);
+  std::filesystem::create_directories(out);
+  if (args.save_graphs) std::filesystem::create_directories(out / "graphs");
+
+  std::optional<SgprNetwork> network;
+  std::filesystem::path model = args.model.empty() ? std::filesystem::path(config.loop.sgpr_model) : std::filesystem::path(args.model);
+  if (sgpr) {
+    if (model.empty()) model = shared_dir() / "models/sgpr/sgpr_kitti.sgw";
+    network.emplace(SgprNetwork::load(model));
+  }
+
+  // 1. One descriptor per frame (graph + pooled embedding, or Scan Context).
+  std::vector<SgprEmbedding> embeddings(sgpr ? n : 0);
+  std::vector<ScanContext> contexts(sgpr ? 0 : n);
+  std::vector<std::size_t> node_counts(n, 0);
+  std::atomic<double> describe_seconds{0};
+  GraphBuilderConfig graph_config;
+  graph_config.use_instances = !args.no_instances;
+  const auto t0 = std::chrono::steady_clock::now();
+  for_each_frame(n, sgpr ? "graphs + embeddings" : "scan contexts", [&](std::size_t i) {
+    const LabelledCloud cloud = reader.load_scan(i);
+    const auto start = std::chrono::steady_clock::now();
+    if (sgpr) {
+      const SemanticGraph graph = build_semantic_graph(cloud, graph_config);
+      embeddings[i] = network->embed(graph);
+      node_counts[i] = graph.size();
+      if (args.save_graphs) write_graph_json(out / "graphs" / (frame_name(i) + ".json"), graph);
+    } else {
+      contexts[i] = make_scan_context(cloud.points);
+    }
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    double expected = describe_seconds.load();
+    while (!describe_seconds.compare_exchange_weak(expected, expected + s)) {
+    }
+  });
+  if (stop_requested()) return 130;
+  const double describe_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // 2. Scores of every evaluated pair (grouped by query frame).
+  const std::vector<PlacePair> pairs = place_pairs(positions, args.protocol);
+  std::vector<std::size_t> query_start(n + 1, pairs.size());
+  for (std::size_t k = pairs.size(); k-- > 0;) query_start[pairs[k].query] = k;
+  for (std::size_t i = n; i-- > 0;) query_start[i] = std::min(query_start[i], query_start[i + 1]);
+  std::vector<double> scores(pairs.size());
+  std::vector<std::uint8_t> truth(pairs.size());
+  for (std::size_t k = 0; k < pairs.size(); ++k) truth[k] = pairs[k].positive ? 1 : 0;
+  const auto t1 = std::chrono::steady_clock::now();
+  for_each_frame(n, "scoring pairs", [&](std::size_t i) {
+    const std::size_t begin = query_start[i], end = query_start[i + 1];
+    if (begin == end) return;
+    if (sgpr) {
+      std::vector<SgprEmbedding> candidates;
+      candidates.reserve(end - begin);
+      for (std::size_t k = begin; k < end; ++k) candidates.push_back(embeddings[pairs[k].candidate]);
+      const auto s = network->score_batch(embeddings[i], candidates);  // the query is the first graph
+      std::copy(s.begin(), s.end(), scores.begin() + static_cast<std::ptrdiff_t>(begin));
+    } else {
+      for (std::size_t k = begin; k < end; ++k)
+        scores[k] = 1.0 - scan_context_distance(contexts[i], contexts[pairs[k].candidate]).distance;
+    }
+  });
+  if (stop_requested()) return 130;
+  const double score_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+
+  const PrSummary summary = precision_recall(scores, truth);
+  nlohmann::json info;
+  info["method"] = args.method;
+  info["sequence"] = std::filesystem::absolute(args.sequence).string();
+  info["frames"] = n;
+  if (sgpr) {
+    info["model"] = model.string();
+    info["use_instances"] = graph_config.use_instances;
+    double mean_nodes = 0;
+    for (const auto c : node_counts) mean_nodes += static_cast<double>(c);
+    info["mean_nodes"] = n ? mean_nodes / static_cast<double>(n) : 0.0;
+  }
+  info["labels"] = args.labels.empty() ? std::string("labels/") : args.labels;
+  info["positive_distance"] = args.protocol.positive_distance;
+  info["negative_distance"] = args.protocol.negative_distance;
+  info["exclude_recent"] = args.protocol.exclude_recent;
+  info["describe_ms_per_frame"] = n ? 1000.0 * describe_seconds.load() / static_cast<double>(n) : 0.0;
+  info["describe_wall_s"] = describe_wall;
+  info["score_wall_s"] = score_wall;
+  write_outputs(out, args.method, summary, info);
+
+  std::cout << fmt::format("place-eval {} on {} ({} frames): {} positive, {} negative pairs\n", args.method,
+                           args.sequence, n, summary.positives, summary.negatives);
+  if (sgpr) std::cout << fmt::format("  mean graph size {:.1f} nodes\n", info["mean_nodes"].get<double>());
+  if (summary.positives == 0) {
+    spdlog::warn("no positive pairs (no revisit within {} m): the metrics are undefined", args.protocol.positive_distance);
+  } else {
+    std::cout << fmt::format("  max F1                     {:.4f} (precision {:.4f}, recall {:.4f}, score >= {:.6g})\n",
+                             summary.max_f1, summary.max_f1_precision, summary.max_f1_recall, summary.max_f1_threshold);
+    std::cout << fmt::format("  precision at 100 % recall  {:.4f}\n", summary.precision_at_full_recall);
+    std::cout << fmt::format("  recall at 100 % precision  {:.4f}\n", summary.recall_at_full_precision);
+  }
+  std::cout << fmt::format("  descriptors {:.1f} ms/frame (one core), scoring {:.2f} s for {} pairs; wrote {}\n",
+                           info["describe_ms_per_frame"].get<double>(), score_wall, pairs.size(),
+                           (out / "pr_curve.{csv,png}").string());
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "place-eval", "Place-recognition evaluation (SGPR or Scan Context) against ground-truth poses", 42,
+    [](CLI::App& app) {
+      auto args = std::make_shared<PlaceEvalArgs>();
+      args->config.add_to(app);
+      app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt, calib.txt)")->required();
+      app.add_option("--method", args->method, "sgpr or scancontext")->capture_default_str();
+      app.add_option("--model", args->model,
+                     "SGPR weights (.sgw); default: config loop.sgpr_model, else <shared>/models/sgpr/sgpr_kitti.sgw");
+      app.add_option("--labels", args->labels, "Folder of .label files to use instead of labels/");
+      app.add_option("--out", args->out, "Output folder (default ./place_eval_<method>)");
+      app.add_option("--positive", args->protocol.positive_distance, "[m] pairs within this distance are matches")
+          ->capture_default_str();
+      app.add_option("--negative", args->protocol.negative_distance, "[m] pairs beyond this distance are non-matches")
+          ->capture_default_str();
+      app.add_option("--exclude", args->protocol.exclude_recent, "most recent frames not compared with a query")
+          ->capture_default_str();
+      app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
+      app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");
+      return [args] { return run_place_eval(*args); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli
