@@ -1,0 +1,123 @@
+// End-to-end: `saloam eval` on the real KITTI 00 estimates and on bad files.
+
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+using testing::cli_path;
+using testing::run_command;
+using testing::shared_file;
+using testing::TempDir;
+
+/// Single-quoted for the shell (built with append: GCC 12 warns falsely on "'" + s).
+std::string quoted(const std::filesystem::path& p) {
+  std::string q(1, '\'');
+  q.append(p.string());
+  q.push_back('\'');
+  return q;
+}
+
+TEST(EvalCli, Kitti00OrbWritesJsonAndPlot) {
+  TempDir dir;
+  const auto gt = shared_file("data/kitti/poses/00.txt");
+  const auto est = shared_file("data/kitti/estimates/KITTI_00_ORB.txt");
+  const auto json_file = dir / "orb.json";
+  const auto png_file = dir / "orb.png";
+  std::string output;
+  const int code = run_command(quoted(cli_path()) + " eval --gt " + quoted(gt) + " --est " + quoted(est) +
+                                   " --json " + quoted(json_file) + " --plot " + quoted(png_file),
+                               &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("| KITTI translation error | 0.69973 % |"), std::string::npos) << output;
+  EXPECT_NE(output.find("| ATE RMSE, se3-aligned | 1.303450 m |"), std::string::npos) << output;
+
+  std::ifstream in(json_file);
+  ASSERT_TRUE(in) << json_file;
+  const auto j = nlohmann::json::parse(in);
+  EXPECT_EQ(j.at("num_poses"), 4541);
+  EXPECT_EQ(j.at("est"), "KITTI_00_ORB.txt");
+  EXPECT_NEAR(j.at("kitti").at("t_err_percent").get<double>(), 0.69973, 2e-3 * 0.69973);
+  EXPECT_NEAR(j.at("kitti").at("r_err_deg_per_100m").get<double>(), 0.25333, 2e-3 * 0.25333);
+  EXPECT_EQ(j.at("kitti").at("segments"), 3283);
+  ASSERT_EQ(j.at("kitti").at("per_length").size(), 8u);
+  EXPECT_EQ(j.at("kitti").at("per_length").at(7).at("length_m"), 800.0);
+  EXPECT_NEAR(j.at("ate").at("rmse_aligned").get<double>(), 1.303450, 1e-6);
+  EXPECT_NEAR(j.at("ate").at("rmse_unaligned").get<double>(), 7.790289, 1e-6);
+  for (const char* key : {"mean_aligned", "median_aligned", "max_aligned"}) {
+    EXPECT_TRUE(j.at("ate").at(key).is_number()) << key;
+  }
+  EXPECT_NEAR(j.at("rpe").at("trans_rmse_m").get<double>(), 0.028120, 1e-6);
+  EXPECT_TRUE(j.at("rpe").at("rot_rmse_deg").is_number());
+
+  ASSERT_TRUE(std::filesystem::exists(png_file));
+  EXPECT_GT(std::filesystem::file_size(png_file), 20000u);
+}
+
+TEST(EvalCli, Sim3AlignmentAndShorterEstimate) {
+  TempDir dir;
+  const auto gt = shared_file("data/kitti/poses/00.txt");
+  // An interrupted run: only the first 1000 poses of the S-PTAM estimate.
+  std::ifstream in(shared_file("data/kitti/estimates/KITTI_00_SPTAM.txt"));
+  std::ofstream out(dir / "short.txt");
+  std::string line;
+  for (int i = 0; i < 1000 && std::getline(in, line); ++i) out << line << '\n';
+  out.close();
+  std::string output;
+  const int code = run_command(quoted(cli_path()) + " eval --gt " + quoted(gt) + " --est " + quoted(dir / "short.txt") +
+                                   " --align sim3 --json " + quoted(dir / "e.json"),
+                               &output);
+  ASSERT_EQ(code, 0) << output;
+  EXPECT_NE(output.find("evaluating the first 1000 poses"), std::string::npos) << output;
+  std::ifstream json_in(dir / "e.json");
+  const auto j = nlohmann::json::parse(json_in);
+  EXPECT_EQ(j.at("num_poses"), 1000);
+  EXPECT_EQ(j.at("gt_poses"), 4541);
+  EXPECT_EQ(j.at("alignment"), "sim3");
+  EXPECT_GT(j.at("ate").at("scale").get<double>(), 0.9);
+  EXPECT_LT(j.at("ate").at("scale").get<double>(), 1.1);
+}
+
+TEST(EvalCli, MalformedPoseFileNamesFileAndLine) {
+  TempDir dir;
+  const auto bad = dir / "bad_poses.txt";
+  {
+    std::ifstream in(shared_file("data/kitti/estimates/KITTI_00_ORB.txt"));
+    std::ofstream out(bad);
+    std::string line;
+    for (int i = 0; i < 5 && std::getline(in, line); ++i) out << line << '\n';
+    out << "1 0 0 0 0 1 0 0 0 0 1 oops\n";  // line 6
+  }
+  std::string output;
+  const int code = run_command(quoted(cli_path()) + " eval --gt " + quoted(shared_file("data/kitti/poses/00.txt")) +
+                                   " --est " + quoted(bad),
+                               &output);
+  EXPECT_NE(code, 0) << output;
+  EXPECT_NE(output.find(bad.string()), std::string::npos) << output;
+  EXPECT_NE(output.find("line 6"), std::string::npos) << output;
+}
+
+TEST(EvalCli, MissingFileAndBadAlignmentFail) {
+  TempDir dir;
+  std::string output;
+  int code = run_command(quoted(cli_path()) + " eval --gt " + quoted(dir / "nope.txt") + " --est " +
+                             quoted(shared_file("data/kitti/estimates/KITTI_00_ORB.txt")),
+                         &output);
+  EXPECT_NE(code, 0) << output;
+  EXPECT_NE(output.find("nope.txt"), std::string::npos) << output;
+
+  code = run_command(quoted(cli_path()) + " eval --gt " + quoted(shared_file("data/kitti/poses/00.txt")) + " --est " +
+                         quoted(shared_file("data/kitti/estimates/KITTI_00_ORB.txt")) + " --align affine",
+                     &output);
+  EXPECT_NE(code, 0) << output;
+  EXPECT_NE(output.find("--align"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace saloam
