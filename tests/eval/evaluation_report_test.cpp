@@ -123,6 +123,17 @@ TEST(EvaluationMarkdown, ShowsHeadlineAndPerLengthTables) {
   EXPECT_EQ(text.find("warning"), std::string::npos);
 }
 
+TEST(EvaluationMarkdown, WithoutAlignmentOnlyUnalignedRows) {
+  const auto gt = loop_path(0, 2);
+  EvaluationOptions options;
+  options.alignment = Alignment::kNone;
+  const auto ev = evaluate_trajectories(gt, drifted(gt), options);
+  std::ostringstream out;
+  print_evaluation_markdown(out, ev);
+  EXPECT_EQ(out.str().find("-aligned"), std::string::npos) << out.str();
+  EXPECT_NE(out.str().find("| ATE RMSE, unaligned | "), std::string::npos);
+}
+
 TEST(EvaluationMarkdown, ShortPathShowsNotAvailableAndWarning) {
   const auto gt = loop_path(0, 1, 30);
   std::vector<Pose> small = gt;

@@ -113,9 +113,11 @@ void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& ev
   out << fmt::format("| KITTI translation error | {} % |\n", fixed(ev.kitti.t_err_percent, 5));
   out << fmt::format("| KITTI rotation error | {} deg/100 m |\n", fixed(ev.kitti.r_err_deg_per_100m, 5));
   out << fmt::format("| KITTI segments (100..800 m) | {} |\n", ev.kitti.segments);
-  out << fmt::format("| ATE RMSE, {}-aligned | {} m |\n", align, fixed(ev.ate.aligned.rmse, 6));
-  out << fmt::format("| ATE mean / median / max, {}-aligned | {} / {} / {} m |\n", align, fixed(ev.ate.aligned.mean, 4),
-                     fixed(ev.ate.aligned.median, 4), fixed(ev.ate.aligned.max, 4));
+  if (ev.ate.alignment != Alignment::kNone) {
+    out << fmt::format("| ATE RMSE, {}-aligned | {} m |\n", align, fixed(ev.ate.aligned.rmse, 6));
+    out << fmt::format("| ATE mean / median / max, {}-aligned | {} / {} / {} m |\n", align,
+                       fixed(ev.ate.aligned.mean, 4), fixed(ev.ate.aligned.median, 4), fixed(ev.ate.aligned.max, 4));
+  }
   if (ev.ate.alignment == Alignment::kSim3) out << fmt::format("| Sim(3) scale | {} |\n", fixed(ev.ate.transform.scale, 6));
   out << fmt::format("| ATE RMSE, unaligned | {} m |\n", fixed(ev.ate.unaligned.rmse, 6));
   out << fmt::format("| ATE mean / median / max, unaligned | {} / {} / {} m |\n", fixed(ev.ate.unaligned.mean, 4),
@@ -175,7 +177,7 @@ void plot_evaluation(const std::filesystem::path& file, const std::vector<Pose>&
   Plot plot(1100, 950);
   plot.set_margins(80, 100, 56, 60);
   plot.fit_range(all, true);
-  const std::string align = alignment_name(ev.ate.alignment);
+  const std::string align = ev.ate.alignment == Alignment::kNone ? "unaligned" : alignment_name(ev.ate.alignment);
   plot.set_title(fmt::format("KITTI t_err {} %  r_err {} deg/100m  |  ATE RMSE {} m ({})  |  RPE {} m",
                              fixed(ev.kitti.t_err_percent, 3), fixed(ev.kitti.r_err_deg_per_100m, 3),
                              fixed(ev.ate.aligned.rmse, 3), align, fixed(ev.rpe.trans_rmse_m, 4)));
@@ -185,7 +187,10 @@ void plot_evaluation(const std::filesystem::path& file, const std::vector<Pose>&
   const Rgb grey{150, 150, 150};
   plot.line(gt_xy, grey, 4.0);
   plot.colored_line(est_xy, errors, 0.0, vmax, 2.0);
-  if (!gt_xy.empty()) plot.marker(gt_xy.front(), {0, 0, 0}, 5.0, "start");
+  if (!gt_xy.empty()) {
+    plot.marker(gt_xy.front(), {0, 0, 0}, 5.0, "start");
+    if ((gt_xy.back() - gt_xy.front()).norm() > 1e-3) plot.marker(gt_xy.back(), {0, 0, 0}, 3.5, "end");
+  }
 
   const std::string est_name = labels.est_name.empty() ? "estimate" : labels.est_name;
   const std::string gt_name = labels.gt_name.empty() ? "ground truth" : labels.gt_name;
