@@ -45,7 +45,6 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     sin_el[static_cast<std::size_t>(b)] = std::sin(e);
     cos_el[static_cast<std::size_t>(b)] = std::cos(e);
   }
-  const Pose start_inv = sweep.start.inverse();
 
   tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
     std::vector<Primitive> agents, near;
@@ -86,8 +85,10 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
         const double far = range_m / lidar.max_range;
         const double p_drop = lidar.dropout + 0.25 * far * far * (1.0 - std::min(1.0, static_cast<double>(hit.remission) * 2.0));
         if (drop < p_drop) continue;
-        const Eigen::Vector3d world_point = origin + range_m * dir;
-        out.point = (start_inv * world_point).cast<float>();
+        // A spinning LiDAR reports each return in its own frame at the
+        // column's instant: the scan is distorted by the motion during the
+        // sweep (pose `start` names the sweep, not every point's frame).
+        out.point = (range_m * dir_s).cast<float>();
         out.remission = static_cast<float>(std::clamp(hit.remission + rem_noise, 0.0, 0.99));
         out.range = static_cast<float>(range_m);
         out.label = hit.label;

@@ -48,7 +48,9 @@ struct SweepSpec {
 
 /// A simulated scan with the range-image position of every point.
 struct SimulatedScan {
-  LabelledCloud cloud;              ///< sensor frame at sweep start, ground-truth labels
+  /// Ground-truth labels; each point in the sensor frame at its own column's
+  /// instant (motion-distorted like real data; exact at sweep start).
+  LabelledCloud cloud;
   std::vector<std::uint16_t> ring;  ///< beam index (0 = top)
   std::vector<std::uint16_t> column;
   std::vector<float> range;         ///< measured range [m]
