@@ -34,6 +34,10 @@ struct FeatureConfig {
   double min_range = 2.5;       ///< [m] closer returns are ignored (vehicle body)
   double max_range = 120.0;     ///< [m]
   int num_beams = 0;            ///< 0 = detect 64/32/16 from the data
+  /// Take rings from the storage order when the scan is stored ring by ring
+  /// (KITTI, simulator), else from the elevation angle. The order stays exact
+  /// when points were motion-compensated; the elevation then does not.
+  bool ring_from_point_order = true;
   /// Seconds into the 0.1 s sweep that a scan's pose refers to: 0 for sweep
   /// start (the simulator), 0.05 for real KITTI (pose when facing forward).
   double pose_time_in_sweep = 0.0;
@@ -99,6 +103,7 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
   v("min_range", c.min_range, "min range [m]");
   v("max_range", c.max_range, "max range [m]");
   v("num_beams", c.num_beams, "beams (0 = detect)");
+  v("ring_from_point_order", c.ring_from_point_order, "rings from storage order when it is ring by ring");
   v("pose_time_in_sweep", c.pose_time_in_sweep, "[s] instant of the sweep a pose refers to");
   v("sweep_duration", c.sweep_duration, "[s] one revolution");
   v("sweep_start_azimuth_deg", c.sweep_start_azimuth_deg, "[deg] azimuth where a sweep starts");

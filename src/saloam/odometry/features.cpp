@@ -32,8 +32,8 @@ BeamLayout detect_beam_layout(const std::vector<Eigen::Vector3f>& points, int nu
   }
   if (elevation.empty()) return BeamLayout::kHdl64;
   std::sort(elevation.begin(), elevation.end());
-  const float low = elevation[elevation.size() / 200];
-  const float high = elevation[elevation.size() - 1 - elevation.size() / 200];
+  const float low = elevation[elevation.size() / 50];
+  const float high = elevation[elevation.size() - 1 - elevation.size() / 50];
   if (high > 12.0f && low > -17.0f) return BeamLayout::kVlp16;
   if (low < -27.0f || high > 6.0f) return BeamLayout::kHdl32;
   return BeamLayout::kHdl64;
@@ -194,30 +194,79 @@ int odometry_class(std::uint16_t raw_label) {
   return learning == 0 ? -1 : learning;
 }
 
+std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
+                                                              const FeatureConfig& config, int expected_rings) {
+  // KITTI and the simulator store a scan ring by ring, each ring in firing
+  // order: the sweep time restarts at every ring change.
+  std::vector<std::vector<std::uint32_t>> rings;
+  std::vector<std::uint32_t> current;
+  double last_time = -1.0;
+  const double wrap = 0.5 * config.sweep_duration;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (std::hypot(p.x(), p.y()) < 1e-3) continue;
+    const double t = sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config);
+    if (last_time >= 0.0 && t < last_time - wrap) {
+      rings.push_back(std::move(current));
+      current.clear();
+    }
+    current.push_back(static_cast<std::uint32_t>(i));
+    last_time = t;
+  }
+  if (!current.empty()) rings.push_back(std::move(current));
+  // Accept only if it looks like rings: many long runs, not more runs than
+  // a spinning LiDAR has beams (expected_rings <= 0: any of 16..128).
+  int long_runs = 0;
+  for (const auto& r : rings) long_runs += r.size() >= 100;
+  const int segments = static_cast<int>(rings.size());
+  const int max_rings = expected_rings > 0 ? expected_rings * 3 / 2 + 2 : 130;
+  const int min_long = expected_rings > 0 ? expected_rings / 4 : 8;
+  if (long_runs < min_long || segments > max_rings) return {};
+  return rings;
+}
+
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels) {
   ScanFeatures out;
-  const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
-  const int rings = ring_count(layout);
-  // Bucket points by ring with their sweep time, then order each ring in time
-  // so that ring neighbours are neighbours in azimuth.
   struct Entry {
     float time;
     std::uint32_t index;
   };
-  std::vector<std::vector<Entry>> buckets(rings);
-  for (auto& b : buckets) b.reserve(cloud.size() / rings * 2);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f& p = cloud.points[i];
-    const double horizontal = std::hypot(p.x(), p.y());
-    if (horizontal < 1e-3) continue;
-    const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
-    if (ring < 0) continue;
-    const double t = sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config);
-    buckets[ring].push_back({static_cast<float>(t), static_cast<std::uint32_t>(i)});
+  std::vector<std::vector<Entry>> buckets;
+  // Rings from the point order when the scan is stored ring by ring (exact
+  // even for scans whose points were moved by motion compensation), else from
+  // the elevation angle.
+  auto ordered = config.ring_from_point_order ? rings_from_point_order(cloud, config, config.num_beams)
+                                              : std::vector<std::vector<std::uint32_t>>{};
+  if (!ordered.empty()) {
+    buckets.resize(ordered.size());
+    for (std::size_t r = 0; r < ordered.size(); ++r) {
+      buckets[r].reserve(ordered[r].size());
+      for (const auto i : ordered[r]) {
+        const Eigen::Vector3f& p = cloud.points[i];
+        buckets[r].push_back({static_cast<float>(sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config)), i});
+      }
+    }
+  } else {
+    const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
+    const int num_rings = ring_count(layout);
+    buckets.resize(num_rings);
+    for (auto& b : buckets) b.reserve(cloud.size() / num_rings * 2);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const Eigen::Vector3f& p = cloud.points[i];
+      const double horizontal = std::hypot(p.x(), p.y());
+      if (horizontal < 1e-3) continue;
+      const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
+      if (ring < 0) continue;
+      const double t = sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config);
+      buckets[ring].push_back({static_cast<float>(t), static_cast<std::uint32_t>(i)});
+    }
+    // Order each ring in time so that ring neighbours are neighbours in azimuth.
+    for (auto& bucket : buckets) {
+      std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
+    }
   }
   std::vector<Eigen::Vector3d> ring_points;
   for (auto& bucket : buckets) {
-    std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
     ring_points.resize(bucket.size());
     for (std::size_t k = 0; k < bucket.size(); ++k) ring_points[k] = cloud.points[bucket[k].index].cast<double>();
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);

@@ -91,6 +91,13 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<double>& roughness,
                                    const std::vector<bool>& unreliable, const FeatureConfig& config);
 
+/// Rings from the storage order (KITTI and the simulator write a scan ring by
+/// ring, each in firing order: a ring ends where the sweep time jumps back).
+/// Returns point indices per ring, or nothing when the order does not look
+/// like rings (then rings come from the elevation). expected_rings <= 0: unknown.
+std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
+                                                              const FeatureConfig& config, int expected_rings);
+
 /// The class index of a raw label for the odometry, or -1 when the point must
 /// not be used (dynamic classes, unlabeled, outlier).
 int odometry_class(std::uint16_t raw_label);
