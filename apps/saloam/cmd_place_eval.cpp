@@ -41,6 +41,7 @@ struct PlaceEvalArgs {
   PlaceEvalConfig protocol;
   bool no_instances = false;
   bool save_graphs = false;
+  bool save_scores = false;
 };
 
 /// Runs `work(i)` for every frame in parallel with a progress bar; stops early on Ctrl-C.
@@ -170,6 +171,13 @@ int run_place_eval(const PlaceEvalArgs& args) {
   if (stop_requested()) return 130;
   const double score_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
 
+  if (args.save_scores) {
+    std::ofstream csv(out / "pair_scores.csv");
+    if (!csv) throw InputError(out / "pair_scores.csv", "cannot create file");
+    csv << "query,candidate,positive,score\n";
+    for (std::size_t k = 0; k < pairs.size(); ++k)
+      csv << fmt::format("{},{},{},{:.9g}\n", pairs[k].query, pairs[k].candidate, truth[k], scores[k]);
+  }
   const PrSummary summary = precision_recall(scores, truth);
   nlohmann::json info;
   info["method"] = args.method;
@@ -227,6 +235,7 @@ const CommandRegistration kRegistration{Command{
           ->capture_default_str();
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
       app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");
+      app.add_flag("--save-scores", args->save_scores, "Also write every pair's score to OUT/pair_scores.csv");
       return [args] { return run_place_eval(*args); };
     }}};
 

@@ -60,7 +60,9 @@ TEST(PrecisionRecall, ThinnedCurveKeepsEndsAndBestPoint) {
   }
   const auto s = precision_recall(scores, positive);
   const auto thin = thin_curve(s, 50);
-  EXPECT_LE(thin.size(), 52U);
+  EXPECT_LE(thin.size(), 2 * 50U + 3U);
+  EXPECT_GE(thin.size(), 10U);
+  for (std::size_t k = 1; k < thin.size(); ++k) EXPECT_LT(thin[k].threshold, thin[k - 1].threshold);
   EXPECT_EQ(thin.front().threshold, s.curve.front().threshold);
   EXPECT_EQ(thin.back().threshold, s.curve.back().threshold);
   bool has_best = false;

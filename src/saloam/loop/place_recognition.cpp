@@ -1,6 +1,7 @@
 #include "saloam/loop/place_recognition.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
 
@@ -54,16 +55,16 @@ PrSummary precision_recall(std::span<const double> scores, std::span<const std::
 std::vector<PrPoint> thin_curve(const PrSummary& summary, std::size_t max_points) {
   const auto& curve = summary.curve;
   if (curve.size() <= max_points || max_points < 2) return curve;
-  std::vector<PrPoint> out;
-  for (std::size_t k = 0; k < max_points; ++k) {
-    const std::size_t index = k * (curve.size() - 1) / (max_points - 1);
-    if (out.empty() || out.back().threshold != curve[index].threshold) out.push_back(curve[index]);
-    // Keep the max-F1 point where it falls between two samples.
-    const std::size_t next = (k + 1) * (curve.size() - 1) / (max_points - 1);
-    if (k + 1 < max_points)
-      for (std::size_t m = index + 1; m < next; ++m)
-        if (curve[m].threshold == summary.max_f1_threshold) out.push_back(curve[m]);
+  // Keep a point once precision or recall has moved by a step since the last
+  // kept one: even detail along the drawn curve, wherever the scores crowd.
+  const double step = 1.0 / static_cast<double>(max_points);
+  std::vector<PrPoint> out{curve.front()};
+  for (std::size_t k = 1; k + 1 < curve.size(); ++k) {
+    const auto& p = curve[k];
+    const bool moved = std::abs(p.recall - out.back().recall) >= step || std::abs(p.precision - out.back().precision) >= step;
+    if (moved || p.threshold == summary.max_f1_threshold) out.push_back(p);
   }
+  out.push_back(curve.back());
   return out;
 }
 

@@ -52,8 +52,9 @@ struct PrSummary {
 /// Ties are handled as one threshold. With no positives all metrics are 0.
 PrSummary precision_recall(std::span<const double> scores, std::span<const std::uint8_t> positive);
 
-/// At most `max_points` points of a curve, evenly spread over its length,
-/// always keeping the first and last points and the max-F1 point.
+/// A thinned curve for plots and CSV: a point is kept when precision or
+/// recall moved by 1 / max_points since the last kept one (so about
+/// max_points to 2 max_points points), plus the first, last and max-F1 points.
 std::vector<PrPoint> thin_curve(const PrSummary& summary, std::size_t max_points);
 
 }  // namespace saloam
