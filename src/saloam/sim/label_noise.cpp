@@ -36,8 +36,8 @@ Confusion confusion_of(std::uint8_t c) {
     case kVegetation: return {0.06, {kTerrain, kTrunk, kBuilding}};
     case kTrunk: return {0.3, {kVegetation, kPole, kTrunk}};
     case kTerrain: return {0.12, {kVegetation, kSidewalk, kTerrain}};
-    case kPole: return {0.25, {kTrafficSign, kTrunk, kBuilding}};
-    case kTrafficSign: return {0.25, {kPole, kBuilding, kPole}};
+    case kPole: return {0.2, {kTrunk, kTrafficSign, kBuilding}};
+    case kTrafficSign: return {0.2, {kPole, kBuilding, kPole}};
     default: return {0.3, {kBuilding, kFence, kBuilding}};
   }
 }
@@ -65,17 +65,20 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
   for (std::size_t i = 0; i < n; ++i) {
     const int r = scan.ring[i], c = scan.column[i];
     std::array<std::uint8_t, 16> other{};
-    int n_other = 0;
+    int n_other = 0, n_seen = 0;
     for (int dr = -1; dr <= 1; ++dr) {
       for (int dc = -options.boundary_columns; dc <= options.boundary_columns; ++dc) {
         const int rr = r + dr, cc = (c + dc + columns) % columns;
         if ((dr == 0 && dc == 0) || rr < 0 || rr >= beams) continue;
         const std::int32_t j = image[static_cast<std::size_t>(rr) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(cc)];
+        if (j >= 0) ++n_seen;
         if (j >= 0 && truth[static_cast<std::size_t>(j)] != truth[i] && n_other < 16) other[static_cast<std::size_t>(n_other++)] = truth[static_cast<std::size_t>(j)];
       }
     }
     const double u = rng.uniform(), v = rng.uniform();
-    if (n_other > 0 && u < options.boundary_flip) out[i] = other[static_cast<std::size_t>(v * n_other)];
+    // More likely the more of the neighbourhood belongs to other classes.
+    const double share = static_cast<double>(n_other) / static_cast<double>(n_seen);
+    if (n_other > 0 && u < options.boundary_flip * share) out[i] = other[static_cast<std::size_t>(v * n_other)];
   }
 
   // 2. Correlated confusions between similar classes, blob by blob.
@@ -90,10 +93,12 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
     }
   }
 
-  // 3. A few plainly wrong labels.
+  // 3. A few plainly wrong labels, drawn from the common classes (networks
+  // do not hallucinate rare ones like signs out of nothing).
+  constexpr std::array<std::uint8_t, 7> kCommon{kRoad, kSidewalk, kBuilding, kVegetation, kTerrain, kCar, kFence};
   for (std::size_t i = 0; i < n; ++i) {
     const double u = rng.uniform(), v = rng.uniform();
-    if (u < options.random_label) out[i] = static_cast<std::uint8_t>(1 + static_cast<int>(v * 19));
+    if (u < options.random_label) out[i] = kCommon[static_cast<std::size_t>(v * kCommon.size())];
   }
 
   std::vector<std::uint16_t> labels(n);

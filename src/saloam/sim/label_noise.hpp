@@ -13,7 +13,7 @@
 namespace saloam::sim {
 
 struct LabelNoiseOptions {
-  double boundary_flip = 0.45;   ///< chance that a point next to another class takes that class
+  double boundary_flip = 0.8;    ///< chance (times the share of other classes around) that a point takes a neighbour's class
   int boundary_columns = 2;      ///< neighbourhood half width in columns
   double confusion_scale = 1.0;  ///< scales the per-class confusion rates
   double random_label = 0.01;    ///< chance of a uniformly random class

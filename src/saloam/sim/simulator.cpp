@@ -44,20 +44,21 @@ std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::
   return frames;
 }
 
-SweepSpec sweep_for_frame(const std::vector<Pose>& traj, std::size_t i, std::size_t stride,
-                          const SimulationOptions& options) {
+SweepSpec sweep_for_frame(const std::vector<Pose>& traj, std::size_t i, const SimulationOptions& options) {
   SweepSpec s;
   s.start = traj.at(i);
   const double period = options.frame_period;
-  if (i + stride < traj.size()) {
-    s.end = traj[i + stride];
-  } else if (i >= stride) {  // last frame: continue the previous motion
-    s.end = orthonormalized(traj[i] * (traj[i - stride].inverse() * traj[i]));
+  // The sweep lasts one frame period whatever the stride: the sensor moves
+  // from pose i towards pose i+1 while it turns.
+  if (i + 1 < traj.size()) {
+    s.end = traj[i + 1];
+  } else if (i >= 1) {  // last pose: continue the previous motion
+    s.end = orthonormalized(traj[i] * (traj[i - 1].inverse() * traj[i]));
   } else {
     s.end = traj[i];
   }
   s.time_start = static_cast<double>(i) * period;
-  s.time_end = static_cast<double>(i + stride) * period;
+  s.time_end = static_cast<double>(i + 1) * period;
   s.seed = hash3(options.seed, 0xf7a3ull, i);
   s.skew = options.skew;
   return s;
@@ -83,7 +84,7 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
   std::vector<double> times;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     lidar_out.push_back(orthonormalized(base_inv * trajectory[frames[k]]));
-    times.push_back(static_cast<double>(k) * options.frame_period);
+    times.push_back(static_cast<double>(frames[k] - frames.front()) * options.frame_period);
   }
   const std::vector<Pose> camera_out = lidar_to_camera_poses(lidar_out, tr);
 
@@ -103,7 +104,7 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
       summary.interrupted = true;
       break;
     }
-    const SweepSpec sweep = sweep_for_frame(trajectory, frames[k], options.stride, options);
+    const SweepSpec sweep = sweep_for_frame(trajectory, frames[k], options);
     SimulatedScan scan = simulate_scan(world, lidar, sweep);
     if (noisy) {
       write_scan_labels(out_dir / "labels_gt" / (frame_name(k) + ".label"), scan.cloud);

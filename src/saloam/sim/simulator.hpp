@@ -3,7 +3,7 @@
 // a world built along it, one simulated HDL-64E sweep per frame, written in
 // the SemanticKITTI layout so every other command reads it like real data:
 //   velodyne/NNNNNN.bin  labels/NNNNNN.label  [labels_gt/NNNNNN.label]
-//   poses.txt (camera frame, P_i = Tr Q_i Tr^-1, P_0 = I)  calib.txt (Tr)  times.txt (10 Hz)
+//   poses.txt (camera frame, P_i = Tr Q_i Tr^-1, P_0 = I)  calib.txt (Tr)  times.txt (s; 10 Hz sensor)
 
 #include <cstddef>
 #include <cstdint>
@@ -28,7 +28,9 @@ struct SimulationOptions {
   std::vector<Pose> camera_poses;
   Pose velo_to_cam = Pose::Identity();  ///< Tr; presets use KITTI 00's when left identity
   bool velo_to_cam_given = false;
-  /// Source frames [first_frame, end_frame) every `stride`-th; renumbered from 0.
+  /// Source frames [first_frame, end_frame) every `stride`-th; renumbered from
+  /// 0. times.txt keeps the true times (stride K: frames K * 0.1 s apart), so
+  /// the motion within a sweep stays that of a real 10 Hz sensor.
   std::size_t first_frame = 0;
   std::size_t end_frame = std::numeric_limits<std::size_t>::max();
   std::size_t stride = 1;
@@ -60,8 +62,9 @@ Pose output_velo_to_cam(const SimulationOptions& options);
 /// Source indices of the frames to simulate. Throws ConfigError on an empty selection.
 std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::size_t trajectory_size);
 
-/// Sweep of output frame with source index `i` (pose i to pose i+stride).
-SweepSpec sweep_for_frame(const std::vector<Pose>& lidar_trajectory, std::size_t source_index, std::size_t stride,
+/// Sweep of the frame with source index `i`: from pose i towards pose i+1
+/// over one frame period (world time i * frame_period).
+SweepSpec sweep_for_frame(const std::vector<Pose>& lidar_trajectory, std::size_t source_index,
                           const SimulationOptions& options);
 
 /// Simulates and writes the sequence to `out_dir` (created). Stops cleanly on

@@ -198,19 +198,26 @@ double World::path_distance(double x, double y) const { return bilinear(distance
 
 World::Zone World::zone_at(double x, double y) const { return zones_[cell_index(x, y)]; }
 
-double World::road_half_width(double x, double y) const { return zone_at(x, y).road; }
+double World::path_lateral(double x, double y) const { return bilinear(lateral_, x, y); }
+
+double World::road_margin(double x, double y) const {
+  const double lat = path_lateral(x, y);
+  const Zone z = zone_at(x, y);
+  return lat >= 0 ? lat - z.road_left : -lat - z.road_right;
+}
 
 GroundInfo World::ground_at(double x, double y) const {
-  const double d = path_distance(x, y);
+  const double lat = path_lateral(x, y);
   const Zone z = zone_at(x, y);
+  const double d = lat >= 0 ? lat - z.road_left : -lat - z.road_right;  // beyond the road edge
   const double base = bilinear(height_, x, y);
   GroundInfo g;
-  const double road = z.road, park = road + z.parking, walk = park + z.sidewalk;
+  const double road = 0.0, park = z.parking, walk = park + z.sidewalk;
   if (d < road) {
     g.height = base;
     g.label = cls::kRoad;
-    // Lane lines: a centre line left of the ego lane and the road edges.
-    const bool marking = (d > 1.65 && d < 1.8) || (d > road - 0.45 && d < road - 0.3);
+    // Lane lines: the centre line left of the ego lane and the road edges.
+    const bool marking = (lat > 1.5 && lat < 1.65) || (d > -0.4 && d < -0.25);
     g.remission = marking ? 0.62f : 0.22f;
     return g;
   }
@@ -407,9 +414,7 @@ void World::agents_at(double t, const Eigen::Vector2d& near, double radius, std:
     const Zone z = zone_at(pos.x(), pos.y());
     if (a.sidewalk_side != 0) {
       // Rural roads have no sidewalk: walk on the verge beside the road.
-      lateral = a.sidewalk_side * (z.road + z.parking + (z.sidewalk > 0 ? 0.5 * z.sidewalk : 1.2));
-    } else if (lateral > 0) {
-      lateral = std::min(lateral, z.road - 0.5 * a.width - 0.2);  // stay on narrow roads
+      lateral = a.sidewalk_side * (z.road(a.sidewalk_side) + z.parking + (z.sidewalk > 0 ? 0.5 * z.sidewalk : 1.2));
     }
     const Eigen::Vector2d xy = pos.head<2>() + lateral * left;
     if ((xy - near).norm() > radius) continue;

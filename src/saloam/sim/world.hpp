@@ -106,8 +106,14 @@ class World {
 
   /// Distance from (x, y) to the driven path (bilinear on the raster) [m].
   [[nodiscard]] double path_distance(double x, double y) const;
-  /// Half width of the road corridor (road class) around the path at (x, y).
-  [[nodiscard]] double road_half_width(double x, double y) const;
+  /// Signed lateral offset from the driven path (positive = left of the
+  /// direction of travel of the nearest path point).
+  [[nodiscard]] double path_lateral(double x, double y) const;
+  /// Distance beyond the edge of the road (negative inside the road). The
+  /// road spans ~2 m to the right of the path and one or two lanes more to the
+  /// left (right-hand traffic), over the whole trajectory.
+  [[nodiscard]] double road_margin(double x, double y) const;
+  [[nodiscard]] bool in_road(double x, double y) const { return road_margin(x, y) < 0.0; }
   /// Ground surface height and class at (x, y).
   [[nodiscard]] GroundInfo ground_at(double x, double y) const;
   [[nodiscard]] double ground_height(double x, double y) const;
@@ -132,10 +138,12 @@ class World {
   friend class WorldBuilder;
   friend World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options);
   struct Zone {
-    float road = 6;      ///< road half width
+    float road_right = 2;  ///< road extent right of the path
+    float road_left = 5;   ///< road extent left of the path (oncoming lane)
     float parking = 0;   ///< parking width beyond the road
     float sidewalk = 3;  ///< sidewalk width (0 = rural, no curb)
     std::uint8_t verge = 0;  ///< 0 terrain, 1 paved (sidewalk), 2 other-ground
+    [[nodiscard]] double road(int side) const { return side > 0 ? road_left : road_right; }
   };
   [[nodiscard]] Zone zone_at(double x, double y) const;
   [[nodiscard]] double bilinear(const std::vector<float>& field, double x, double y) const;
@@ -147,7 +155,7 @@ class World {
   // Ground raster.
   Eigen::Vector2d origin_{0, 0};
   int nx_ = 0, ny_ = 0;
-  std::vector<float> distance_, height_, bump_;
+  std::vector<float> distance_, lateral_, height_, bump_;
   std::vector<Zone> zones_;
   // Static objects and their 2D grid (CSR).
   std::vector<Primitive> primitives_;

@@ -121,6 +121,20 @@ class WorldBuilder {
       }
     }
 
+    // Signed lateral offset: which side of the nearest path point's direction.
+    w_.lateral_.resize(n);
+    for (int iy = 0; iy < w_.ny_; ++iy) {
+      for (int ix = 0; ix < w_.nx_; ++ix) {
+        const std::size_t i = idx(ix, iy);
+        const auto k = static_cast<std::size_t>(source[i]);
+        const std::size_t k0 = k > 0 ? k - 1 : k, k1 = std::min(w_.path_.size() - 1, k + 1);
+        const Eigen::Vector2d dir = (w_.path_[k1] - w_.path_[k0]).head<2>();
+        const Eigen::Vector2d rel = center(ix, iy) - w_.path_[k].head<2>();
+        const double cross = dir.x() * rel.y() - dir.y() * rel.x();
+        w_.lateral_[i] = cross >= 0 ? w_.distance_[i] : -w_.distance_[i];
+      }
+    }
+
     // Height of the nearest path point, smoothed so that two passes at
     // slightly different heights meet without a step.
     w_.height_.resize(n);
@@ -135,14 +149,18 @@ class WorldBuilder {
         const Eigen::Vector2d c = center(ix, iy);
         World::Zone z;
         const bool rural = noise_at(hash_combine(seed_, kSaltRural), c.x(), c.y(), 260.0) > 0.7;
-        z.road = static_cast<float>(4.0 + 2.4 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
+        // Right-hand traffic: the path runs in the right lane; the oncoming
+        // lane (3.2 m further left) and, on avenues, one more lane lie left.
+        z.road_right = static_cast<float>(1.75 + 0.55 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
+        const bool avenue = noise_at(hash_combine(seed_, kSaltRoad + 1000), c.x(), c.y(), 300.0) > 0.78;
+        z.road_left = z.road_right + 3.2f + (avenue ? 3.3f : 0.0f);
         const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 110.0);
         const double lot = noise_at(hash_combine(seed_, kSaltLot), c.x(), c.y(), 70.0);
         z.parking = 0.0f;
-        if (!rural && park > 0.55) z.parking = 2.4f;
-        if (!rural && lot > 0.8) z.parking = 15.0f;
+        if (!rural && park > 0.72) z.parking = 2.4f;
+        if (!rural && lot > 0.9) z.parking = 15.0f;
         z.sidewalk = rural ? 0.0f
-                           : static_cast<float>(1.8 + 2.4 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
+                           : static_cast<float>(2.2 + 2.6 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
         const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
         z.verge = rural || verge < 0.6 ? 0 : (verge < 0.8 ? 1 : 2);
         const std::size_t i = idx(ix, iy);
@@ -181,9 +199,10 @@ class WorldBuilder {
 
   // ------------------------------------------------------------ placement helpers
 
-  [[nodiscard]] double street_edge(const Eigen::Vector2d& p) const {
+  /// Lateral distance from the path to the back of the sidewalk on one side.
+  [[nodiscard]] double street_edge(const Eigen::Vector2d& p, int side) const {
     const World::Zone z = w_.zone_at(p.x(), p.y());
-    return z.road + z.parking + z.sidewalk;
+    return z.road(side) + z.parking + z.sidewalk;
   }
   [[nodiscard]] bool inside_grid(const Eigen::Vector2d& p) const {
     return p.x() > w_.origin_.x() + 1 && p.y() > w_.origin_.y() + 1 &&
@@ -211,9 +230,9 @@ class WorldBuilder {
                  bool road_only) const {
     return for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
       if (!inside_grid(p)) return false;
-      const double d = w_.path_distance(p.x(), p.y());
-      const double limit = road_only ? w_.road_half_width(p.x(), p.y()) : street_edge(p);
-      return d >= limit + clearance && occupied_[w_.cell_index(p.x(), p.y())] == 0;
+      const World::Zone z = w_.zone_at(p.x(), p.y());
+      const double limit = road_only ? 0.0 : z.parking + z.sidewalk;
+      return w_.road_margin(p.x(), p.y()) >= limit + clearance && occupied_[w_.cell_index(p.x(), p.y())] == 0;
     });
   }
   void mark_rect(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy) {
@@ -271,9 +290,9 @@ class WorldBuilder {
         const double depth = rng.uniform(8, 18);
         const double pick = rng.uniform();
         const double height = pick < 0.12 ? rng.uniform(5, 8) : (pick < 0.75 ? rng.uniform(8, 16) : rng.uniform(16, 25));
-        const double setback = rng.chance(0.25) ? rng.uniform(6, 15) : rng.uniform(0.5, 4);
+        const double setback = rng.chance(0.65) ? rng.uniform(3.5, 12) : rng.uniform(0.5, 2.5);
         const double yaw = rng.uniform(-0.035, 0.035);
-        const double edge = street_edge(probe);
+        const double edge = street_edge(probe, side);
         for (int attempt = 0; attempt < 2; ++attempt, length *= 0.55) {
           Eigen::Vector3d mid3;
           Eigen::Vector2d mdir;
@@ -288,7 +307,16 @@ class WorldBuilder {
           // Front yard: hedge or fence along the property line, sometimes a tree.
           const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * (edge + 0.4);
           if (setback > 2.0) property_line(yard, axis, 0.5 * length, rng);
-          const double gap = rng.chance(0.35) ? rng.uniform(0.0, 1.0) : rng.uniform(3, 16);
+          // Garden: bushes and a small tree between the property line and the house.
+          for (int k = 0; setback > 3.0 && k < static_cast<int>(length / 6.0); ++k) {
+            const Eigen::Vector2d g = p + rng.uniform(0.1, 0.9) * length * axis +
+                                      side * mleft * (edge + rng.uniform(1.4, setback - 0.8));
+            const double r = std::min(rng.uniform(0.5, 1.5), 0.5 * setback - 0.6);
+            if (r < 0.4 || !rect_free(g, {1, 0}, r, r, 0.5, false)) continue;
+            if (r > 1.1 && rng.chance(0.35)) add_tree(g, r + 1.0, rng); else add_bush(g, r, rng);
+            mark_rect(g, {1, 0}, r, r);
+          }
+          const double gap = rng.chance(0.45) ? rng.uniform(0.0, 1.0) : rng.uniform(2, 12);
           return length + gap;
         }
         return 4.0;
@@ -363,6 +391,44 @@ class WorldBuilder {
     mark_rect(c, axis, half_length, 0.5);
   }
 
+  // Hedges and fences along the back of the sidewalk wherever no building
+  // stands there: streets in KITTI are lined with them.
+  void place_boundaries() {
+    for (int side = -1; side <= 1; side += 2) {
+      Rng rng(hash3(seed_, kSaltFences, static_cast<std::uint64_t>(side + 5)));
+      walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const Eigen::Vector2d probe = p + side * left * 7.0;
+        const double edge = street_edge(probe, side);
+        const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
+        const double length = rng.uniform(4, 18);
+        const double pick = rng.uniform();
+        if (pick < (rural ? 0.45 : 0.22)) return length;  // open
+        const double off = edge + rng.uniform(0.3, rural ? 4.0 : 1.2);
+        const Eigen::Vector2d c = p + 0.5 * length * dir + side * left * off;
+        const double g = ground(c);
+        if (pick < (rural ? 0.75 : 0.68)) {  // hedge
+          const double half_w = rng.uniform(0.35, 0.7);
+          if (!rect_free(c, dir, 0.5 * length, half_w, 0.1, false)) return 2.0;
+          Primitive h = box(cls::kVegetation, c, dir, 0.5 * length, half_w, g - 0.1, g + rng.uniform(0.8, 2.2), rng.uniform(0.38, 0.5));
+          h.mean_free_path = 0.3f;
+          w_.primitives_.push_back(h);
+          mark_rect(c, dir, 0.5 * length, half_w);
+        } else {  // fence: boards, railings or chain-link the beam partly passes
+          if (!rect_free(c, dir, 0.5 * length, 0.3, 0.1, false)) return 2.0;
+          Primitive f = box(cls::kFence, c, dir, 0.5 * length, 0.04, g, g + rng.uniform(0.9, 2.0), rng.uniform(0.2, 0.5));
+          if (rng.chance(0.4)) {
+            f.half_y = 0.2f;
+            f.mean_free_path = 0.9f;
+          }
+          w_.primitives_.push_back(f);
+          mark_rect(c, dir, 0.5 * length, 0.3);
+        }
+        return length + (rng.chance(0.6) ? 0.0 : rng.uniform(1, 6));
+      });
+    }
+  }
+
   void place_street_furniture() {
     // Street lights and signs near the curb, trees in the verge.
     for (int side = -1; side <= 1; side += 2) {
@@ -370,7 +436,7 @@ class WorldBuilder {
       walk(rng.uniform(0, 20), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
         const Eigen::Vector2d left(-dir.y(), dir.x());
         const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
-        const double off = z.road + z.parking + (z.sidewalk > 0 ? 0.45 : 1.2);
+        const double off = z.road(side) + z.parking + (z.sidewalk > 0 ? 0.45 : 1.2);
         const Eigen::Vector2d c = p + side * left * off;
         if (!far_from(poles_, c, 15.0) || !disc_free(c, 0.3, 0.25)) return 3.0;
         const double g = ground(c);
@@ -413,12 +479,12 @@ class WorldBuilder {
         const Eigen::Vector2d left(-dir.y(), dir.x());
         const Eigen::Vector2d probe = p + side * left * 7.0;
         const World::Zone z = w_.zone_at(probe.x(), probe.y());
-        const double edge = z.road + z.parking + z.sidewalk;
+        const double edge = z.road(side) + z.parking + z.sidewalk;
         const bool rural = z.sidewalk == 0;
         // Tree rows along the verge; rural land gets more and bigger trees, further out too.
         const double offset = edge + rng.uniform(1.0, rural ? 12.0 : 3.0);
         const Eigen::Vector2d c = p + side * left * offset;
-        const double crown = std::min(rng.uniform(1.5, rural ? 3.8 : 3.0), offset - z.road - 0.6);
+        const double crown = std::min(rng.uniform(1.8, rural ? 4.2 : 3.5), offset - z.road(side) - 0.6);
         if (crown < 1.0 || !far_from(trees_, c, 5.0) || !disc_free(c, crown, 0.5) || !disc_free(c, 0.6, 0.3)) {
           return 2.0;
         }
@@ -429,19 +495,20 @@ class WorldBuilder {
         }
         trees_.push_back(c);
         mark_rect(c, dir, 0.6, 0.6);
-        return rng.uniform(rural ? 5 : 7, rural ? 12 : 16);
+        return rng.uniform(rural ? 4 : 5, rural ? 10 : 12);
       });
     }
     // Scattered trees and bushes further from the street (parks, fields, yards).
     Rng rng(hash_combine(seed_, kSaltTrees + 50));
     walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
-      for (int k = 0; k < 3; ++k) {
+      const bool rural_here = w_.zone_at(p.x(), p.y()).sidewalk == 0;
+      for (int k = 0; k < (rural_here ? 8 : 4); ++k) {
         const int side = rng.chance(0.5) ? -1 : 1;
         const Eigen::Vector2d c = p + side * left * rng.uniform(12, 60) + dir * rng.uniform(-5, 5);
         if (!inside_grid(c)) continue;
-        const double edge = street_edge(c);
-        if (w_.path_distance(c.x(), c.y()) < edge + 3) continue;
+        const World::Zone zc = w_.zone_at(c.x(), c.y());
+        if (w_.road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 3) continue;
         const double crown = rng.uniform(1.5, 4.0);
         if (!far_from(trees_, c, 4.0) || !rect_free(c, {1, 0}, crown, crown, 0.8, false)) continue;
         if (rng.chance(0.75)) add_tree(c, crown, rng); else add_bush(c, rng.uniform(0.7, 2.0), rng);
@@ -501,7 +568,7 @@ class WorldBuilder {
     walk(rng.uniform(30, 120), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const int side = rng.chance(0.5) ? -1 : 1;
       const Eigen::Vector2d left(-dir.y(), dir.x());
-      const double edge = street_edge(p + side * left * 7.0);
+      const double edge = street_edge(p + side * left * 7.0, side);
       const Eigen::Vector2d c = p + side * left * (edge + 1.2);
       const double g = ground(c);
       if (rng.chance(0.5)) {  // bus shelter / kiosk
@@ -543,17 +610,17 @@ class WorldBuilder {
         }
         const bool lot = z.parking > 5;
         if (lot && label == cls::kTruck) label = cls::kCar, length = 4.5, width = 1.8, height = 1.5;
-        const bool present = rng.chance(lot ? 0.65 : 0.75);
+        const bool present = rng.chance(lot ? 0.55 : 0.6);
         double advance = lot ? 2.8 : length + rng.uniform(0.8, 2.5);
         if (!present) return advance;
         std::vector<Eigen::Vector2d> spots;
         Eigen::Vector2d axis = dir;
         if (lot) {  // two rows of perpendicular bays
           axis = left;
-          spots.push_back(p + side * left * (z.road + 3.2));
-          if (rng.chance(0.8)) spots.push_back(p + side * left * (z.road + z.parking - 3.2));
+          spots.push_back(p + side * left * (z.road(side) + 3.2));
+          if (rng.chance(0.8)) spots.push_back(p + side * left * (z.road(side) + z.parking - 3.2));
         } else {
-          spots.push_back(p + side * left * (z.road + 0.5 * z.parking + 0.1));
+          spots.push_back(p + side * left * (z.road(side) + 0.5 * z.parking + 0.1));
         }
         for (const auto& c : spots) {
           const double hx = 0.5 * length + 0.15, hy = 0.5 * width + 0.1;
@@ -610,7 +677,7 @@ class WorldBuilder {
       a.t_ref = t;
       a.s_ref = w_.ego_arc_length(t);
       a.speed = -rng.uniform(7, 13);
-      a.lateral = rng.uniform(3.2, 3.6);
+      a.lateral = rng.uniform(3.1, 3.4);
       a.t_begin = t - 15;
       a.t_end = t + 15;
       vehicle_dims(a, rng);
@@ -732,6 +799,7 @@ World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed,
   builder.place_buildings();
   builder.place_parked_vehicles(total_time);
   builder.place_street_furniture();
+  builder.place_boundaries();
   builder.place_structures();
   builder.place_agents(total_time);
   builder.build_grid();
