@@ -126,8 +126,21 @@ int run_place_eval(const PlaceEvalArgs& args) {
   GraphBuilderConfig graph_config;
   graph_config.use_instances = !args.no_instances;
   const auto t0 = std::chrono::steady_clock::now();
+  // A frame that cannot be read (missing, empty or truncated scan) is left out
+  // of the evaluation with a warning instead of ending the whole run.
+  std::vector<std::uint8_t> readable(n, 1);
+  std::mutex skipped_mutex;
+  std::vector<std::string> skipped;
   for_each_frame(n, sgpr ? "graphs + embeddings" : "scan contexts", [&](std::size_t i) {
-    const LabelledCloud cloud = reader.load_scan(i);
+    LabelledCloud cloud;
+    try {
+      cloud = reader.load_scan(i);
+    } catch (const InputError& e) {
+      readable[i] = 0;
+      const std::lock_guard lock(skipped_mutex);
+      skipped.push_back(e.what());
+      return;
+    }
     const auto start = std::chrono::steady_clock::now();
     if (sgpr) {
       const SemanticGraph graph = build_semantic_graph(cloud, graph_config);
@@ -142,11 +155,14 @@ int run_place_eval(const PlaceEvalArgs& args) {
     while (!describe_seconds.compare_exchange_weak(expected, expected + s)) {
     }
   });
+  std::sort(skipped.begin(), skipped.end());
+  for (const auto& message : skipped) spdlog::warn("frame left out of the evaluation: {}", message);
   if (stop_requested()) return 130;
   const double describe_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
   // 2. Scores of every evaluated pair (grouped by query frame).
-  const std::vector<PlacePair> pairs = place_pairs(positions, args.protocol);
+  std::vector<PlacePair> pairs = place_pairs(positions, args.protocol);
+  std::erase_if(pairs, [&](const PlacePair& p) { return !readable[p.query] || !readable[p.candidate]; });
   std::vector<std::size_t> query_start(n + 1, pairs.size());
   for (std::size_t k = pairs.size(); k-- > 0;) query_start[pairs[k].query] = k;
   for (std::size_t i = n; i-- > 0;) query_start[i] = std::min(query_start[i], query_start[i + 1]);
@@ -183,24 +199,29 @@ int run_place_eval(const PlaceEvalArgs& args) {
   info["method"] = args.method;
   info["sequence"] = std::filesystem::absolute(args.sequence).string();
   info["frames"] = n;
+  info["frames_left_out"] = skipped.size();
   if (sgpr) {
     info["model"] = model.string();
     info["use_instances"] = graph_config.use_instances;
     double mean_nodes = 0;
     for (const auto c : node_counts) mean_nodes += static_cast<double>(c);
-    info["mean_nodes"] = n ? mean_nodes / static_cast<double>(n) : 0.0;
+    const std::size_t described = n - skipped.size();
+    info["mean_nodes"] = described ? mean_nodes / static_cast<double>(described) : 0.0;
   }
   info["labels"] = args.labels.empty() ? std::string("labels/") : args.labels;
   info["positive_distance"] = args.protocol.positive_distance;
   info["negative_distance"] = args.protocol.negative_distance;
   info["exclude_recent"] = args.protocol.exclude_recent;
-  info["describe_ms_per_frame"] = n ? 1000.0 * describe_seconds.load() / static_cast<double>(n) : 0.0;
+  info["describe_ms_per_frame"] =
+      n > skipped.size() ? 1000.0 * describe_seconds.load() / static_cast<double>(n - skipped.size()) : 0.0;
   info["describe_wall_s"] = describe_wall;
   info["score_wall_s"] = score_wall;
   write_outputs(out, args.method, summary, info);
 
-  std::cout << fmt::format("place-eval {} on {} ({} frames): {} positive, {} negative pairs\n", args.method,
-                           args.sequence, n, summary.positives, summary.negatives);
+  std::cout << fmt::format("place-eval {} on {} ({} frames{}): {} positive, {} negative pairs\n", args.method,
+                           args.sequence, n,
+                           skipped.empty() ? "" : fmt::format(", {} unreadable left out", skipped.size()),
+                           summary.positives, summary.negatives);
   if (sgpr) std::cout << fmt::format("  mean graph size {:.1f} nodes\n", info["mean_nodes"].get<double>());
   if (summary.positives == 0) {
     spdlog::warn("no positive pairs (no revisit within {} m): the metrics are undefined", args.protocol.positive_distance);

@@ -148,5 +148,21 @@ TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
   EXPECT_NE(output.find("--method 'nope'"), std::string::npos) << output;
 }
 
+TEST(LoopCli, PlaceEvalLeavesOutUnreadableFrames) {
+  testing::TempDir tmp;
+  const auto seq = write_revisit_sequence(tmp);
+  std::ofstream(seq / "velodyne" / "000010.bin", std::ios::trunc).close();  // an empty scan
+  std::string output;
+  ASSERT_EQ(testing::run_command(
+                saloam_cmd(fmt::format("place-eval {} --method scancontext --out {}", quoted(seq), quoted(tmp / "e"))),
+                &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("000010.bin"), std::string::npos) << output;
+  EXPECT_NE(output.find("1 unreadable left out"), std::string::npos) << output;
+  const auto summary = nlohmann::json::parse(std::ifstream(tmp / "e/summary.json"));
+  EXPECT_EQ(summary["frames_left_out"].get<int>(), 1);
+}
+
 }  // namespace
 }  // namespace saloam
