@@ -12,8 +12,11 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/io/scan_io.hpp"
 #include "saloam/loop/graph_json.hpp"
 #include "saloam/loop/semantic_graph.hpp"
+#include "saloam/loop/sgpr_network.hpp"
+#include "saloam/sim/simulator.hpp"
 #include "testing/test_support.hpp"
 
 namespace saloam {
@@ -297,6 +300,43 @@ TEST(GraphJson, MalformedGraphsAreClearErrors) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("not found"), std::string::npos);
   }
+}
+
+}  // namespace
+}  // namespace saloam
+
+namespace saloam {
+namespace {
+
+// Integration with the simulator: one 32-beam frame of the urban-loop preset.
+TEST(SemanticGraph, SimulatedScanGivesAPlausibleDeterministicGraph) {
+  testing::TempDir dir;
+  sim::SimulationOptions options;
+  options.first_frame = 40;
+  options.end_frame = 41;
+  options.beams = 32;
+  options.show_progress = false;
+  sim::simulate_sequence(options, dir.path());
+  const auto cloud = read_scan(dir / "velodyne/000000.bin", dir / "labels/000000.label");
+  const auto graph = build_semantic_graph(cloud);
+  EXPECT_GE(graph.size(), 5U);
+  EXPECT_LE(graph.size(), 100U);
+  const std::set<int> classes(graph.nodes.begin(), graph.nodes.end());
+  EXPECT_TRUE(classes.count(node_class::kBuilding) || classes.count(node_class::kVegetation));
+  for (const auto& c : graph.centers) EXPECT_LT(c.head<2>().norm(), 130.0);
+  for (std::size_t e = 0; e < graph.edges.size(); ++e) {
+    EXPECT_LT(graph.edges[e][0], graph.edges[e][1]);
+    EXPECT_GT(graph.weights[e], 0.0);
+    EXPECT_LE(graph.weights[e], 1.0);
+  }
+  const auto again = build_semantic_graph(cloud);
+  EXPECT_EQ(again.nodes, graph.nodes);
+  EXPECT_EQ(again.centers, graph.centers);
+  EXPECT_EQ(again.edges, graph.edges);
+  // The graph embeds and scores itself as the same place.
+  const auto network = SgprNetwork::load(testing::shared_file("models/sgpr/sgpr_kitti.sgw"));
+  const auto h = network.embed(graph);
+  EXPECT_GT(network.score(h, h), 0.5);
 }
 
 }  // namespace
