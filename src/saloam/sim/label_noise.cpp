@@ -24,15 +24,15 @@ struct Confusion {
 Confusion confusion_of(std::uint8_t c) {
   switch (c) {
     case kCar: return {0.04, {kTruck, kOtherVehicle, kCar}};
-    case kTruck: return {0.55, {kCar, kOtherVehicle, kBuilding}};
-    case kOtherVehicle: return {0.5, {kCar, kTruck, kBuilding}};
+    case kTruck: return {0.5, {kCar, kOtherVehicle, kBuilding}};
+    case kOtherVehicle: return {0.4, {kCar, kTruck, kBuilding}};
     case kPerson: return {0.15, {kBicyclist, kPole, kVegetation}};
     case kRoad: return {0.03, {kParking, kSidewalk, kRoad}};
-    case kParking: return {0.45, {kRoad, kSidewalk, kTerrain}};
+    case kParking: return {0.35, {kRoad, kSidewalk, kTerrain}};
     case kSidewalk: return {0.12, {kRoad, kParking, kTerrain}};
-    case kOtherGround: return {0.6, {kSidewalk, kTerrain, kRoad}};
+    case kOtherGround: return {0.5, {kSidewalk, kTerrain, kRoad}};
     case kBuilding: return {0.06, {kFence, kVegetation, kBuilding}};
-    case kFence: return {0.4, {kBuilding, kVegetation, kTerrain}};
+    case kFence: return {0.3, {kBuilding, kVegetation, kTerrain}};
     case kVegetation: return {0.06, {kTerrain, kTrunk, kBuilding}};
     case kTrunk: return {0.3, {kVegetation, kPole, kTrunk}};
     case kTerrain: return {0.12, {kVegetation, kSidewalk, kTerrain}};

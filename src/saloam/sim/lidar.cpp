@@ -28,6 +28,18 @@ double LidarModel::column_fraction(int column) const { return (column + 0.5) / a
 
 double LidarModel::column_azimuth(int column) const { return kPi - 2.0 * kPi * column_fraction(column); }
 
+Pose column_pose(const LidarModel& lidar, const SweepSpec& sweep, int column) {
+  return sweep.skew ? interpolate(sweep.start, sweep.end, lidar.column_fraction(column)) : sweep.start;
+}
+
+std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const LidarModel& lidar, const SweepSpec& sweep) {
+  std::vector<Eigen::Vector3d> out(scan.cloud.size());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = column_pose(lidar, sweep, scan.column.at(i)) * scan.cloud.points[i].cast<double>();
+  }
+  return out;
+}
+
 SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep) {
   const int columns = lidar.azimuth_steps, beams = lidar.beams();
   if (columns <= 0 || beams <= 0) throw ConfigError("lidar model needs beams and azimuth steps");
@@ -50,7 +62,7 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     std::vector<Primitive> agents, near;
     for (int c = range.begin(); c < range.end(); ++c) {
       const double frac = lidar.column_fraction(c);
-      const Pose sensor = sweep.skew ? interpolate(sweep.start, sweep.end, frac) : sweep.start;
+      const Pose sensor = column_pose(lidar, sweep, c);
       const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
       const double az = lidar.column_azimuth(c);
       const Eigen::Vector3d origin = sensor.translation();

@@ -6,8 +6,11 @@
 // decreasing), starting and ending behind the car (azimuth +-180 deg), like
 // KITTI's scans. Column c is fired at time t0 + period * (c + 0.5) / columns
 // at azimuth pi - 2 pi (c + 0.5) / columns. Points are written ring by ring
-// (top beam first), each ring in firing order, and are expressed in the
-// sensor frame at sweep start.
+// (top beam first), each ring in firing order. With skew on, each return is
+// in the sensor frame at its own column's instant, as a real spinning LiDAR
+// reports it (motion-distorted); the frame's pose is the pose at sweep start,
+// so de-skewing a point of time fraction s = (pi - azimuth) / (2 pi) into the
+// sweep-start frame uses the motion from pose i towards pose i+1.
 
 #include <cstdint>
 #include <vector>
@@ -55,6 +58,13 @@ struct SimulatedScan {
   std::vector<std::uint16_t> column;
   std::vector<float> range;         ///< measured range [m]
 };
+
+/// Sensor pose T_W<-L when column `column` fires (what simulate_scan uses).
+Pose column_pose(const LidarModel& lidar, const SweepSpec& sweep, int column);
+
+/// The points of a scan in the world frame, each moved with its own column's
+/// pose: an exact de-skew with the true motion (for tests and ground truth).
+std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const LidarModel& lidar, const SweepSpec& sweep);
 
 /// Ray casts one sweep (columns in parallel; the output does not depend on
 /// the number of threads).

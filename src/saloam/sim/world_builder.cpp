@@ -154,11 +154,11 @@ class WorldBuilder {
         z.road_right = static_cast<float>(1.75 + 0.55 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
         const bool avenue = noise_at(hash_combine(seed_, kSaltRoad + 1000), c.x(), c.y(), 300.0) > 0.78;
         z.road_left = z.road_right + 3.2f + (avenue ? 3.3f : 0.0f);
-        const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 110.0);
+        const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 55.0);
         const double lot = noise_at(hash_combine(seed_, kSaltLot), c.x(), c.y(), 70.0);
         z.parking = 0.0f;
-        if (!rural && park > 0.72) z.parking = 2.4f;
-        if (!rural && lot > 0.9) z.parking = 15.0f;
+        if (!rural && park > 0.62) z.parking = 2.4f;
+        if (!rural && lot > 0.88) z.parking = 15.0f;
         z.sidewalk = rural ? 0.0f
                            : static_cast<float>(2.2 + 2.6 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
         const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
@@ -308,10 +308,10 @@ class WorldBuilder {
           const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * (edge + 0.4);
           if (setback > 2.0) property_line(yard, axis, 0.5 * length, rng);
           // Garden: bushes and a small tree between the property line and the house.
-          for (int k = 0; setback > 3.0 && k < static_cast<int>(length / 6.0); ++k) {
+          for (int k = 0; setback > 3.0 && k < static_cast<int>(length / 4.0); ++k) {
             const Eigen::Vector2d g = p + rng.uniform(0.1, 0.9) * length * axis +
                                       side * mleft * (edge + rng.uniform(1.4, setback - 0.8));
-            const double r = std::min(rng.uniform(0.5, 1.5), 0.5 * setback - 0.6);
+            const double r = std::min(rng.uniform(0.5, 1.8), 0.5 * setback - 0.6);
             if (r < 0.4 || !rect_free(g, {1, 0}, r, r, 0.5, false)) continue;
             if (r > 1.1 && rng.chance(0.35)) add_tree(g, r + 1.0, rng); else add_bush(g, r, rng);
             mark_rect(g, {1, 0}, r, r);
@@ -373,10 +373,10 @@ class WorldBuilder {
 
   void property_line(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, Rng& rng) {
     const double pick = rng.uniform();
-    if (pick < 0.3) return;
+    if (pick < 0.15) return;
     const double g = ground(c);
     if (!rect_free(c, axis, half_length, 0.4, 0.1, false)) return;
-    if (pick < 0.65) {  // hedge
+    if (pick < 0.72) {  // hedge
       Primitive h = box(cls::kVegetation, c, axis, half_length, rng.uniform(0.3, 0.55), g - 0.1, g + rng.uniform(0.8, 1.8), 0.45);
       h.mean_free_path = 0.35f;
       w_.primitives_.push_back(h);
@@ -403,11 +403,11 @@ class WorldBuilder {
         const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
         const double length = rng.uniform(4, 18);
         const double pick = rng.uniform();
-        if (pick < (rural ? 0.45 : 0.22)) return length;  // open
+        if (pick < (rural ? 0.4 : 0.15)) return length;  // open
         const double off = edge + rng.uniform(0.3, rural ? 4.0 : 1.2);
         const Eigen::Vector2d c = p + 0.5 * length * dir + side * left * off;
         const double g = ground(c);
-        if (pick < (rural ? 0.75 : 0.68)) {  // hedge
+        if (pick < (rural ? 0.75 : 0.7)) {  // hedge
           const double half_w = rng.uniform(0.35, 0.7);
           if (!rect_free(c, dir, 0.5 * length, half_w, 0.1, false)) return 2.0;
           Primitive h = box(cls::kVegetation, c, dir, 0.5 * length, half_w, g - 0.1, g + rng.uniform(0.8, 2.2), rng.uniform(0.38, 0.5));
@@ -495,7 +495,7 @@ class WorldBuilder {
         }
         trees_.push_back(c);
         mark_rect(c, dir, 0.6, 0.6);
-        return rng.uniform(rural ? 4 : 5, rural ? 10 : 12);
+        return rng.uniform(4, rural ? 10 : 9);
       });
     }
     // Scattered trees and bushes further from the street (parks, fields, yards).
@@ -503,9 +503,9 @@ class WorldBuilder {
     walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
       const bool rural_here = w_.zone_at(p.x(), p.y()).sidewalk == 0;
-      for (int k = 0; k < (rural_here ? 8 : 4); ++k) {
+      for (int k = 0; k < (rural_here ? 12 : 5); ++k) {
         const int side = rng.chance(0.5) ? -1 : 1;
-        const Eigen::Vector2d c = p + side * left * rng.uniform(12, 60) + dir * rng.uniform(-5, 5);
+        const Eigen::Vector2d c = p + side * left * rng.uniform(8, 50) + dir * rng.uniform(-5, 5);
         if (!inside_grid(c)) continue;
         const World::Zone zc = w_.zone_at(c.x(), c.y());
         if (w_.road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 3) continue;
