@@ -1,0 +1,113 @@
+// End-to-end: `saloam simulate` (presets, KITTI trajectories, noisy labels,
+// bad options) and `saloam render`.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "saloam/io/calibration.hpp"
+#include "saloam/io/sequence.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::cli_path;
+using testing::run_command;
+using testing::shared_file;
+using testing::TempDir;
+
+std::string q(const fs::path& p) {
+  std::string s(1, '\'');
+  s.append(p.string());
+  s.push_back('\'');
+  return s;
+}
+
+std::string simulate(const fs::path& out, const std::string& extra) {
+  return q(cli_path()) + " simulate --out " + q(out) + " --beams 16 --azimuth-steps 600 " + extra;
+}
+
+TEST(SimulateCli, PresetWritesAReadableSequence) {
+  TempDir dir;
+  const fs::path seq = dir / "seq";
+  std::string output;
+  ASSERT_EQ(run_command(simulate(seq, "--preset figure-eight --frames 10:14 --seed 5"), &output), 0) << output;
+  EXPECT_NE(output.find("wrote 4 frames"), std::string::npos) << output;
+  const SequenceReader reader(seq);
+  EXPECT_EQ(reader.size(), 4u);
+  EXPECT_TRUE(reader.has_labels());
+  EXPECT_TRUE(reader.has_poses());
+  EXPECT_TRUE(reader.has_calib());
+  EXPECT_EQ(reader.load_scan(3).size(), reader.load_scan(3).label.size());
+}
+
+TEST(SimulateCli, KittiTrajectoryWithPerSequenceCalibList) {
+  TempDir dir;
+  const fs::path seq = dir / "seq";
+  const auto poses = shared_file("data/kitti/poses/04.txt");
+  const auto calib = shared_file("data/kitti/calib_velo_to_cam.txt");
+  std::string output;
+  ASSERT_EQ(run_command(simulate(seq, "--trajectory " + q(poses) + " --calib " + q(calib) + " --frames 0:2"), &output), 0)
+      << output;
+  // The sequence number comes from the pose file's name: Tr of line 04.
+  const SequenceReader reader(seq);
+  EXPECT_TRUE(reader.velo_to_cam().isApprox(read_velo_to_cam(calib, 4), 1e-9));
+  EXPECT_FALSE(reader.velo_to_cam().isApprox(read_velo_to_cam(calib, 0), 1e-6));
+  // A KITTI calib.txt (with a Tr: line) works as well: use the one just written.
+  const fs::path seq2 = dir / "seq2";
+  ASSERT_EQ(run_command(simulate(seq2, "--trajectory " + q(poses) + " --calib " + q(seq / "calib.txt") + " --frames 0:1"),
+                        &output),
+            0)
+      << output;
+}
+
+TEST(SimulateCli, NoisyLabelsPrintMiouAndKeepTruth) {
+  TempDir dir;
+  const fs::path seq = dir / "seq";
+  std::string output;
+  ASSERT_EQ(run_command(simulate(seq, "--frames 0:2 --labels noisy"), &output), 0) << output;
+  EXPECT_NE(output.find("noisy labels: mIoU"), std::string::npos) << output;
+  EXPECT_TRUE(fs::exists(seq / "labels_gt" / "000001.label"));
+  EXPECT_TRUE(fs::exists(seq / "labels" / "000001.label"));
+}
+
+TEST(SimulateCli, BadOptionsGiveClearErrors) {
+  TempDir dir;
+  std::string output;
+  EXPECT_NE(run_command(simulate(dir / "a", "--frames 5:2"), &output), 0);
+  EXPECT_NE(output.find("--frames"), std::string::npos) << output;
+  EXPECT_NE(run_command(simulate(dir / "b", "--frames 99999:100000"), &output), 0);
+  EXPECT_NE(output.find("selects nothing"), std::string::npos) << output;
+  const auto poses = shared_file("data/kitti/poses/00.txt");
+  EXPECT_NE(run_command(simulate(dir / "c", "--trajectory " + q(poses)), &output), 0);
+  EXPECT_NE(output.find("--calib"), std::string::npos) << output;
+  EXPECT_NE(run_command(simulate(dir / "d", "--preset nowhere"), &output), 0);
+  EXPECT_NE(run_command(simulate(dir / "e", "--labels maybe"), &output), 0);
+  // A calibration list without a line for the pose file's sequence.
+  const fs::path renamed = dir / "42.txt";
+  fs::copy_file(poses, renamed);
+  EXPECT_NE(run_command(simulate(dir / "f", "--trajectory " + q(renamed) + " --calib " +
+                                             q(shared_file("data/kitti/calib_velo_to_cam.txt"))),
+                        &output),
+            0);
+  EXPECT_NE(output.find("42"), std::string::npos) << output;
+}
+
+TEST(RenderCli, WritesMapAndRangeImage) {
+  TempDir dir;
+  const fs::path seq = dir / "seq";
+  std::string output;
+  ASSERT_EQ(run_command(simulate(seq, "--frames 0:3"), &output), 0) << output;
+  ASSERT_EQ(run_command(q(cli_path()) + " render " + q(seq) + " --out " + q(dir / "png") + " --frame 2", &output), 0)
+      << output;
+  EXPECT_GT(fs::file_size(dir / "png" / "map.png"), 5000u);
+  EXPECT_GT(fs::file_size(dir / "png" / "range_000002.png"), 2000u);
+  EXPECT_NE(run_command(q(cli_path()) + " render " + q(seq) + " --out " + q(dir / "png") + " --frame 7", &output), 0);
+  EXPECT_NE(output.find("out of range"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace saloam
