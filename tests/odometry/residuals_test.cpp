@@ -168,7 +168,7 @@ TEST(Registration, RecoversKnownTransformOfItself) {
     const Pose err = truth.inverse() * result.pose;
     // Not exact: neighbourhoods at wall/wall and wall/road junctions give
     // slightly bent "planes" (fewer with per-class matching).
-    EXPECT_LT(err.translation().norm(), 1e-3) << "semantics " << semantics;
+    EXPECT_LT(err.translation().norm(), semantics ? 1e-3 : 5e-3) << "semantics " << semantics;
     EXPECT_LT(rotation_angle(err), 5e-4) << "semantics " << semantics;
     EXPECT_GT(result.edge_matches, 100);
     EXPECT_GT(result.planar_matches, 2000);

@@ -194,18 +194,28 @@ int odometry_class(std::uint16_t raw_label) {
   return learning == 0 ? -1 : learning;
 }
 
-std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
-                                                              const FeatureConfig& config, int expected_rings) {
+namespace {
+std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config) {
+  std::vector<float> times(cloud.size(), -1.0f);  // -1: on the sensor axis, unusable
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) continue;
+    times[i] = static_cast<float>(sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config));
+  }
+  return times;
+}
+
+std::vector<std::vector<std::uint32_t>> rings_from_order(const std::vector<float>& times,
+                                                         const FeatureConfig& config, int expected_rings) {
   // KITTI and the simulator store a scan ring by ring, each ring in firing
   // order: the sweep time restarts at every ring change.
   std::vector<std::vector<std::uint32_t>> rings;
   std::vector<std::uint32_t> current;
   double last_time = -1.0;
   const double wrap = 0.5 * config.sweep_duration;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f& p = cloud.points[i];
-    if (std::hypot(p.x(), p.y()) < 1e-3) continue;
-    const double t = sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config);
+  for (std::size_t i = 0; i < times.size(); ++i) {
+    const double t = times[i];
+    if (t < 0.0) continue;
     if (last_time >= 0.0 && t < last_time - wrap) {
       rings.push_back(std::move(current));
       current.clear();
@@ -224,6 +234,12 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
   if (long_runs < min_long || segments > max_rings) return {};
   return rings;
 }
+}  // namespace
+
+std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
+                                                              const FeatureConfig& config, int expected_rings) {
+  return rings_from_order(point_sweep_times(cloud, config), config, expected_rings);
+}
 
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels) {
   ScanFeatures out;
@@ -235,16 +251,14 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // Rings from the point order when the scan is stored ring by ring (exact
   // even for scans whose points were moved by motion compensation), else from
   // the elevation angle.
-  auto ordered = config.ring_from_point_order ? rings_from_point_order(cloud, config, config.num_beams)
+  const std::vector<float> times = point_sweep_times(cloud, config);
+  auto ordered = config.ring_from_point_order ? rings_from_order(times, config, config.num_beams)
                                               : std::vector<std::vector<std::uint32_t>>{};
   if (!ordered.empty()) {
     buckets.resize(ordered.size());
     for (std::size_t r = 0; r < ordered.size(); ++r) {
       buckets[r].reserve(ordered[r].size());
-      for (const auto i : ordered[r]) {
-        const Eigen::Vector3f& p = cloud.points[i];
-        buckets[r].push_back({static_cast<float>(sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config)), i});
-      }
+      for (const auto i : ordered[r]) buckets[r].push_back({times[i], i});
     }
   } else {
     const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
@@ -253,12 +267,11 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
     for (auto& b : buckets) b.reserve(cloud.size() / num_rings * 2);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       const Eigen::Vector3f& p = cloud.points[i];
+      if (times[i] < 0.0f) continue;
       const double horizontal = std::hypot(p.x(), p.y());
-      if (horizontal < 1e-3) continue;
       const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
       if (ring < 0) continue;
-      const double t = sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config);
-      buckets[ring].push_back({static_cast<float>(t), static_cast<std::uint32_t>(i)});
+      buckets[ring].push_back({times[i], static_cast<std::uint32_t>(i)});
     }
     // Order each ring in time so that ring neighbours are neighbours in azimuth.
     for (auto& bucket : buckets) {

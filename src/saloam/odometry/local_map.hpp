@@ -5,8 +5,10 @@
 // Also the (semantic) voxel downsampling used for features and submaps.
 
 #include <array>
+#include <cstdint>
 #include <deque>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -58,6 +60,19 @@ class ClassSubmap {
   std::unique_ptr<Tree> tree_;
 };
 
+/// Integer voxel coordinates plus class: the key of semantic voxel grids.
+struct VoxelKey {
+  std::int32_t x, y, z;
+  std::int32_t c;
+  bool operator==(const VoxelKey&) const = default;
+};
+struct VoxelKeyHash {
+  std::size_t operator()(const VoxelKey& k) const {
+    return (static_cast<std::size_t>(k.x) * 73856093u) ^ (static_cast<std::size_t>(k.y) * 19349669u) ^
+           (static_cast<std::size_t>(k.z) * 83492791u) ^ (static_cast<std::size_t>(k.c) * 2654435761u);
+  }
+};
+
 class SemanticLocalMap {
  public:
   SemanticLocalMap(int max_frames, ClassVoxelSizes voxel_size);
@@ -65,22 +80,34 @@ class SemanticLocalMap {
   /// Adds one frame's features (already in the world frame), drops the oldest
   /// beyond N_m and rebuilds the per-class submaps.
   void add_frame(FeatureCloud edges_world, FeatureCloud planars_world);
-  [[nodiscard]] bool empty() const { return frames_.empty(); }
+  [[nodiscard]] bool empty() const { return frame_count_ == 0; }
   [[nodiscard]] const ClassSubmap& edges(ClassIndex c) const { return *edge_maps_[c]; }
   [[nodiscard]] const ClassSubmap& planars(ClassIndex c) const { return *planar_maps_[c]; }
   [[nodiscard]] std::size_t num_edge_points() const;
   [[nodiscard]] std::size_t num_planar_points() const;
 
  private:
-  struct Frame {
-    FeatureCloud edges;
-    FeatureCloud planars;
+  // Voxel grid kept incrementally: each voxel holds the newest point that
+  // fell into it and the frame it came from; a frame's voxels are released
+  // when it leaves the window (unless a newer frame took them over).
+  struct Voxel {
+    Eigen::Vector3d point;
+    std::uint64_t frame;
   };
-  void rebuild();
+  struct Grid {
+    std::unordered_map<VoxelKey, Voxel, VoxelKeyHash> voxels;
+    std::deque<std::vector<VoxelKey>> frame_keys;  ///< keys written by each frame in the window
+  };
+  void insert(Grid& grid, const FeatureCloud& cloud);
+  void evict_oldest(Grid& grid);
+  void rebuild_trees(const Grid& grid, std::array<std::unique_ptr<ClassSubmap>, kNumClassIndices>& maps) const;
+  [[nodiscard]] VoxelKey key_of(const Eigen::Vector3d& p, ClassIndex c) const;
 
   int max_frames_;
   ClassVoxelSizes voxel_size_;
-  std::deque<Frame> frames_;
+  std::uint64_t frame_count_ = 0;
+  Grid edge_grid_;
+  Grid planar_grid_;
   std::array<std::unique_ptr<ClassSubmap>, kNumClassIndices> edge_maps_;
   std::array<std::unique_ptr<ClassSubmap>, kNumClassIndices> planar_maps_;
 };

@@ -27,7 +27,8 @@ Moments moments(std::span<const Eigen::Vector3d> points) {
 std::optional<Line> fit_line(std::span<const Eigen::Vector3d> points, double min_ratio) {
   if (points.size() < 2) return std::nullopt;
   const Moments m = moments(points);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m.covariance);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(m.covariance);  // closed form for 3x3: several times faster
   const Eigen::Vector3d& values = eig.eigenvalues();  // ascending
   if (values(2) <= 1e-12 || values(2) < min_ratio * values(1)) return std::nullopt;
   return Line{m.mean, eig.eigenvectors().col(2).normalized()};
@@ -36,7 +37,8 @@ std::optional<Line> fit_line(std::span<const Eigen::Vector3d> points, double min
 std::optional<Plane> fit_plane(std::span<const Eigen::Vector3d> points, double max_distance) {
   if (points.size() < 3) return std::nullopt;
   const Moments m = moments(points);
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m.covariance);
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+  eig.computeDirect(m.covariance);
   const Eigen::Vector3d& values = eig.eigenvalues();
   // Collinear neighbours do not define a plane.
   if (values(1) < 1e-3 * values(2) || values(2) <= 1e-12) return std::nullopt;

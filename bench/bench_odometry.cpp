@@ -1,0 +1,109 @@
+// Odometry speed on the real KITTI scans (shared/data/kitti/scans_00):
+// feature extraction, local-map update (rebuild of the per-class kd-trees),
+// registration and the whole pipeline per frame, single-threaded unless
+// stated. Peak memory is reported as a counter (max RSS, getrusage).
+
+#include <sys/resource.h>
+
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+
+#include "saloam/io/scan_io.hpp"
+#include "saloam/odometry/pipeline.hpp"
+
+namespace saloam {
+namespace {
+
+const std::vector<LabelledCloud>& scans() {
+  static const std::vector<LabelledCloud> data = [] {
+    std::vector<LabelledCloud> out;
+    for (int i = 0; i < 6; ++i) {
+      char name[64];
+      std::snprintf(name, sizeof(name), "/data/kitti/scans_00/%06d.bin", i);
+      out.push_back(read_scan(std::string(SALOAM_BENCH_SHARED_DIR) + name));
+    }
+    return out;
+  }();
+  return data;
+}
+
+OdometryConfig kitti_config() {
+  OdometryConfig config;
+  config.features.pose_time_in_sweep = 0.05;
+  return config;
+}
+
+double peak_rss_mib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+void BM_ExtractFeatures(benchmark::State& state) {
+  const auto config = kitti_config();
+  std::size_t i = 0;
+  for (auto _ : state) {
+    auto f = extract_features(scans()[i++ % scans().size()], config.features, false);
+    benchmark::DoNotOptimize(f);
+  }
+  state.counters["points"] = static_cast<double>(scans()[0].size());
+}
+BENCHMARK(BM_ExtractFeatures)->Unit(benchmark::kMillisecond);
+
+// Local map of N_m = 20 frames: voxel downsampling of all frames + kd-tree rebuild.
+void BM_LocalMapUpdate(benchmark::State& state) {
+  const auto config = kitti_config();
+  const auto sizes = class_voxel_sizes(config);
+  std::vector<ScanFeatures> features;
+  for (const auto& s : scans()) {
+    auto f = extract_features(s, config.features, false);
+    f.edges = voxel_downsample(f.edges, sizes);
+    f.planars = voxel_downsample(f.planars, sizes);
+    features.push_back(std::move(f));
+  }
+  SemanticLocalMap map(config.local_map_frames, sizes);
+  // Fill the map with 20 frames (shifted copies) before timing.
+  for (int k = 0; k < config.local_map_frames; ++k) {
+    auto f = features[k % features.size()];
+    for (auto& p : f.planars.points) p.x() += 0.7 * k;
+    for (auto& p : f.edges.points) p.x() += 0.7 * k;
+    map.add_frame(f.edges, f.planars);
+  }
+  int k = config.local_map_frames;
+  for (auto _ : state) {
+    auto f = features[k % features.size()];
+    for (auto& p : f.planars.points) p.x() += 0.7 * k;
+    for (auto& p : f.edges.points) p.x() += 0.7 * k;
+    ++k;
+    map.add_frame(std::move(f.edges), std::move(f.planars));
+  }
+  state.counters["map_points"] = static_cast<double>(map.num_edge_points() + map.num_planar_points());
+}
+BENCHMARK(BM_LocalMapUpdate)->Unit(benchmark::kMillisecond);
+
+// The whole pipeline per frame (features, de-skew, registration, map
+// update) over the six real scans, fresh pipeline each pass (so the local map
+// holds at most 5 frames: `saloam bench` on a long sequence gives the steady
+// state with N_m = 20); threads = argument. Time per frame.
+void BM_PipelineFrame(benchmark::State& state) {
+  auto config = kitti_config();
+  config.threads = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    OdometryPipeline odometry(config);
+    for (int i = 0; i < 6; ++i) odometry.register_frame(scans()[i], 0.1 * i);
+    benchmark::DoNotOptimize(odometry.poses().back());
+  }
+  state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations()) * 6);
+  state.counters["ms_per_frame"] = benchmark::Counter(static_cast<double>(state.iterations()) * 6 / 1000.0,
+                                                      benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["peak_rss_MiB"] = peak_rss_mib();
+}
+BENCHMARK(BM_PipelineFrame)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace saloam
+
+BENCHMARK_MAIN();
