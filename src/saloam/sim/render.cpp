@@ -6,6 +6,7 @@
 
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/sequence.hpp"
@@ -75,10 +76,26 @@ MapRenderStats render_map(const fs::path& sequence_dir, const fs::path& png, con
     if (stop_requested()) break;
     const LabelledCloud cloud = reader.load_scan(i);
     const Pose& T = poses[i];
+    // De-skew: a point at azimuth a was measured at fraction (pi - a) / 2 pi
+    // of the 0.1 s sweep (clockwise from behind), on the way to the next pose.
+    Pose motion = Pose::Identity();
+    double sweep_share = 0.0;
+    if (options.deskew && n > 1) {
+      const std::size_t j = i + 1 < n ? i + 1 : i - 1;
+      const double dt = std::abs(reader.times()[j] - reader.times()[i]);
+      motion = i + 1 < n ? Pose(T.inverse() * poses[j]) : Pose(poses[j].inverse() * T);
+      sweep_share = dt > 1e-6 ? std::min(1.0, 0.1 / dt) : 0.0;
+    }
     for (std::size_t k = 0; k < cloud.size(); ++k) {
       const Eigen::Vector3f& q = cloud.points[k];
       if (q.head<2>().norm() > options.max_range) continue;
-      const Eigen::Vector3d w = T * q.cast<double>();
+      Eigen::Vector3d w;
+      if (sweep_share > 0) {
+        const double s = (kPi - std::atan2(q.y(), q.x())) / (2 * kPi) * sweep_share;
+        w = T * (interpolate(Pose::Identity(), motion, s) * q.cast<double>());
+      } else {
+        w = T * q.cast<double>();
+      }
       const Eigen::Vector2d px = pixel(w.head<2>());
       const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
       if (x < 0 || y < 0 || x >= stats.width || y >= stats.height) continue;

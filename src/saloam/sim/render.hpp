@@ -16,6 +16,9 @@ struct MapRenderOptions {
   std::size_t frame_step = 0;      ///< use every n-th scan (0 = automatic, about 300 scans)
   double max_range = 60.0;         ///< ignore points further than this from the sensor
   bool show_progress = true;
+  /// Undo the motion distortion of each scan with the poses (sweep of 0.1 s
+  /// from behind, clockwise, as in KITTI and in `saloam simulate`).
+  bool deskew = true;
 };
 
 struct MapRenderStats {

@@ -198,7 +198,13 @@ double World::path_distance(double x, double y) const { return bilinear(distance
 
 World::Zone World::zone_at(double x, double y) const { return zones_[cell_index(x, y)]; }
 
-double World::path_lateral(double x, double y) const { return bilinear(lateral_, x, y); }
+double World::path_lateral(double x, double y) const {
+  // The side comes from the nearest cell, the magnitude from the continuous
+  // distance field: interpolating the signed field across a Voronoi edge
+  // between two centre lines would make a thin false road there.
+  const double d = path_distance(x, y);
+  return lateral_[cell_index(x, y)] >= 0 ? d : -d;
+}
 
 double World::road_margin(double x, double y) const {
   const double lat = path_lateral(x, y);

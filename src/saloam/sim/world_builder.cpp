@@ -69,7 +69,19 @@ class WorldBuilder {
     const std::size_t n = static_cast<std::size_t>(w_.nx_) * static_cast<std::size_t>(w_.ny_);
     if (n > 200'000'000ull) throw ConfigError("trajectory spans too large an area for the simulator's ground raster");
 
-    // Nearest path sample per cell: seed the cells on the path, then a
+    // Road centre lines: the driven path plus side streets branching off it
+    // (dead-end stubs, so that the street has open intersections).
+    std::vector<Eigen::Vector3d> centres;
+    std::vector<Eigen::Vector2d> centre_dirs;
+    for (std::size_t k = 0; k < w_.path_.size(); ++k) {
+      const std::size_t k0 = k > 0 ? k - 1 : k, k1 = std::min(w_.path_.size() - 1, k + 1);
+      Eigen::Vector2d dir = (w_.path_[k1] - w_.path_[k0]).head<2>();
+      centres.push_back(w_.path_[k]);
+      centre_dirs.push_back(dir.norm() > 1e-9 ? Eigen::Vector2d(dir.normalized()) : Eigen::Vector2d(1, 0));
+    }
+    add_side_streets(centres, centre_dirs);
+
+    // Nearest centre-line sample per cell: seed the cells on the lines, then a
     // two-pass propagation (a feature transform, close to the exact Euclidean one).
     std::vector<std::int32_t> source(n, -1);
     w_.distance_.assign(n, std::numeric_limits<float>::infinity());
@@ -79,10 +91,11 @@ class WorldBuilder {
     auto idx = [&](int ix, int iy) {
       return static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.nx_) + static_cast<std::size_t>(ix);
     };
-    for (std::size_t k = 0; k < w_.path_.size(); ++k) {
-      const int ix = static_cast<int>((w_.path_[k].x() - lo.x()) / cell);
-      const int iy = static_cast<int>((w_.path_[k].y() - lo.y()) / cell);
-      const double dist = (center(ix, iy) - w_.path_[k].head<2>()).norm();
+    for (std::size_t k = 0; k < centres.size(); ++k) {
+      const int ix = static_cast<int>((centres[k].x() - lo.x()) / cell);
+      const int iy = static_cast<int>((centres[k].y() - lo.y()) / cell);
+      if (ix < 0 || iy < 0 || ix >= w_.nx_ || iy >= w_.ny_) continue;
+      const double dist = (center(ix, iy) - centres[k].head<2>()).norm();
       const std::size_t i = idx(ix, iy);
       if (dist < w_.distance_[i]) {
         w_.distance_[i] = static_cast<float>(dist);
@@ -93,7 +106,7 @@ class WorldBuilder {
       if (jx < 0 || jy < 0 || jx >= w_.nx_ || jy >= w_.ny_) return;
       const std::int32_t src = source[idx(jx, jy)];
       if (src < 0) return;
-      const double dist = (center(ix, iy) - w_.path_[static_cast<std::size_t>(src)].head<2>()).norm();
+      const double dist = (center(ix, iy) - centres[static_cast<std::size_t>(src)].head<2>()).norm();
       const std::size_t i = idx(ix, iy);
       if (dist < w_.distance_[i]) {
         w_.distance_[i] = static_cast<float>(dist);
@@ -127,9 +140,8 @@ class WorldBuilder {
       for (int ix = 0; ix < w_.nx_; ++ix) {
         const std::size_t i = idx(ix, iy);
         const auto k = static_cast<std::size_t>(source[i]);
-        const std::size_t k0 = k > 0 ? k - 1 : k, k1 = std::min(w_.path_.size() - 1, k + 1);
-        const Eigen::Vector2d dir = (w_.path_[k1] - w_.path_[k0]).head<2>();
-        const Eigen::Vector2d rel = center(ix, iy) - w_.path_[k].head<2>();
+        const Eigen::Vector2d& dir = centre_dirs[k];
+        const Eigen::Vector2d rel = center(ix, iy) - centres[k].head<2>();
         const double cross = dir.x() * rel.y() - dir.y() * rel.x();
         w_.lateral_[i] = cross >= 0 ? w_.distance_[i] : -w_.distance_[i];
       }
@@ -138,7 +150,7 @@ class WorldBuilder {
     // Height of the nearest path point, smoothed so that two passes at
     // slightly different heights meet without a step.
     w_.height_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) w_.height_[i] = static_cast<float>(w_.path_[static_cast<std::size_t>(source[i])].z());
+    for (std::size_t i = 0; i < n; ++i) w_.height_[i] = static_cast<float>(centres[static_cast<std::size_t>(source[i])].z());
     box_blur(w_.height_, 4);
     box_blur(w_.height_, 4);
 
@@ -170,6 +182,41 @@ class WorldBuilder {
       }
     }
     occupied_.assign(n, 0);
+  }
+
+  void add_side_streets(std::vector<Eigen::Vector3d>& centres, std::vector<Eigen::Vector2d>& dirs) {
+    Rng rng(hash_combine(seed_, kSaltRoad + 7));
+    PointSet junctions;
+    const double len = w_.path_length();
+    for (double s = rng.uniform(20, 80); s < len - 10; s += rng.uniform(60, 180)) {
+      Eigen::Vector3d pos;
+      Eigen::Vector2d dir;
+      w_.path_point(s, pos, dir);
+      // Not on open land, and one junction per place even where the path passes twice.
+      if (noise_at(hash_combine(seed_, kSaltRural), pos.x(), pos.y(), 260.0) > 0.7) continue;
+      if (!far_from(junctions, pos.head<2>(), 50.0)) continue;
+      // Only on straight stretches: a side street off a bend would run askew.
+      Eigen::Vector3d before, after;
+      Eigen::Vector2d dir_before, dir_after;
+      w_.path_point(s - 15.0, before, dir_before);
+      w_.path_point(s + 15.0, after, dir_after);
+      if (dir_before.dot(dir_after) < std::cos(0.25)) continue;
+      junctions.push_back(pos.head<2>());
+      const Eigen::Vector2d left(-dir.y(), dir.x());
+      const double pick = rng.uniform();
+      for (int side = -1; side <= 1; side += 2) {
+        if ((pick < 0.35 && side > 0) || (pick > 0.7 && side < 0)) continue;  // T-junctions or crossings
+        const double length = rng.uniform(40, 90);
+        // The stub's centre line runs in its right lane, like the path: shift it
+        // so that its road is centred on the crossing.
+        const Eigen::Vector2d out = side * left;
+        const Eigen::Vector2d start = pos.head<2>() - Eigen::Vector2d(-out.y(), out.x()) * 1.6;
+        for (double u = 2.0; u < length; u += 0.5) {
+          centres.emplace_back(start.x() + u * out.x(), start.y() + u * out.y(), pos.z());
+          dirs.push_back(out);
+        }
+      }
+    }
   }
 
   void box_blur(std::vector<float>& f, int radius) const {
@@ -231,8 +278,9 @@ class WorldBuilder {
     return for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
       if (!inside_grid(p)) return false;
       const World::Zone z = w_.zone_at(p.x(), p.y());
-      const double limit = road_only ? 0.0 : z.parking + z.sidewalk;
-      return w_.road_margin(p.x(), p.y()) >= limit + clearance && occupied_[w_.cell_index(p.x(), p.y())] == 0;
+      // Off the street: a margin from the road even where there is no sidewalk.
+      const double limit = road_only ? clearance : std::max(z.parking + z.sidewalk + clearance, 0.5);
+      return w_.road_margin(p.x(), p.y()) >= limit && occupied_[w_.cell_index(p.x(), p.y())] == 0;
     });
   }
   void mark_rect(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy) {
@@ -375,9 +423,10 @@ class WorldBuilder {
     const double pick = rng.uniform();
     if (pick < 0.15) return;
     const double g = ground(c);
-    if (!rect_free(c, axis, half_length, 0.4, 0.1, false)) return;
+    const double half_width = rng.uniform(0.3, 0.55);
+    if (!rect_free(c, axis, half_length, std::max(0.4, half_width), 0.1, false)) return;
     if (pick < 0.72) {  // hedge
-      Primitive h = box(cls::kVegetation, c, axis, half_length, rng.uniform(0.3, 0.55), g - 0.1, g + rng.uniform(0.8, 1.8), 0.45);
+      Primitive h = box(cls::kVegetation, c, axis, half_length, half_width, g - 0.1, g + rng.uniform(0.8, 1.8), 0.45);
       h.mean_free_path = 0.35f;
       w_.primitives_.push_back(h);
     } else {  // fence: solid boards or chain-link the beam partly passes
