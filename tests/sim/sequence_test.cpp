@@ -1,9 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
+#include <thread>
 #include <fstream>
 #include <iterator>
 
+#include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/io/calibration.hpp"
@@ -117,6 +121,38 @@ TEST(Sequence, KittiTrajectoryInput) {
   std::size_t road = 0;
   for (auto l : cloud.label) road += l == cls::kRoad ? 1 : 0;
   EXPECT_GT(road, cloud.size() / 10);
+}
+
+TEST(Sequence, StopRequestKeepsAValidPartialSequence) {
+  TempDir dir;
+  SimulationOptions o = small_options();
+  o.first_frame = 0;
+  o.end_frame = 400;
+  o.stride = 1;
+  // Ask to stop (as Ctrl-C does) once a few scans are on disk.
+  std::atomic<bool> done{false};
+  std::thread watcher([&] {
+    while (!done) {
+      std::error_code ec;
+      if (fs::exists(dir / "velodyne" / "000002.bin", ec)) {
+        request_stop();
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  const auto summary = simulate_sequence(o, dir.path());
+  done = true;
+  watcher.join();
+  stop_flag().store(false);
+  EXPECT_TRUE(summary.interrupted);
+  ASSERT_GE(summary.frames, 3u);
+  ASSERT_LT(summary.frames, 400u);
+  const SequenceReader reader(dir.path());
+  EXPECT_EQ(reader.size(), summary.frames);
+  EXPECT_EQ(read_kitti_poses(dir / "poses.txt").size(), summary.frames);
+  EXPECT_EQ(read_times(dir / "times.txt").size(), summary.frames);
+  EXPECT_NO_THROW(reader.load_scan(summary.frames - 1));
 }
 
 TEST(Sequence, BadOptionsAreClearErrors) {

@@ -189,11 +189,6 @@ Route figure_eight() {
   bulb(0.5 * (lo + hi), &turn);
   route.insert(route.end(), turn.begin(), turn.end());
   // Back along the route in the opposite lane: the first lobe in reverse.
-  Turtle t{route.back(), 0};
-  Route back;
-  const Eigen::Vector2d left(-end_dir.y(), end_dir.x());
-  const Eigen::Vector2d shift = route.back() - (c(2 * kPi) + 25 * end_dir) ;
-  (void)t;
   Route reverse_part;
   append_curve(reverse_part, [&](double u) {
     const Eigen::Vector2d p = c(u);
@@ -201,13 +196,11 @@ Route figure_eight() {
     Eigen::Vector2d d = c(u + h) - c(u - h);
     d.normalize();
     return Eigen::Vector2d(p + lane * Eigen::Vector2d(-d.y(), d.x()));
-  }, 2 * kPi + 0.0, 2 * kPi - 2.6);
+  }, 2 * kPi, 2 * kPi - 2.6);
   // Connect the bulb's exit to the reversed route with a straight piece.
   const Eigen::Vector2d from = route.back(), to = reverse_part.front();
   const int n = static_cast<int>(std::ceil((to - from).norm() / kSpacing));
   for (int k = 1; k <= n; ++k) route.push_back(from + (to - from) * (static_cast<double>(k) / n));
-  (void)shift;
-  (void)left;
   route.insert(route.end(), reverse_part.begin() + 1, reverse_part.end());
   return wander(smooth(route, 30), 0.25, 140.0);
 }
