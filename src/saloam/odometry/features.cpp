@@ -5,6 +5,8 @@
 #include <limits>
 #include <numeric>
 
+#include <tbb/parallel_for.h>
+
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -241,7 +243,8 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
   return rings_from_order(point_sweep_times(cloud, config), config, expected_rings);
 }
 
-ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels) {
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
+                              bool parallel) {
   ScanFeatures out;
   struct Entry {
     float time;
@@ -278,9 +281,12 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
       std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
     }
   }
-  std::vector<Eigen::Vector3d> ring_points;
-  for (auto& bucket : buckets) {
-    ring_points.resize(bucket.size());
+  // Rings are independent: with `parallel`, one task per ring; the results
+  // are concatenated in ring order so the output does not depend on threads.
+  std::vector<ScanFeatures> per_ring(buckets.size());
+  auto process_ring = [&](std::size_t r) {
+    const auto& bucket = buckets[r];
+    std::vector<Eigen::Vector3d> ring_points(bucket.size());
     for (std::size_t k = 0; k < bucket.size(); ++k) ring_points[k] = cloud.points[bucket[k].index].cast<double>();
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
     auto unreliable =
@@ -302,8 +308,22 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
         target.push_back(ring_points[k], static_cast<ClassIndex>(c), e.time);
       }
     };
-    emit(selection.edges, out.edges);
-    emit(selection.planars, out.planars);
+    emit(selection.edges, per_ring[r].edges);
+    emit(selection.planars, per_ring[r].planars);
+  };
+  if (parallel) {
+    tbb::parallel_for(std::size_t{0}, buckets.size(), process_ring);
+  } else {
+    for (std::size_t r = 0; r < buckets.size(); ++r) process_ring(r);
+  }
+  auto append = [](FeatureCloud& to, const FeatureCloud& from) {
+    to.points.insert(to.points.end(), from.points.begin(), from.points.end());
+    to.classes.insert(to.classes.end(), from.classes.begin(), from.classes.end());
+    to.sweep_time.insert(to.sweep_time.end(), from.sweep_time.begin(), from.sweep_time.end());
+  };
+  for (const auto& f : per_ring) {
+    append(out.edges, f.edges);
+    append(out.planars, f.planars);
   }
   return out;
 }

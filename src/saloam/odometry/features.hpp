@@ -106,6 +106,8 @@ int odometry_class(std::uint16_t raw_label);
 /// label-agnostic mode) every point is class 0; otherwise dynamic and
 /// unlabeled points are dropped from the features (after the roughness, which
 /// is pure geometry: removing them first would create false edges).
-ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels);
+/// With `parallel`, rings are processed as TBB tasks (same result).
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
+                              bool parallel = false);
 
 }  // namespace saloam

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <unordered_set>
 
+#include <tbb/parallel_invoke.h>
+
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -75,15 +77,15 @@ VoxelKey SemanticLocalMap::key_of(const Eigen::Vector3d& p, ClassIndex c) const 
                   static_cast<std::int32_t>(std::floor(p.z() * inv)), c};
 }
 
-void SemanticLocalMap::insert(Grid& grid, const FeatureCloud& cloud) {
+void SemanticLocalMap::insert(Grid& grid, const FeatureCloud& cloud, std::uint64_t frame) {
   std::vector<VoxelKey> keys;
   keys.reserve(cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const VoxelKey key = key_of(cloud.points[i], cloud.classes[i]);
-    auto [it, inserted] = grid.voxels.try_emplace(key, Voxel{cloud.points[i], frame_count_});
+    auto [it, inserted] = grid.voxels.try_emplace(key, Voxel{cloud.points[i], frame});
     if (!inserted) {
-      if (it->second.frame == frame_count_) continue;  // first point of this frame stays
-      it->second = Voxel{cloud.points[i], frame_count_};  // the newest frame wins
+      if (it->second.frame == frame) continue;  // first point of this frame stays
+      it->second = Voxel{cloud.points[i], frame};  // the newest frame wins
     }
     keys.push_back(key);
   }
@@ -106,17 +108,23 @@ void SemanticLocalMap::rebuild_trees(const Grid& grid,
   for (int c = 0; c < kNumClassIndices; ++c) maps[c]->rebuild(std::move(per_class[c]));
 }
 
-void SemanticLocalMap::add_frame(FeatureCloud edges_world, FeatureCloud planars_world) {
+void SemanticLocalMap::add_frame(const FeatureCloud& edges_world, const FeatureCloud& planars_world, bool parallel) {
   // The voxel grids are updated incrementally (cost ~ one frame); the
   // kd-trees are rebuilt from the grids (measured in bench_odometry,
   // BM_LocalMapUpdate): a rebuild of ~40k points takes a few ms.
-  insert(edge_grid_, edges_world);
-  insert(planar_grid_, planars_world);
-  ++frame_count_;
-  while (static_cast<int>(edge_grid_.frame_keys.size()) > max_frames_) evict_oldest(edge_grid_);
-  while (static_cast<int>(planar_grid_.frame_keys.size()) > max_frames_) evict_oldest(planar_grid_);
-  rebuild_trees(edge_grid_, edge_maps_);
-  rebuild_trees(planar_grid_, planar_maps_);
+  const std::uint64_t frame = frame_count_++;
+  auto update = [&](Grid& grid, const FeatureCloud& cloud, auto& maps) {
+    insert(grid, cloud, frame);
+    while (static_cast<int>(grid.frame_keys.size()) > max_frames_) evict_oldest(grid);
+    rebuild_trees(grid, maps);
+  };
+  if (parallel) {
+    tbb::parallel_invoke([&] { update(edge_grid_, edges_world, edge_maps_); },
+                         [&] { update(planar_grid_, planars_world, planar_maps_); });
+  } else {
+    update(edge_grid_, edges_world, edge_maps_);
+    update(planar_grid_, planars_world, planar_maps_);
+  }
 }
 
 std::size_t SemanticLocalMap::num_edge_points() const {

@@ -78,8 +78,9 @@ class SemanticLocalMap {
   SemanticLocalMap(int max_frames, ClassVoxelSizes voxel_size);
 
   /// Adds one frame's features (already in the world frame), drops the oldest
-  /// beyond N_m and rebuilds the per-class submaps.
-  void add_frame(FeatureCloud edges_world, FeatureCloud planars_world);
+  /// beyond N_m and rebuilds the per-class submaps (edge and planar trees as
+  /// two TBB tasks with `parallel`).
+  void add_frame(const FeatureCloud& edges_world, const FeatureCloud& planars_world, bool parallel = false);
   [[nodiscard]] bool empty() const { return frame_count_ == 0; }
   [[nodiscard]] const ClassSubmap& edges(ClassIndex c) const { return *edge_maps_[c]; }
   [[nodiscard]] const ClassSubmap& planars(ClassIndex c) const { return *planar_maps_[c]; }
@@ -98,7 +99,7 @@ class SemanticLocalMap {
     std::unordered_map<VoxelKey, Voxel, VoxelKeyHash> voxels;
     std::deque<std::vector<VoxelKey>> frame_keys;  ///< keys written by each frame in the window
   };
-  void insert(Grid& grid, const FeatureCloud& cloud);
+  void insert(Grid& grid, const FeatureCloud& cloud, std::uint64_t frame);
   void evict_oldest(Grid& grid);
   void rebuild_trees(const Grid& grid, std::array<std::unique_ptr<ClassSubmap>, kNumClassIndices>& maps) const;
   [[nodiscard]] VoxelKey key_of(const Eigen::Vector3d& p, ClassIndex c) const;

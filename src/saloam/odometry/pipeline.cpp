@@ -45,33 +45,41 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
   FrameTimings timing;
   auto t0 = Clock::now();
   const bool use_labels = config_.use_semantics && cloud.has_labels;
-  ScanFeatures features = extract_features(cloud, config_.features, use_labels);
+  ScanFeatures features = extract_features(cloud, config_.features, use_labels, settings_.parallel);
   timing.features_ms = ms_since(t0);
 
-  // Constant-velocity model: the motion of the last frame, rescaled to this
-  // frame's time step, predicts the pose and the motion during the sweep.
+  // Internally every scan is de-skewed to, and registered at, mid-sweep: the
+  // correction is then symmetric in time, so an error in the assumed velocity
+  // distorts the scan without shifting it on average. De-skewing to the sweep
+  // start instead couples half the velocity error into the pose, and the
+  // constant-velocity loop (pose -> velocity -> de-skew -> pose) oscillates and
+  // diverges (measured on simulated data). The reported pose is moved to
+  // `pose_time_in_sweep` afterwards.
   t0 = Clock::now();
-  const std::size_t k = poses_.size();
-  Pose prediction = k > 0 ? poses_.back() : Pose::Identity();
+  const bool deskewing = config_.deskew;
+  const double mid = 0.5 * config_.features.sweep_duration;
+  const double reference_time = deskewing ? mid : config_.features.pose_time_in_sweep;
+  const std::size_t k = sweep_poses_.size();
+  Pose prediction = k > 0 ? sweep_poses_.back() : Pose::Identity();
   Vector6d motion = Vector6d::Zero();
   double period = config_.features.sweep_duration;
+  if (k >= 1 && timestamp - timestamps_[k - 1] > 1e-6) period = timestamp - timestamps_[k - 1];
   if (k >= 2) {
+    // Constant velocity: the last frame's motion, rescaled to this time step.
     const double dt_prev = timestamps_[k - 1] - timestamps_[k - 2];
     const double dt = timestamp - timestamps_[k - 1];
-    const Vector6d last_motion = se3_log(poses_[k - 2].inverse() * poses_[k - 1]);
     const double scale = (dt_prev > 1e-6 && dt > 1e-6) ? dt / dt_prev : 1.0;
-    motion = scale * last_motion;
-    if (dt > 1e-6) period = dt;
-    prediction = orthonormalized(poses_.back() * se3_exp(motion));
+    motion = scale * se3_log(sweep_poses_[k - 2].inverse() * sweep_poses_[k - 1]);
+    prediction = orthonormalized(sweep_poses_.back() * se3_exp(motion));
   }
-  if (config_.deskew && k >= 2) {
-    deskew(features.edges, motion, period, config_.features.pose_time_in_sweep);
-    deskew(features.planars, motion, period, config_.features.pose_time_in_sweep);
+  if (deskewing && k >= 2) {
+    deskew(features.edges, motion, period, reference_time);
+    deskew(features.planars, motion, period, reference_time);
   }
-  // The second frame has no motion history: keep its raw features to de-skew
-  // it (and the first frame) once its motion is known.
+  // The second frame has no motion history: keep the raw features of the
+  // first two frames to de-skew them once the motion is known.
   ScanFeatures raw;
-  if (config_.deskew && k <= 1) raw = features;
+  if (deskewing && k <= 1) raw = features;
   features.edges = voxel_downsample(features.edges, voxel_sizes_);
   features.planars = voxel_downsample(features.planars, voxel_sizes_);
   timing.deskew_downsample_ms = ms_since(t0);
@@ -84,26 +92,25 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
   if (!map_.empty()) {
     last_stats_.registration = register_scan(features.edges, features.planars, map_, prediction, settings_);
     pose = last_stats_.registration.pose;
-    if (config_.deskew && k == 1 && last_stats_.registration.ok) {
+    if (deskewing && k == 1 && last_stats_.registration.ok) {
       // Bootstrap: de-skew the first two frames with the motion just
       // estimated, rebuild the map from the first and register again.
-      const Vector6d first_motion = se3_log(poses_[0].inverse() * pose);
-      const double pt = config_.features.pose_time_in_sweep;
+      const Vector6d first_motion = se3_log(sweep_poses_[0].inverse() * pose);
       ScanFeatures first = first_raw_;
-      deskew(first.edges, first_motion, period, pt);
-      deskew(first.planars, first_motion, period, pt);
+      deskew(first.edges, first_motion, period, reference_time);
+      deskew(first.planars, first_motion, period, reference_time);
       map_ = SemanticLocalMap(config_.local_map_frames, voxel_sizes_);
-      map_.add_frame(transformed(voxel_downsample(first.edges, voxel_sizes_), poses_[0]),
-                     transformed(voxel_downsample(first.planars, voxel_sizes_), poses_[0]));
-      deskew(raw.edges, first_motion, period, pt);
-      deskew(raw.planars, first_motion, period, pt);
+      map_.add_frame(transformed(voxel_downsample(first.edges, voxel_sizes_), sweep_poses_[0]),
+                     transformed(voxel_downsample(first.planars, voxel_sizes_), sweep_poses_[0]), settings_.parallel);
+      deskew(raw.edges, first_motion, period, reference_time);
+      deskew(raw.planars, first_motion, period, reference_time);
       features.edges = voxel_downsample(raw.edges, voxel_sizes_);
       features.planars = voxel_downsample(raw.planars, voxel_sizes_);
       last_stats_.registration = register_scan(features.edges, features.planars, map_, pose, settings_);
       pose = last_stats_.registration.pose;
     }
   }
-  if (config_.deskew && k == 0) first_raw_ = std::move(raw);
+  if (deskewing && k == 0) first_raw_ = std::move(raw);
   if (k >= 1) first_raw_ = ScanFeatures{};
   pose = orthonormalized(pose);
   timing.registration_ms = ms_since(t0);
@@ -111,13 +118,26 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
   t0 = Clock::now();
   last_world_.edges = transformed(features.edges, pose);
   last_world_.planars = transformed(features.planars, pose);
-  map_.add_frame(last_world_.edges, last_world_.planars);
+  map_.add_frame(last_world_.edges, last_world_.planars, settings_.parallel);
   timing.map_update_ms = ms_since(t0);
 
-  poses_.push_back(pose);
+  sweep_poses_.push_back(pose);
   timestamps_.push_back(timestamp);
   timings_.push_back(timing);
-  return pose;
+
+  // Reported pose at `pose_time_in_sweep`: P_k = C * M_k * exp(-a * xi_k) with
+  // M_k the mid-sweep pose, xi_k its frame motion and a = (mid - t_pose) / period.
+  // C = exp(a * xi_1) makes P_0 the identity (the world is the first scan's
+  // sensor frame at its pose instant); xi_0 := xi_1 (constant velocity).
+  const double a = deskewing ? (mid - config_.features.pose_time_in_sweep) / period : 0.0;
+  if (k == 0 || a == 0.0) {
+    poses_.push_back(k == 0 ? Pose::Identity() : sweep_poses_.front().inverse() * pose);
+  } else {
+    const Vector6d xi = se3_log(sweep_poses_[k - 1].inverse() * pose);
+    if (k == 1) world_from_first_sweep_ = orthonormalized(se3_exp(a * xi));
+    poses_.push_back(orthonormalized(world_from_first_sweep_ * sweep_poses_.front().inverse() * pose * se3_exp(-a * xi)));
+  }
+  return poses_.back();
 }
 
 }  // namespace saloam

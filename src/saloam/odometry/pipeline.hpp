@@ -63,7 +63,9 @@ class OdometryPipeline {
   ClassVoxelSizes voxel_sizes_;
   SemanticLocalMap map_;
   std::unique_ptr<tbb::task_arena> arena_;
-  std::vector<Pose> poses_;
+  std::vector<Pose> poses_;        ///< reported: at pose_time_in_sweep, world = first pose
+  std::vector<Pose> sweep_poses_;  ///< internal: mid-sweep poses (de-skew reference)
+  Pose world_from_first_sweep_ = Pose::Identity();
   std::vector<double> timestamps_;
   std::vector<FrameTimings> timings_;
   FrameStats last_stats_;
