@@ -212,14 +212,36 @@ double World::road_margin(double x, double y) const {
   return lat >= 0 ? lat - z.road_left : -lat - z.road_right;
 }
 
-GroundInfo World::ground_at(double x, double y) const {
-  const double lat = path_lateral(x, y);
-  const Zone z = zone_at(x, y);
+World::FieldSample World::sample(double x, double y) const {
+  const double inv = 1.0 / options_.ground_cell;
+  const double ux = (x - origin_.x()) * inv, uy = (y - origin_.y()) * inv;
+  const int cx = std::clamp(static_cast<int>(ux), 0, nx_ - 1), cy = std::clamp(static_cast<int>(uy), 0, ny_ - 1);
+  const double fx = std::clamp(ux - 0.5, 0.0, nx_ - 1.001), fy = std::clamp(uy - 0.5, 0.0, ny_ - 1.001);
+  const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+  const double tx = fx - ix, ty = fy - iy;
+  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const PackedCell& a = packed_[i];
+  const PackedCell& b = packed_[i + 1];
+  const PackedCell& c = packed_[i + static_cast<std::size_t>(nx_)];
+  const PackedCell& e = packed_[i + static_cast<std::size_t>(nx_) + 1];
+  const double wa = (1 - tx) * (1 - ty), wb = tx * (1 - ty), wc = (1 - tx) * ty, we = tx * ty;
+  return {wa * a.distance + wb * b.distance + wc * c.distance + we * e.distance,
+          wa * a.height + wb * b.height + wc * c.height + we * e.height,
+          wa * a.bump + wb * b.bump + wc * c.bump + we * e.bump,
+          static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(cx)};
+}
+
+GroundInfo World::ground_at(double x, double y) const { return ground_from(sample(x, y)); }
+
+GroundInfo World::ground_from(const FieldSample& s) const {
+  // Side from the nearest cell, magnitude from the continuous distance (see path_lateral).
+  const double lat = lateral_[s.cell] >= 0 ? s.distance : -s.distance;
+  const Zone& z = zones_[s.cell];
   const double d = lat >= 0 ? lat - z.road_left : -lat - z.road_right;  // beyond the road edge
-  const double base = bilinear(height_, x, y);
+  const double base = s.height;
   GroundInfo g;
-  const double road = 0.0, park = z.parking, walk = park + z.sidewalk;
-  if (d < road) {
+  const double park = z.parking, walk = park + z.sidewalk;
+  if (d < 0.0) {
     g.height = base;
     g.label = cls::kRoad;
     // Lane lines: the centre line left of the ego lane and the road edges.
@@ -242,7 +264,7 @@ GroundInfo World::ground_at(double x, double y) const {
   }
   // Verge: gently undulating, rising away from the street.
   const double fade = std::min(1.0, (d - walk) / 12.0);
-  g.height = base + curb + fade * bilinear(bump_, x, y);
+  g.height = base + curb + fade * s.bump;
   switch (z.verge) {
     case 1: g.label = cls::kSidewalk; g.remission = 0.3f; break;
     case 2: g.label = cls::kOtherGround; g.remission = 0.24f; break;
@@ -255,31 +277,46 @@ double World::ground_height(double x, double y) const { return ground_at(x, y).h
 
 double World::ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const {
   // March along the ray with steps that grow with range and shrink near the
-  // ground, then bisect the crossing (the ground has curbs: no closed form).
+  // ground, then refine the crossing by regula falsi (the ground has curbs:
+  // no closed form, but it is nearly planar, so few refinements are needed).
   auto above = [&](double t) {
     const Eigen::Vector3d p = o + t * d;
-    return p.z() - ground_height(p.x(), p.y());
+    return p.z() - ground_from(sample(p.x(), p.y())).height;
   };
-  double t_prev = 0.0;
-  if (above(0.0) <= 0) return 0.0;
+  double t_prev = 0.0, f_prev = above(0.0);
+  if (f_prev <= 0) return 0.0;
   double t = 1.0;
   while (t_prev < max_t) {
     t = std::min(t, max_t);
     const double f = above(t);
     if (f <= 0) {
-      double lo = t_prev, hi = t;
-      for (int i = 0; i < 14 && hi - lo > 0.002; ++i) {
-        const double mid = 0.5 * (lo + hi);
-        (above(mid) > 0 ? lo : hi) = mid;
+      // Illinois variant of regula falsi on [t_prev (above), t (below)].
+      double lo = t_prev, hi = t, f_lo = f_prev, f_hi = f;
+      int side = 0;
+      for (int i = 0; i < 20 && hi - lo > 0.003; ++i) {
+        const double m = std::clamp(lo + (hi - lo) * f_lo / (f_lo - f_hi), lo + 1e-4, hi - 1e-4);
+        const double fm = above(m);
+        if (fm > 0) {
+          lo = m;
+          f_lo = fm;
+          if (side == -1) f_hi *= 0.5;
+          side = -1;
+        } else {
+          hi = m;
+          f_hi = fm;
+          if (side == 1) f_lo *= 0.5;
+          side = 1;
+        }
       }
       return hi;
     }
     // Rays going up and well above the ground never come back.
     if (d.z() > 0.0 && f > 2.5) return kInf;
     t_prev = t;
+    f_prev = f;
     double step = std::max(0.2, 0.04 * t);
-    if (d.z() < -1e-3) step = std::max(step, 0.7 * f / -d.z());
-    t += std::min(step, std::max(0.5, 0.2 * t));
+    if (d.z() < -1e-3) step = std::max(step, 0.8 * f / -d.z());
+    t += std::min(step, std::max(0.5, 0.35 * t));
   }
   return kInf;
 }

@@ -147,6 +147,14 @@ class World {
   };
   [[nodiscard]] Zone zone_at(double x, double y) const;
   [[nodiscard]] double bilinear(const std::vector<float>& field, double x, double y) const;
+  /// Distance, height and bump interpolated together, plus the cell index
+  /// (the ray marcher's hot path: one set of weights for all three).
+  struct FieldSample {
+    double distance, height, bump;
+    std::size_t cell;
+  };
+  [[nodiscard]] FieldSample sample(double x, double y) const;
+  [[nodiscard]] GroundInfo ground_from(const FieldSample& s) const;
   [[nodiscard]] std::size_t cell_index(double x, double y) const;
   [[nodiscard]] double ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const;
 
@@ -156,6 +164,10 @@ class World {
   Eigen::Vector2d origin_{0, 0};
   int nx_ = 0, ny_ = 0;
   std::vector<float> distance_, lateral_, height_, bump_;
+  struct PackedCell {
+    float distance, height, bump, pad;
+  };
+  std::vector<PackedCell> packed_;  ///< distance_, height_, bump_ interleaved
   std::vector<Zone> zones_;
   // Static objects and their 2D grid (CSR).
   std::vector<Primitive> primitives_;

@@ -181,6 +181,8 @@ class WorldBuilder {
                                          0.8 * noise_at(hash_combine(seed_, kSaltBump2), c.x(), c.y(), 55.0) - 0.6);
       }
     }
+    w_.packed_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) w_.packed_[i] = {w_.distance_[i], w_.height_[i], w_.bump_[i], 0.0f};
     occupied_.assign(n, 0);
   }
 
