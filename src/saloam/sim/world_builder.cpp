@@ -172,7 +172,7 @@ class WorldBuilder {
         if (!rural && park > 0.62) z.parking = 2.4f;
         if (!rural && lot > 0.88) z.parking = 15.0f;
         z.sidewalk = rural ? 0.0f
-                           : static_cast<float>(2.2 + 2.6 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
+                           : static_cast<float>(1.7 + 2.0 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
         const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
         z.verge = rural || verge < 0.6 ? 0 : (verge < 0.8 ? 1 : 2);
         const std::size_t i = idx(ix, iy);
