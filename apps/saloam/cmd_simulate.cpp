@@ -129,7 +129,7 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--preset", args->preset, fmt::format("Built-in route: {} (default urban-loop)", fmt::join(names, ", ")))
           ->check(CLI::IsMember(names));
       app.add_option("--frames", args->frames, "Source frames A:B (B exclusive; A: or :B allowed)");
-      app.add_option("--stride", args->stride, "Use every K-th source pose (faster motion per frame)")->check(CLI::Range(1, 100000));
+      app.add_option("--stride", args->stride, "Use every K-th source pose (frames K x 0.1 s apart in times.txt; each sweep still lasts 0.1 s)")->check(CLI::Range(1, 100000));
       app.add_option("--seed", args->seed, "World and noise seed");
       app.add_option("--labels", args->labels, "gt: exact labels; noisy: emulated network output in labels/, truth in labels_gt/")
           ->check(CLI::IsMember({"gt", "noisy"}));

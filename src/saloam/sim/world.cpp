@@ -13,12 +13,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// Independent noise channels (seed salts) for the layout fields.
-enum Salt : std::uint64_t {
-  kSaltRoad = 11, kSaltParking, kSaltSidewalk, kSaltVerge, kSaltRural, kSaltBump, kSaltBuildings, kSaltTrees,
-  kSaltPoles, kSaltCars, kSaltAgents, kSaltFences, kSaltRemission, kSaltLot
-};
-
 struct Interval {
   double t0 = kInf, t1 = -kInf;
   Eigen::Vector3d normal{0, 0, 1};
