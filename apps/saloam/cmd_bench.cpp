@@ -2,8 +2,10 @@
 // frame, excluding disk I/O), time per stage, and peak memory (getrusage).
 
 #include <sys/resource.h>
+#include <time.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -69,14 +71,23 @@ int run_bench(const BenchOptions& options) {
   const auto [first, last] = parse_range(options.frames, reader.size());
 
   OdometryPipeline odometry(config.odometry);
-  std::vector<double> wall_ms;
+  std::vector<double> wall_ms, cpu_ms;
+  // CPU time of this thread: on a shared machine wall time includes waiting
+  // for a core; with --threads 1 the thread's CPU time is the cost of the frame.
+  auto thread_cpu_ms = [] {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+  };
   std::size_t points = 0;
   ProgressBar progress(last - first, "bench");
   for (std::size_t i = first; i < last && !stop_requested(); ++i) {
     const LabelledCloud cloud = reader.load_scan(i);  // I/O outside the timed region
     points += cloud.size();
     const auto t0 = std::chrono::steady_clock::now();
+    const double c0 = thread_cpu_ms();
     odometry.register_frame(cloud, reader.times().at(i));
+    cpu_ms.push_back(thread_cpu_ms() - c0);
     wall_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
     progress.advance();
   }
@@ -98,7 +109,14 @@ int run_bench(const BenchOptions& options) {
                            options.threads, config.odometry.use_semantics && reader.has_labels() ? "on" : "off");
   std::cout << fmt::format("frequency: median {:.1f} Hz ({:.1f} ms), worst frame {:.1f} Hz ({:.1f} ms), mean {:.1f} ms\n",
                            1000.0 / total.median, total.median, 1000.0 / total.max, total.max, total.mean);
-  std::cout << "stage              median ms   mean ms    max ms\n";
+  if (options.threads == 1) {
+    const Summary cpu = summarize(cpu_ms);
+    std::cout << fmt::format("cpu time:  median {:.1f} Hz ({:.1f} ms), worst frame {:.1f} Hz ({:.1f} ms), mean {:.1f} ms\n",
+                             1000.0 / cpu.median, cpu.median, 1000.0 / cpu.max, cpu.max, cpu.mean);
+  }
+  double load[3] = {0, 0, 0};
+  if (getloadavg(load, 3) > 0) std::cout << fmt::format("load average {:.2f} (wall time suffers above the core count)\n", load[0]);
+  std::cout << "stage (wall)       median ms   mean ms    max ms\n";
   for (const auto& [name, v] : {std::pair{"features", &features}, std::pair{"deskew+downsample", &deskew},
                                 std::pair{"registration", &registration}, std::pair{"map update", &map}}) {
     const Summary s = summarize(*v);

@@ -1,6 +1,7 @@
 #include "saloam/odometry/features.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -146,7 +147,6 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
   std::vector<bool> blocked(unreliable);
   const int first = w, last = n - w;  // points with a full window
   const int sectors = std::max(1, config.num_sectors);
-  std::vector<int> order;
   // Blocks the ring neighbours of a selected point, as long as they are
   // close in space (not across an occlusion).
   auto block_neighbours = [&](int i) {
@@ -161,26 +161,30 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
       }
     }
   };
+  // (roughness, index) pairs: sorting contiguous keys is much faster than an
+  // indirect comparison through the roughness array.
+  std::vector<std::pair<double, int>> order;
   for (int s = 0; s < sectors; ++s) {
     const int begin = first + (last - first) * s / sectors;
     const int end = first + (last - first) * (s + 1) / sectors;
     if (end <= begin) continue;
-    order.resize(end - begin);
-    std::iota(order.begin(), order.end(), begin);
-    std::sort(order.begin(), order.end(), [&](int a, int b) { return roughness[a] < roughness[b]; });
+    order.clear();
+    for (int i = begin; i < end; ++i) {
+      if (!blocked[i] && std::isfinite(roughness[i])) order.emplace_back(roughness[i], i);
+    }
+    std::sort(order.begin(), order.end());
     int picked = 0;
     for (auto it = order.rbegin(); it != order.rend() && picked < config.edges_per_sector; ++it) {
-      const int i = *it;
-      if (blocked[i] || !std::isfinite(roughness[i])) continue;
-      if (roughness[i] <= config.alpha) break;
+      const int i = it->second;
+      if (it->first <= config.alpha) break;
+      if (blocked[i]) continue;
       out.edges.push_back(i);
       block_neighbours(i);
       ++picked;
     }
     picked = 0;
-    for (const int i : order) {
-      if (picked >= config.planars_per_sector) break;
-      if (roughness[i] >= config.alpha) break;
+    for (const auto& [c, i] : order) {
+      if (picked >= config.planars_per_sector || c >= config.alpha) break;
       if (blocked[i]) continue;
       out.planars.push_back(i);
       block_neighbours(i);
@@ -190,10 +194,22 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
   return out;
 }
 
-int odometry_class(std::uint16_t raw_label) {
+namespace {
+int compute_odometry_class(std::uint16_t raw_label) {
   if (raw_label == cls::kUnlabeled || raw_label == cls::kOutlier || is_dynamic(raw_label)) return -1;
   const int learning = to_learning_class(static_class(raw_label));
   return learning == 0 ? -1 : learning;
+}
+}  // namespace
+
+int odometry_class(std::uint16_t raw_label) {
+  // Raw ids are below 260; a table avoids the class-table search per point.
+  static const std::array<std::int8_t, 512> table = [] {
+    std::array<std::int8_t, 512> t{};
+    for (std::size_t id = 0; id < t.size(); ++id) t[id] = static_cast<std::int8_t>(compute_odometry_class(static_cast<std::uint16_t>(id)));
+    return t;
+  }();
+  return raw_label < table.size() ? table[raw_label] : compute_odometry_class(raw_label);
 }
 
 namespace {
