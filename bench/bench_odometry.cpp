@@ -6,10 +6,14 @@
 #include <sys/resource.h>
 
 #include <cstdio>
+#include <deque>
+#include <random>
 #include <string>
 #include <vector>
 
 #include <benchmark/benchmark.h>
+
+#include <nanoflann.hpp>
 
 #include "saloam/io/scan_io.hpp"
 #include "saloam/odometry/pipeline.hpp"
@@ -83,6 +87,85 @@ void BM_LocalMapUpdate(benchmark::State& state) {
   state.counters["map_points"] = static_cast<double>(map.num_edge_points() + map.num_planar_points());
 }
 BENCHMARK(BM_LocalMapUpdate)->Unit(benchmark::kMillisecond);
+
+// Rebuild vs incremental kd-tree for the local map: a map of 20 frames of
+// ~2000 planar points; per frame one frame is added and the oldest removed,
+// then 6000 5-NN queries (the registration's load for one outer iteration).
+// Static: rebuild the tree from scratch each frame. Dynamic: nanoflann's
+// KDTreeSingleIndexDynamicAdaptor (addPoints, lazy removePoint, log(n) trees).
+struct PointStore {
+  std::vector<Eigen::Vector3d> pts;
+  [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts.size(); }
+  [[nodiscard]] double kdtree_get_pt(std::size_t i, std::size_t d) const { return pts[i][static_cast<int>(d)]; }
+  template <class B>
+  bool kdtree_get_bbox(B&) const { return false; }
+};
+std::vector<Eigen::Vector3d> random_frame(std::mt19937& rng, int k) {
+  std::uniform_real_distribution<double> u(-40.0, 40.0);
+  std::vector<Eigen::Vector3d> f(2000);
+  for (auto& p : f) p = Eigen::Vector3d(u(rng) + 0.7 * k, u(rng), 0.05 * u(rng));
+  return f;
+}
+void run_queries(benchmark::State& state, const auto& tree, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-40.0, 40.0);
+  std::uint32_t idx[5];
+  double d2[5];
+  for (int q = 0; q < 6000; ++q) {
+    const Eigen::Vector3d p(u(rng), u(rng), 0.0);
+    nanoflann::KNNResultSet<double, std::uint32_t> result(5);
+    result.init(idx, d2);
+    tree.findNeighbors(result, p.data(), nanoflann::SearchParams());
+    benchmark::DoNotOptimize(d2[0]);
+  }
+  (void)state;
+}
+void BM_MapTreeRebuild(benchmark::State& state) {
+  std::mt19937 rng(1);
+  std::deque<std::vector<Eigen::Vector3d>> frames;
+  int k = 0;
+  for (; k < 20; ++k) frames.push_back(random_frame(rng, k));
+  PointStore store;
+  for (auto _ : state) {
+    frames.pop_front();
+    frames.push_back(random_frame(rng, k++));
+    store.pts.clear();
+    for (const auto& f : frames) store.pts.insert(store.pts.end(), f.begin(), f.end());
+    nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointStore>, PointStore, 3, std::uint32_t>
+        tree(3, store, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+    tree.buildIndex();
+    run_queries(state, tree, rng);
+  }
+}
+BENCHMARK(BM_MapTreeRebuild)->Unit(benchmark::kMillisecond);
+// nanoflann 1.4's dynamic index trips GCC 12's -Wmaybe-uninitialized inside its header.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+void BM_MapTreeDynamic(benchmark::State& state) {
+  std::mt19937 rng(1);
+  PointStore store;
+  using Tree = nanoflann::KDTreeSingleIndexDynamicAdaptor<nanoflann::L2_Simple_Adaptor<double, PointStore>, PointStore, 3,
+                                                          std::uint32_t>;
+  Tree tree(3, store, nanoflann::KDTreeSingleIndexAdaptorParams(10));
+  int k = 0;
+  for (; k < 20; ++k) {
+    const auto f = random_frame(rng, k);
+    const auto start = static_cast<std::uint32_t>(store.pts.size());
+    store.pts.insert(store.pts.end(), f.begin(), f.end());
+    tree.addPoints(start, static_cast<std::uint32_t>(store.pts.size() - 1));
+  }
+  for (auto _ : state) {
+    // Points are never compacted: the store keeps the removed frames.
+    const auto oldest = static_cast<std::size_t>(k - 20) * 2000;
+    for (std::size_t i = oldest; i < oldest + 2000; ++i) tree.removePoint(i);
+    const auto f = random_frame(rng, k++);
+    const auto start = static_cast<std::uint32_t>(store.pts.size());
+    store.pts.insert(store.pts.end(), f.begin(), f.end());
+    tree.addPoints(start, static_cast<std::uint32_t>(store.pts.size() - 1));
+    run_queries(state, tree, rng);
+  }
+}
+#pragma GCC diagnostic pop
+BENCHMARK(BM_MapTreeDynamic)->Unit(benchmark::kMillisecond);
 
 // The whole pipeline per frame (features, de-skew, registration, map
 // update) over the six real scans, fresh pipeline each pass (so the local map

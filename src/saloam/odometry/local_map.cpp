@@ -110,8 +110,10 @@ void SemanticLocalMap::rebuild_trees(const Grid& grid,
 
 void SemanticLocalMap::add_frame(const FeatureCloud& edges_world, const FeatureCloud& planars_world, bool parallel) {
   // The voxel grids are updated incrementally (cost ~ one frame); the
-  // kd-trees are rebuilt from the grids (measured in bench_odometry,
-  // BM_LocalMapUpdate): a rebuild of ~40k points takes a few ms.
+  // kd-trees are rebuilt from the grids. Measured in bench_odometry: rebuild
+  // plus 6000 queries 18 ms CPU (BM_MapTreeRebuild) against 35 ms for
+  // nanoflann's incremental index (BM_MapTreeDynamic: slower queries over
+  // log(n) trees, and lazily removed points are never freed).
   const std::uint64_t frame = frame_count_++;
   auto update = [&](Grid& grid, const FeatureCloud& cloud, auto& maps) {
     insert(grid, cloud, frame);

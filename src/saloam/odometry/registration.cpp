@@ -127,7 +127,6 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
     result.rejected_by_constraint = n_rejected;
     if (n_edges + n_planes < 20) return result;  // not enough to constrain 6 DoF reliably
 
-    bool converged = false;
     for (int it = 0; it < settings.max_iterations; ++it) {
       Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
       Vector6d g = Vector6d::Zero();
@@ -154,12 +153,8 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
       if (!delta.allFinite()) return result;
       T = apply_update(delta, T);
       ++result.iterations;
-      if (delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6) {
-        converged = true;
-        break;
-      }
+      if (delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6) break;  // converged
     }
-    (void)converged;
   }
   result.pose = T;
   result.ok = true;
