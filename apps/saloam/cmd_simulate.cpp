@@ -110,6 +110,12 @@ int run_simulate(const SimulateArgs& args) {
                                100.0 * s.score.iou(c));
     }
   }
+  if (s.reseated_frames > 0) {
+    spdlog::warn("the trajectory's height does not fit one ground surface at {} frames (up to {:.1f} m off): the sensor "
+                 "was kept 1.2-2.5 m above the simulated ground there, so poses.txt (the trajectory as given) and the scans "
+                 "disagree in height at those frames",
+                 s.reseated_frames, s.max_sensor_offset);
+  }
   if (s.interrupted) spdlog::warn("stopped after {} frames; the sequence written so far is complete and readable", s.frames);
   return 0;
 }

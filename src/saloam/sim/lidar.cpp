@@ -58,6 +58,7 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     cos_el[static_cast<std::size_t>(b)] = std::cos(e);
   }
 
+  std::vector<float> column_offset(static_cast<std::size_t>(columns), 0.0f);
   tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
     std::vector<Primitive> agents, near;
     for (int c = range.begin(); c < range.end(); ++c) {
@@ -65,7 +66,11 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       const Pose sensor = column_pose(lidar, sweep, c);
       const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
       const double az = lidar.column_azimuth(c);
-      const Eigen::Vector3d origin = sensor.translation();
+      // The sensor stays on a car on the ground (World::sensor_origin); the
+      // points are in the sensor frame, so a height error of the pose, if
+      // any, shows up as it does in real data: between poses and scans.
+      const Eigen::Vector3d origin = world.sensor_origin(sensor.translation());
+      column_offset[static_cast<std::size_t>(c)] = static_cast<float>(origin.z() - sensor.translation().z());
       // Moving objects at this column's time, kept only near the column's vertical plane.
       world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
       const Eigen::Vector3d heading = sensor.linear() * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0);
@@ -128,6 +133,9 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     }
   }
   scan.cloud.has_labels = true;
+  for (const float dz : column_offset) {
+    if (std::abs(dz) > std::abs(scan.sensor_offset)) scan.sensor_offset = dz;
+  }
   return scan;
 }
 

@@ -57,6 +57,9 @@ struct SimulatedScan {
   std::vector<std::uint16_t> ring;  ///< beam index (0 = top)
   std::vector<std::uint16_t> column;
   std::vector<float> range;         ///< measured range [m]
+  /// Largest vertical distance [m] between the pose and where the sensor
+  /// rode on the ground (World::sensor_origin); ~0 for consistent trajectories.
+  float sensor_offset = 0;
 };
 
 /// Sensor pose T_W<-L when column `column` fires (what simulate_scan uses).

@@ -1,6 +1,9 @@
 #include "saloam/sim/simulator.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -106,6 +109,15 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
     }
     const SweepSpec sweep = sweep_for_frame(trajectory, frames[k], options);
     SimulatedScan scan = simulate_scan(world, lidar, sweep);
+    if (scan.cloud.size() == 0) {
+      const Eigen::Vector3d p = sweep.start.translation();
+      throw std::runtime_error(fmt::format(
+          "simulated frame {} (source pose {}, sensor at {:.2f} {:.2f} {:.2f}) has no points; not writing an empty scan to {}",
+          k, frames[k], p.x(), p.y(), p.z(), (out_dir / "velodyne" / (frame_name(k) + ".bin")).string()));
+    }
+    const double offset = std::abs(static_cast<double>(scan.sensor_offset));
+    summary.max_sensor_offset = std::max(summary.max_sensor_offset, offset);
+    if (offset > 0.0) ++summary.reseated_frames;
     if (noisy) {
       write_scan_labels(out_dir / "labels_gt" / (frame_name(k) + ".label"), scan.cloud);
       const std::vector<std::uint16_t> predicted =

@@ -53,6 +53,10 @@ struct SimulationSummary {
   double label_accuracy = std::numeric_limits<double>::quiet_NaN();
   SegmentationScore score;         ///< per-class IoU of the noisy labels
   bool interrupted = false;
+  /// Frames where the sensor had to leave the trajectory's height to stay on
+  /// the ground (inconsistent ground-truth heights), and the largest offset [m].
+  std::size_t reseated_frames = 0;
+  double max_sensor_offset = 0;
 };
 
 /// The whole source trajectory in the LiDAR frame, Q_i = T_L0<-Li.
@@ -68,7 +72,9 @@ SweepSpec sweep_for_frame(const std::vector<Pose>& lidar_trajectory, std::size_t
                           const SimulationOptions& options);
 
 /// Simulates and writes the sequence to `out_dir` (created). Stops cleanly on
-/// stop_requested(): the frames written so far form a valid sequence.
+/// stop_requested(): the frames written so far form a valid sequence. A frame
+/// without any return is an error (std::runtime_error naming the frame), never
+/// an empty scan file.
 SimulationSummary simulate_sequence(const SimulationOptions& options, const std::filesystem::path& out_dir);
 
 }  // namespace saloam::sim

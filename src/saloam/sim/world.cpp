@@ -12,6 +12,10 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
+// How far the sensor may sit below / above its nominal height over the ground
+// (suspension, load, a curb under one wheel, the smoothing of the ground).
+constexpr double kSensorClearanceBelow = 0.5;
+constexpr double kSensorClearanceAbove = 0.8;
 
 struct Interval {
   double t0 = kInf, t1 = -kInf;
@@ -268,6 +272,13 @@ GroundInfo World::ground_from(const FieldSample& s) const {
 }
 
 double World::ground_height(double x, double y) const { return ground_at(x, y).height; }
+
+Eigen::Vector3d World::sensor_origin(const Eigen::Vector3d& pose_origin) const {
+  const double ground = ground_height(pose_origin.x(), pose_origin.y());
+  const double z = std::clamp(pose_origin.z(), ground + options_.sensor_height - kSensorClearanceBelow,
+                              ground + options_.sensor_height + kSensorClearanceAbove);
+  return {pose_origin.x(), pose_origin.y(), z};
+}
 
 double World::ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const {
   // March along the ray with steps that grow with range and shrink near the

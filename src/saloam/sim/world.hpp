@@ -117,6 +117,13 @@ class World {
   /// Ground surface height and class at (x, y).
   [[nodiscard]] GroundInfo ground_at(double x, double y) const;
   [[nodiscard]] double ground_height(double x, double y) const;
+  /// Where the LiDAR really is when the trajectory puts it at `pose_origin`:
+  /// at the pose, unless that is not `sensor_height` - 0.5 m to + 0.8 m above
+  /// the ground under it (a car stands on its wheels); then at the nearest
+  /// bound. That happens only where the trajectory's height does not fit one
+  /// ground surface (ground-truth height errors, e.g. KITTI 08); it is a
+  /// function of the pose, so revisits stay consistent.
+  [[nodiscard]] Eigen::Vector3d sensor_origin(const Eigen::Vector3d& pose_origin) const;
 
   [[nodiscard]] const std::vector<Primitive>& primitives() const { return primitives_; }
   [[nodiscard]] const std::vector<Agent>& agents() const { return agents_; }

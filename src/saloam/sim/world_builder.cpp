@@ -148,7 +148,11 @@ class WorldBuilder {
     }
 
     // Height of the nearest path point, smoothed so that two passes at
-    // slightly different heights meet without a step.
+    // slightly different heights meet without a step. Ground-truth
+    // trajectories are not always consistent in height (KITTI 08 climbs 9 m
+    // in its first 13 m with a level car, and passes its start again 6 m
+    // higher): no single ground lies 1.73 m under every pose there, so the
+    // sensor keeps a physical clearance above this ground (World::sensor_origin).
     w_.height_.resize(n);
     for (std::size_t i = 0; i < n; ++i) w_.height_[i] = static_cast<float>(centres[static_cast<std::size_t>(source[i])].z());
     box_blur(w_.height_, 4);
@@ -221,28 +225,28 @@ class WorldBuilder {
     }
   }
 
+  // Separable box filter with running sums (O(n) whatever the radius); the
+  // window is clipped at the raster border.
   void box_blur(std::vector<float>& f, int radius) const {
-    std::vector<float> tmp(f.size());
     const int nx = w_.nx_, ny = w_.ny_;
-    for (int iy = 0; iy < ny; ++iy) {
-      for (int ix = 0; ix < nx; ++ix) {
-        double sum = 0;
-        int cnt = 0;
-        for (int k = std::max(0, ix - radius); k <= std::min(nx - 1, ix + radius); ++k, ++cnt) {
-          sum += f[static_cast<std::size_t>(iy) * nx + k];
-        }
-        tmp[static_cast<std::size_t>(iy) * nx + ix] = static_cast<float>(sum / cnt);
+    std::vector<float> tmp(f.size());
+    std::vector<double> line;
+    auto blur_line = [&](int count, auto&& get, auto&& set) {
+      line.assign(static_cast<std::size_t>(count) + 1, 0.0);
+      for (int k = 0; k < count; ++k) line[static_cast<std::size_t>(k) + 1] = line[static_cast<std::size_t>(k)] + get(k);
+      for (int k = 0; k < count; ++k) {
+        const int a = std::max(0, k - radius), b = std::min(count - 1, k + radius);
+        set(k, static_cast<float>((line[static_cast<std::size_t>(b) + 1] - line[static_cast<std::size_t>(a)]) / (b - a + 1)));
       }
+    };
+    for (int iy = 0; iy < ny; ++iy) {
+      const std::size_t row = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx);
+      blur_line(nx, [&](int k) { return static_cast<double>(f[row + static_cast<std::size_t>(k)]); },
+                [&](int k, float v) { tmp[row + static_cast<std::size_t>(k)] = v; });
     }
-    for (int iy = 0; iy < ny; ++iy) {
-      for (int ix = 0; ix < nx; ++ix) {
-        double sum = 0;
-        int cnt = 0;
-        for (int k = std::max(0, iy - radius); k <= std::min(ny - 1, iy + radius); ++k, ++cnt) {
-          sum += tmp[static_cast<std::size_t>(k) * nx + ix];
-        }
-        f[static_cast<std::size_t>(iy) * nx + ix] = static_cast<float>(sum / cnt);
-      }
+    for (int ix = 0; ix < nx; ++ix) {
+      auto at = [&](int k) { return static_cast<std::size_t>(k) * static_cast<std::size_t>(nx) + static_cast<std::size_t>(ix); };
+      blur_line(ny, [&](int k) { return static_cast<double>(tmp[at(k)]); }, [&](int k, float v) { f[at(k)] = v; });
     }
   }
 
