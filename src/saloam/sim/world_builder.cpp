@@ -173,12 +173,12 @@ class WorldBuilder {
         const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 55.0);
         const double lot = noise_at(hash_combine(seed_, kSaltLot), c.x(), c.y(), 70.0);
         z.parking = 0.0f;
-        if (!rural && park > 0.62) z.parking = 2.4f;
-        if (!rural && lot > 0.88) z.parking = 15.0f;
+        if (!rural && park > 0.55) z.parking = 2.3f;
+        if (!rural && lot > 0.92) z.parking = 15.0f;
         z.sidewalk = rural ? 0.0f
-                           : static_cast<float>(1.7 + 2.0 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
+                           : static_cast<float>(1.5 + 1.6 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
         const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
-        z.verge = rural || verge < 0.6 ? 0 : (verge < 0.8 ? 1 : 2);
+        z.verge = rural || verge < 0.72 ? 0 : (verge < 0.86 ? 1 : 2);
         const std::size_t i = idx(ix, iy);
         w_.zones_[i] = z;
         w_.bump_[i] = static_cast<float>(0.7 * noise_at(hash_combine(seed_, kSaltBump), c.x(), c.y(), 14.0) +
@@ -295,6 +295,12 @@ class WorldBuilder {
       return true;
     });
   }
+  /// Square of half side r clear of the road by `clearance` (objects ignored).
+  bool clear_of_road(const Eigen::Vector2d& c, double r, double clearance) const {
+    return for_rect(c, {1, 0}, r, r, [&](const Eigen::Vector2d& p) {
+      return inside_grid(p) && w_.road_margin(p.x(), p.y()) >= clearance;
+    });
+  }
   bool disc_free(const Eigen::Vector2d& c, double r, double road_clearance) const {
     return rect_free(c, {1, 0}, r, r, road_clearance, true);
   }
@@ -348,10 +354,6 @@ class WorldBuilder {
         const double yaw = rng.uniform(-0.035, 0.035);
         const double edge = street_edge(probe, side);
         for (int attempt = 0; attempt < 2; ++attempt, length *= 0.55) {
-          Eigen::Vector3d mid3;
-          Eigen::Vector2d mdir;
-          double s_mid = 0;
-          (void)s_mid;
           const Eigen::Vector2d axis = Eigen::Rotation2Dd(yaw) * dir;
           const Eigen::Vector2d mleft(-axis.y(), axis.x());
           const Eigen::Vector2d c = p + 0.5 * length * axis + side * mleft * (edge + setback + 0.5 * depth);
@@ -359,18 +361,34 @@ class WorldBuilder {
           add_building(c, axis, 0.5 * length, 0.5 * depth, height, rng);
           mark_rect(c, axis, 0.5 * length + 0.8, 0.5 * depth + 0.8);
           // Front yard: hedge or fence along the property line, sometimes a tree.
-          const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * (edge + 0.4);
-          if (setback > 2.0) property_line(yard, axis, 0.5 * length, rng);
-          // Garden: bushes and a small tree between the property line and the house.
-          for (int k = 0; setback > 3.0 && k < static_cast<int>(length / 4.0); ++k) {
+          // (0.75 m in: the widest hedge still clears the sidewalk by 0.1 m.)
+          const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * (edge + 0.85);
+          if (setback > 2.0) property_line(yard, axis, side * mleft, 0.5 * length, rng);
+          // Garden: bushes and trees between the property line and the house
+          // (front gardens in KITTI's towns are densely planted).
+          for (int k = 0; setback > 3.0 && k < static_cast<int>(length / 2.5); ++k) {
             const Eigen::Vector2d g = p + rng.uniform(0.1, 0.9) * length * axis +
                                       side * mleft * (edge + rng.uniform(1.4, setback - 0.8));
-            const double r = std::min(rng.uniform(0.5, 1.8), 0.5 * setback - 0.6);
+            const double r = std::min(rng.uniform(0.6, 2.2), 0.5 * setback - 0.5);
             if (r < 0.4 || !rect_free(g, {1, 0}, r, r, 0.5, false)) continue;
-            if (r > 1.1 && rng.chance(0.35)) add_tree(g, r + 1.0, rng); else add_bush(g, r, rng);
+            if (r > 1.0 && rng.chance(0.45)) add_tree(g, r + 1.2, rng); else add_bush(g, r, rng);
             mark_rect(g, {1, 0}, r, r);
           }
-          const double gap = rng.chance(0.45) ? rng.uniform(0.0, 1.0) : rng.uniform(2, 12);
+          // Shrubs along the house front (foundation planting) on some plots.
+          if (setback > 2.5 && rng.chance(0.5)) {
+            const Eigen::Vector2d front = p + 0.5 * length * axis + side * mleft * (edge + setback - 0.6);
+            add_hedge(front, axis, 0.5 * length - 0.5, 0.45, rng.uniform(0.7, 1.6), rng);
+          }
+          const double gap = rng.chance(0.4) ? rng.uniform(0.0, 1.0) : rng.uniform(2, 14);
+          // Trees and shrubs fill most gaps between houses.
+          if (gap > 2.5 && rng.chance(0.8)) {
+            const double r = std::min(0.5 * gap - 0.4, rng.uniform(1.5, 3.5));
+            const Eigen::Vector2d g = p + (length + 0.5 * gap) * axis + side * mleft * (edge + setback + rng.uniform(1.0, 0.5 * depth + 2.0));
+            if (r > 0.8 && rect_free(g, {1, 0}, r, r, 1.0, false)) {
+              if (rng.chance(0.6)) add_tree(g, r + 0.8, rng); else add_bush(g, r, rng);
+              mark_rect(g, {1, 0}, r, r);
+            }
+          }
           return length + gap;
         }
         return 4.0;
@@ -425,25 +443,87 @@ class WorldBuilder {
     return g;
   }
 
-  void property_line(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, Rng& rng) {
+  /// Along a property line: a hedge, or a fence with shrubs or a hedge
+  /// behind it (`away` points from the street into the plot).
+  void property_line(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, const Eigen::Vector2d& away,
+                     double half_length, Rng& rng) {
     const double pick = rng.uniform();
-    if (pick < 0.15) return;
-    const double g = ground(c);
-    const double half_width = rng.uniform(0.3, 0.55);
-    if (!rect_free(c, axis, half_length, std::max(0.4, half_width), 0.1, false)) return;
-    if (pick < 0.72) {  // hedge
-      Primitive h = box(cls::kVegetation, c, axis, half_length, half_width, g - 0.1, g + rng.uniform(0.8, 1.8), 0.45);
-      h.mean_free_path = 0.35f;
-      w_.primitives_.push_back(h);
-    } else {  // fence: solid boards or chain-link the beam partly passes
-      Primitive f = box(cls::kFence, c, axis, half_length, 0.04, g, g + rng.uniform(1.0, 1.9), rng.uniform(0.2, 0.5));
-      if (rng.chance(0.5)) {
-        f.half_y = 0.25f;
-        f.mean_free_path = 1.2f;
-      }
-      w_.primitives_.push_back(f);
+    if (pick < 0.08) return;
+    if (pick < 0.58) {
+      add_hedge(c, axis, half_length, rng.uniform(0.35, 0.7), rng.uniform(0.9, 2.2), rng);
+    } else {
+      add_fence(c, axis, half_length, rng.uniform(1.0, 1.9), 0.5, rng);
+      if (rng.chance(0.75)) planting_behind(c, axis, away, half_length, rng);
     }
-    mark_rect(c, axis, half_length, 0.5);
+  }
+
+  /// Places a straight run in pieces of at most ~5 m, each checked on its
+  /// own, so that a run along a curving street or a skewed plot keeps the
+  /// pieces that fit instead of failing as a whole. Returns the pieces placed.
+  template <class F>
+  int in_pieces(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, F&& place_piece) {
+    const int pieces = std::max(1, static_cast<int>(std::ceil(2.0 * half_length / 5.0)));
+    const double half_piece = half_length / pieces;
+    int placed = 0;
+    for (int k = 0; k < pieces; ++k) {
+      const Eigen::Vector2d pc = c + (-half_length + (2 * k + 1) * half_piece) * axis;
+      placed += place_piece(pc, half_piece) ? 1 : 0;
+    }
+    return placed;
+  }
+
+  bool add_hedge(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, double half_width,
+                 double height, Rng& rng) {
+    return in_pieces(c, axis, half_length, [&](const Eigen::Vector2d& pc, double half) {
+             return add_hedge_piece(pc, axis, half, half_width, height, rng);
+           }) > 0;
+  }
+
+  bool add_hedge_piece(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, double half_width,
+                       double height, Rng& rng) {
+    if (!rect_free(c, axis, half_length, half_width, 0.1, false)) return false;
+    const double g = ground(c);
+    Primitive h = box(cls::kVegetation, c, axis, half_length, half_width, g - 0.1, g + height, rng.uniform(0.38, 0.5));
+    h.mean_free_path = 0.3f;
+    w_.primitives_.push_back(h);
+    mark_rect(c, axis, half_length, half_width);
+    return true;
+  }
+
+  /// Fence: boards, railings, or chain-link the beam partly passes.
+  bool add_fence(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, double height,
+                 double chain_link, Rng& rng) {
+    const bool chain = rng.chance(chain_link);
+    const double remission = rng.uniform(0.2, 0.5);
+    return in_pieces(c, axis, half_length, [&](const Eigen::Vector2d& pc, double half) {
+             if (!rect_free(pc, axis, half, 0.3, 0.1, false)) return false;
+             const double g = ground(pc);
+             Primitive f = box(cls::kFence, pc, axis, half, 0.04, g, g + height, remission);
+             if (chain) {
+               f.half_y = 0.2f;
+               f.mean_free_path = 1.0f;
+             }
+             w_.primitives_.push_back(f);
+             mark_rect(pc, axis, half, 0.3);
+             return true;
+           }) > 0;
+  }
+
+  /// Shrubs or a hedge just behind a fence, taller than it now and then.
+  void planting_behind(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, const Eigen::Vector2d& away,
+                       double half_length, Rng& rng) {
+    if (rng.chance(0.45)) {
+      const double hw = rng.uniform(0.4, 0.9);
+      add_hedge(c + away * (0.45 + hw), axis, half_length, hw, rng.uniform(1.2, 2.8), rng);
+      return;
+    }
+    for (double u = -half_length + 0.8; u < half_length - 0.5; u += rng.uniform(1.5, 3.5)) {
+      const double r = rng.uniform(0.6, 1.6);
+      const Eigen::Vector2d b = c + u * axis + away * (0.4 + r);
+      if (!rect_free(b, {1, 0}, r, r, 0.1, false)) continue;
+      add_bush(b, r, rng);
+      mark_rect(b, {1, 0}, r, r);
+    }
   }
 
   // Hedges and fences along the back of the sidewalk wherever no building
@@ -456,28 +536,18 @@ class WorldBuilder {
         const Eigen::Vector2d probe = p + side * left * 7.0;
         const double edge = street_edge(probe, side);
         const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
-        const double length = rng.uniform(4, 18);
+        const double length = rng.uniform(6, 30);
         const double pick = rng.uniform();
-        if (pick < (rural ? 0.4 : 0.15)) return length;  // open
-        const double off = edge + rng.uniform(0.3, rural ? 4.0 : 1.2);
+        if (pick < (rural ? 0.4 : 0.1)) return length;  // open
+        const double half_w = rng.uniform(0.35, 0.8);
+        // Street side of the hedge or fence at least 0.15 m behind the sidewalk.
+        const double off = edge + 0.15 + half_w + rng.uniform(0.0, rural ? 3.0 : 0.6);
         const Eigen::Vector2d c = p + 0.5 * length * dir + side * left * off;
-        const double g = ground(c);
-        if (pick < (rural ? 0.75 : 0.7)) {  // hedge
-          const double half_w = rng.uniform(0.35, 0.7);
-          if (!rect_free(c, dir, 0.5 * length, half_w, 0.1, false)) return 2.0;
-          Primitive h = box(cls::kVegetation, c, dir, 0.5 * length, half_w, g - 0.1, g + rng.uniform(0.8, 2.2), rng.uniform(0.38, 0.5));
-          h.mean_free_path = 0.3f;
-          w_.primitives_.push_back(h);
-          mark_rect(c, dir, 0.5 * length, half_w);
-        } else {  // fence: boards, railings or chain-link the beam partly passes
-          if (!rect_free(c, dir, 0.5 * length, 0.3, 0.1, false)) return 2.0;
-          Primitive f = box(cls::kFence, c, dir, 0.5 * length, 0.04, g, g + rng.uniform(0.9, 2.0), rng.uniform(0.2, 0.5));
-          if (rng.chance(0.4)) {
-            f.half_y = 0.2f;
-            f.mean_free_path = 0.9f;
-          }
-          w_.primitives_.push_back(f);
-          mark_rect(c, dir, 0.5 * length, 0.3);
+        if (pick < (rural ? 0.72 : 0.55)) {
+          if (!add_hedge(c, dir, 0.5 * length, half_w, rng.uniform(0.8, 2.4), rng)) return 2.0;
+        } else {
+          if (!add_fence(c, dir, 0.5 * length, rng.uniform(0.9, 2.0), 0.4, rng)) return 2.0;
+          if (rng.chance(rural ? 0.4 : 0.7)) planting_behind(c, dir, side * left, 0.5 * length, rng);
         }
         return length + (rng.chance(0.6) ? 0.0 : rng.uniform(1, 6));
       });
@@ -493,7 +563,7 @@ class WorldBuilder {
         const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
         const double off = z.road(side) + z.parking + (z.sidewalk > 0 ? 0.45 : 1.2);
         const Eigen::Vector2d c = p + side * left * off;
-        if (!far_from(poles_, c, 15.0) || !disc_free(c, 0.3, 0.25)) return 3.0;
+        if (!far_from(poles_, c, 9.0) || !disc_free(c, 0.3, 0.25)) return 3.0;
         const double g = ground(c);
         if (rng.chance(0.7)) {  // street light with an arm over the road
           Primitive pole;
@@ -513,7 +583,7 @@ class WorldBuilder {
           post.shape = Shape::kCylinder;
           post.label = cls::kPole;
           post.center = c.cast<float>();
-          post.half_x = 0.04f;
+          post.half_x = static_cast<float>(rng.uniform(0.04, 0.06));
           post.z_min = static_cast<float>(g);
           const double h = rng.uniform(2.0, 2.8);
           post.z_max = static_cast<float>(g + h);
@@ -525,9 +595,14 @@ class WorldBuilder {
         }
         poles_.push_back(c);
         mark_rect(c, dir, 0.3, 0.3);
-        return rng.uniform(20, 40);
+        return rng.uniform(10, 26);
       });
     }
+  }
+
+  // Trees after hedges and fences: crowns may overhang them (and gardens),
+  // only the trunk needs free ground; no crown reaches over the road.
+  void place_trees() {
     for (int side = -1; side <= 1; side += 2) {
       Rng rng(hash3(seed_, kSaltTrees, static_cast<std::uint64_t>(side + 5)));
       walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
@@ -539,18 +614,18 @@ class WorldBuilder {
         // Tree rows along the verge; rural land gets more and bigger trees, further out too.
         const double offset = edge + rng.uniform(1.0, rural ? 12.0 : 3.0);
         const Eigen::Vector2d c = p + side * left * offset;
-        const double crown = std::min(rng.uniform(1.8, rural ? 4.2 : 3.5), offset - z.road(side) - 0.6);
-        if (crown < 1.0 || !far_from(trees_, c, 5.0) || !disc_free(c, crown, 0.5) || !disc_free(c, 0.6, 0.3)) {
+        const double crown = std::min(rng.uniform(2.5, rural ? 5.5 : 5.0), offset - z.road(side) - 0.6);
+        if (crown < 1.0 || !far_from(trees_, c, 5.0) || !clear_of_road(c, crown, 0.5) || !disc_free(c, 0.6, 0.3)) {
           return 2.0;
         }
-        if (rng.chance(rural ? 0.85 : 0.7)) {
+        if (rng.chance(rural ? 0.8 : 0.65)) {
           add_tree(c, crown, rng);
         } else {
-          add_bush(c, rng.uniform(0.5, 1.3), rng);
+          add_bush(c, rng.uniform(0.8, 1.8), rng);
         }
         trees_.push_back(c);
         mark_rect(c, dir, 0.6, 0.6);
-        return rng.uniform(4, rural ? 10 : 9);
+        return rng.uniform(3, rural ? 8 : 7);
       });
     }
     // Scattered trees and bushes further from the street (parks, fields, yards).
@@ -558,15 +633,25 @@ class WorldBuilder {
     walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
       const bool rural_here = w_.zone_at(p.x(), p.y()).sidewalk == 0;
-      for (int k = 0; k < (rural_here ? 12 : 5); ++k) {
+      for (int k = 0; k < (rural_here ? 28 : 16); ++k) {
         const int side = rng.chance(0.5) ? -1 : 1;
-        const Eigen::Vector2d c = p + side * left * rng.uniform(8, 50) + dir * rng.uniform(-5, 5);
+        const Eigen::Vector2d c = p + side * left * rng.uniform(6, 50) + dir * rng.uniform(-5, 5);
         if (!inside_grid(c)) continue;
         const World::Zone zc = w_.zone_at(c.x(), c.y());
-        if (w_.road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 3) continue;
-        const double crown = rng.uniform(1.5, 4.0);
-        if (!far_from(trees_, c, 4.0) || !rect_free(c, {1, 0}, crown, crown, 0.8, false)) continue;
-        if (rng.chance(0.75)) add_tree(c, crown, rng); else add_bush(c, rng.uniform(0.7, 2.0), rng);
+        if (w_.road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 2) continue;
+        const double pick = rng.uniform();
+        if (pick < 0.3) {  // shrubs and tall weeds covering part of the grass
+          const double rx = rng.uniform(1.5, 4.5), ry = rx * rng.uniform(0.5, 1.0);
+          const double yaw = rng.uniform(0, kPi);
+          const Eigen::Vector2d axis(std::cos(yaw), std::sin(yaw));
+          if (!rect_free(c, axis, rx, ry, 0.8, false)) continue;
+          add_shrub_patch(c, axis, rx, ry, rng.uniform(0.5, 1.4), rng);
+          mark_rect(c, axis, rx, ry);
+          continue;
+        }
+        const double crown = rng.uniform(2.0, 5.0);
+        if (!far_from(trees_, c, 4.0) || !clear_of_road(c, crown, 0.8) || !disc_free(c, 0.8, 0.8)) continue;
+        if (pick < 0.8) add_tree(c, crown, rng); else add_bush(c, rng.uniform(0.8, 2.2), rng);
         trees_.push_back(c);
         mark_rect(c, {1, 0}, 0.8, 0.8);
       }
@@ -581,7 +666,7 @@ class WorldBuilder {
     trunk.shape = Shape::kCylinder;
     trunk.label = cls::kTrunk;
     trunk.center = c.cast<float>();
-    trunk.half_x = static_cast<float>(rng.uniform(0.12, 0.3));
+    trunk.half_x = static_cast<float>(rng.uniform(0.1, 0.25));
     trunk.z_min = static_cast<float>(g);
     trunk.z_max = static_cast<float>(g + trunk_h + crown * 0.8);
     trunk.remission = static_cast<float>(rng.uniform(0.25, 0.4));
@@ -601,6 +686,24 @@ class WorldBuilder {
     leaves.remission = static_cast<float>(rng.uniform(0.35, 0.55));
     leaves.mean_free_path = static_cast<float>(rng.uniform(0.4, 0.9));
     w_.primitives_.push_back(leaves);
+  }
+
+  /// A low, wide mound of shrubs on open ground (a flattened ellipsoid).
+  void add_shrub_patch(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double rx, double ry, double height, Rng& rng) {
+    const double g = ground(c);
+    Primitive b;
+    b.shape = Shape::kEllipsoid;
+    b.label = cls::kVegetation;
+    b.center = c.cast<float>();
+    b.cos_yaw = static_cast<float>(axis.x());
+    b.sin_yaw = static_cast<float>(axis.y());
+    b.half_x = static_cast<float>(rx);
+    b.half_y = static_cast<float>(ry);
+    b.z_min = static_cast<float>(g - height);
+    b.z_max = static_cast<float>(g + height);
+    b.remission = static_cast<float>(rng.uniform(0.35, 0.55));
+    b.mean_free_path = 0.35f;
+    w_.primitives_.push_back(b);
   }
 
   void add_bush(const Eigen::Vector2d& c, double r, Rng& rng) {
@@ -665,8 +768,8 @@ class WorldBuilder {
         }
         const bool lot = z.parking > 5;
         if (lot && label == cls::kTruck) label = cls::kCar, length = 4.5, width = 1.8, height = 1.5;
-        const bool present = rng.chance(lot ? 0.55 : 0.6);
-        double advance = lot ? 2.8 : length + rng.uniform(0.8, 2.5);
+        const bool present = rng.chance(lot ? 0.55 : 0.72);
+        double advance = lot ? 2.8 : length + rng.uniform(0.7, 2.0);
         if (!present) return advance;
         std::vector<Eigen::Vector2d> spots;
         Eigen::Vector2d axis = dir;
@@ -855,6 +958,7 @@ World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed,
   builder.place_parked_vehicles(total_time);
   builder.place_street_furniture();
   builder.place_boundaries();
+  builder.place_trees();
   builder.place_structures();
   builder.place_agents(total_time);
   builder.build_grid();
