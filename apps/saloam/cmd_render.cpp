@@ -37,7 +37,7 @@ int run_render(const RenderArgs& args) {
   std::cout << "range image: " << range_png.string() << '\n';
 
   sim::MapRenderOptions options;
-  options.metres_per_pixel = args.resolution;
+  options.picture.metres_per_pixel = args.resolution;
   options.frame_step = args.frame_step;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
   const auto map_png = out / "map.png";

@@ -78,5 +78,40 @@ TEST(MapRender, WritesAPicture) {
   EXPECT_GT(std::filesystem::file_size(dir / "map.png"), 500u);
 }
 
+TEST(MapRender, HighestPointWinsAndSizeFollowsTheOptions) {
+  TopDownCanvas canvas({-6, -6}, {6, 6}, {0.1, 2000, true});
+  EXPECT_EQ(canvas.stats().width, 120);
+  EXPECT_EQ(canvas.stats().height, 120);
+  LabelledCloud s = scene();
+  canvas.add(s);
+  // The wall (x = 5) stands over the road; elsewhere the road shows.
+  EXPECT_EQ(canvas.shown_label(5.0, 0.0), cls::kBuilding);
+  EXPECT_EQ(canvas.shown_label(-2.0, 3.0), cls::kRoad);
+  EXPECT_EQ(canvas.shown_label(1.0, 1.0), cls::kMovingCar);  // above the road there
+  EXPECT_EQ(canvas.shown_label(-5.9, -5.9), 0);             // nothing drawn
+  EXPECT_EQ(canvas.shown_label(40.0, 0.0), 0);              // outside
+  canvas.add(Eigen::Vector3d(100, 100, 0), cls::kRoad);     // outside: not drawn
+  EXPECT_EQ(canvas.stats().points_drawn, s.size());
+  // North up: a point at larger y lands on a smaller row, so the picture is
+  // not mirrored (checked through the class lookup on both sides).
+  canvas.add(Eigen::Vector3d(-3, 4, 1.0), cls::kPole);
+  EXPECT_EQ(canvas.shown_label(-3, 4), cls::kPole);
+  EXPECT_EQ(canvas.shown_label(-3, -4), cls::kRoad);
+  testing::TempDir dir;
+  const TopDownStats written = canvas.save(dir / "map.png", {Pose::Identity()});
+  EXPECT_EQ(written.width, 120);
+  EXPECT_GT(std::filesystem::file_size(dir / "map.png"), 500u);
+}
+
+TEST(MapRender, ResolutionIsWidenedToRespectTheLargestSide) {
+  const TopDownCanvas canvas({0, 0}, {1000, 500}, {0.1, 800, true});
+  EXPECT_EQ(canvas.stats().width, 800);
+  EXPECT_EQ(canvas.stats().height, 400);
+  EXPECT_NEAR(canvas.stats().metres_per_pixel, 1.25, 1e-9);
+  const TopDownCanvas fitted({0, 0}, {100, 50}, {0.0, 500, true});
+  EXPECT_EQ(fitted.stats().width, 500);
+  EXPECT_NEAR(fitted.stats().metres_per_pixel, 0.2, 1e-9);
+}
+
 }  // namespace
 }  // namespace saloam

@@ -8,9 +8,99 @@
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam {
+namespace {
+constexpr float kInf = std::numeric_limits<float>::infinity();
+}  // namespace
 
-void render_top_down(const std::filesystem::path& png, const LabelledCloud& map, const std::vector<Pose>& trajectory,
-                     const TopDownOptions& options) {
+TopDownCanvas::TopDownCanvas(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, const TopDownOptions& options)
+    : options_(options), lo_(lo), hi_(hi.cwiseMax(lo + Eigen::Vector2d(1e-3, 1e-3))), zmin_(kInf), zmax_(-kInf) {
+  const Eigen::Vector2d extent = hi_ - lo_;
+  const int max_pixels = std::max(1, options.max_pixels);
+  double mpp = options.metres_per_pixel > 0 ? options.metres_per_pixel : extent.maxCoeff() / max_pixels;
+  mpp = std::max({mpp, extent.maxCoeff() / max_pixels, 0.02});
+  stats_.metres_per_pixel = mpp;
+  stats_.width = std::max(1, static_cast<int>(std::ceil(extent.x() / mpp)));
+  stats_.height = std::max(1, static_cast<int>(std::ceil(extent.y() / mpp)));
+  const auto n = static_cast<std::size_t>(stats_.width) * static_cast<std::size_t>(stats_.height);
+  top_.assign(n, -kInf);
+  bottom_.assign(n, kInf);
+  label_.assign(n, 0);
+}
+
+Eigen::Vector2i TopDownCanvas::pixel(double x, double y) const {
+  const double mpp = stats_.metres_per_pixel;
+  return {static_cast<int>(std::floor((x - lo_.x()) / mpp)), static_cast<int>(std::floor((hi_.y() - y) / mpp))};
+}
+
+void TopDownCanvas::add(const Eigen::Vector3d& point, std::uint16_t label, bool labelled) {
+  const Eigen::Vector2i px = pixel(point.x(), point.y());
+  if (px.x() < 0 || px.y() < 0 || px.x() >= stats_.width || px.y() >= stats_.height) return;
+  const std::size_t idx = static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(stats_.width) + static_cast<std::size_t>(px.x());
+  const auto z = static_cast<float>(point.z());
+  if (z > top_[idx]) {
+    top_[idx] = z;
+    label_[idx] = labelled ? label : 0;
+  }
+  bottom_[idx] = std::min(bottom_[idx], z);
+  zmin_ = std::min(zmin_, z);
+  zmax_ = std::max(zmax_, z);
+  any_labelled_ = any_labelled_ || labelled;
+  ++stats_.points_drawn;
+}
+
+std::uint16_t TopDownCanvas::shown_label(double x, double y) const {
+  const Eigen::Vector2i px = pixel(x, y);
+  if (px.x() < 0 || px.y() < 0 || px.x() >= stats_.width || px.y() >= stats_.height) return 0;
+  return label_[static_cast<std::size_t>(px.y()) * static_cast<std::size_t>(stats_.width) + static_cast<std::size_t>(px.x())];
+}
+
+void TopDownCanvas::add(const LabelledCloud& cloud) {
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    add(cloud.points[i].cast<double>(), cloud.has_labels ? cloud.label[i] : 0, cloud.has_labels);
+  }
+}
+
+TopDownStats TopDownCanvas::save(const std::filesystem::path& png, const std::vector<Pose>& trajectory) const {
+  const int width = stats_.width, height = stats_.height;
+  RasterImage image(width, height, {18, 18, 22});
+  const float zspan = std::max(zmax_ - zmin_, 1.0f);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const std::size_t idx = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x);
+      if (!std::isfinite(top_[idx])) continue;
+      Rgb c{0, 0, 0};
+      if (!any_labelled_) {
+        c = viridis((top_[idx] - zmin_) / zspan);
+      } else {
+        c = label_[idx] == cls::kUnlabeled ? Rgb{150, 150, 150} : class_color(label_[idx]);
+      }
+      // Relief: what stands higher over the lowest point of its pixel is brighter.
+      const double relief = std::clamp((top_[idx] - bottom_[idx]) / 8.0, 0.0, 1.0);
+      const double shade = 0.72 + 0.28 * relief;
+      auto s = [&](std::uint8_t v) { return static_cast<std::uint8_t>(std::clamp(v * shade, 0.0, 255.0)); };
+      image.set(x, y, {s(c.r), s(c.g), s(c.b)});
+    }
+  }
+  if (options_.draw_trajectory && !trajectory.empty()) {
+    const double mpp = stats_.metres_per_pixel;
+    const int thickness = std::max(1, static_cast<int>(std::lround(0.5 / mpp)));
+    for (std::size_t i = 1; i < trajectory.size(); ++i) {
+      const auto a = pixel(trajectory[i - 1].translation().x(), trajectory[i - 1].translation().y());
+      const auto b = pixel(trajectory[i].translation().x(), trajectory[i].translation().y());
+      image.draw_line(a.x(), a.y(), b.x(), b.y(), {255, 255, 255}, thickness);
+    }
+    const int radius = std::max(3, static_cast<int>(std::lround(1.5 / mpp)));
+    const auto end = pixel(trajectory.back().translation().x(), trajectory.back().translation().y());
+    image.draw_disc(end.x(), end.y(), radius, {230, 0, 0});
+    const auto start = pixel(trajectory.front().translation().x(), trajectory.front().translation().y());
+    image.draw_disc(start.x(), start.y(), radius, {0, 230, 0});
+  }
+  image.save_png(png);
+  return stats_;
+}
+
+TopDownStats render_top_down(const std::filesystem::path& png, const LabelledCloud& map, const std::vector<Pose>& trajectory,
+                             const TopDownOptions& options) {
   Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
   Eigen::Vector2d hi = -lo;
   for (const auto& p : map.points) {
@@ -22,58 +112,9 @@ void render_top_down(const std::filesystem::path& png, const LabelledCloud& map,
     hi = hi.cwiseMax(T.translation().head<2>());
   }
   if (map.empty() && trajectory.empty()) lo = hi = Eigen::Vector2d::Zero();
-  lo -= Eigen::Vector2d(5, 5);
-  hi += Eigen::Vector2d(5, 5);
-  const Eigen::Vector2d extent = hi - lo;
-  const double mpp = options.metres_per_pixel > 0 ? options.metres_per_pixel
-                                                  : std::max(extent.maxCoeff() / options.max_pixels, 0.05);
-  const int width = std::max(1, static_cast<int>(std::ceil(extent.x() / mpp)));
-  const int height = std::max(1, static_cast<int>(std::ceil(extent.y() / mpp)));
-  auto to_px = [&](double x, double y) {
-    return Eigen::Vector2i(static_cast<int>((x - lo.x()) / mpp), height - 1 - static_cast<int>((y - lo.y()) / mpp));
-  };
-
-  // Height buffer: the highest point per pixel wins.
-  std::vector<float> top(static_cast<std::size_t>(width) * height, -std::numeric_limits<float>::infinity());
-  std::vector<std::uint16_t> label(top.size(), 0);
-  float zmin = std::numeric_limits<float>::max(), zmax = -zmin;
-  for (std::size_t i = 0; i < map.size(); ++i) {
-    const auto& p = map.points[i];
-    const auto px = to_px(p.x(), p.y());
-    if (px.x() < 0 || px.y() < 0 || px.x() >= width || px.y() >= height) continue;
-    const std::size_t idx = static_cast<std::size_t>(px.y()) * width + px.x();
-    if (p.z() > top[idx]) {
-      top[idx] = p.z();
-      label[idx] = map.label[i];
-    }
-    zmin = std::min(zmin, p.z());
-    zmax = std::max(zmax, p.z());
-  }
-  RasterImage image(width, height, {20, 20, 24});
-  const float zspan = std::max(zmax - zmin, 1.0f);
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const std::size_t idx = static_cast<std::size_t>(y) * width + x;
-      if (!std::isfinite(top[idx])) continue;
-      Rgb c = map.has_labels ? class_color(label[idx]) : viridis((top[idx] - zmin) / zspan);
-      if (map.has_labels && label[idx] == cls::kUnlabeled) c = {120, 120, 120};
-      // Height shading: higher is brighter, so buildings stand out from the road.
-      const double shade = 0.65 + 0.35 * std::clamp((top[idx] - zmin) / zspan * 2.0f, 0.0f, 1.0f);
-      image.set(x, y, {static_cast<std::uint8_t>(c.r * shade), static_cast<std::uint8_t>(c.g * shade),
-                       static_cast<std::uint8_t>(c.b * shade)});
-    }
-  }
-  if (options.draw_trajectory && trajectory.size() > 1) {
-    const int radius = std::max(1, static_cast<int>(std::lround(0.6 / mpp)));
-    for (std::size_t i = 1; i < trajectory.size(); ++i) {
-      const auto a = to_px(trajectory[i - 1].translation().x(), trajectory[i - 1].translation().y());
-      const auto b = to_px(trajectory[i].translation().x(), trajectory[i].translation().y());
-      image.draw_line(a.x(), a.y(), b.x(), b.y(), {255, 255, 255}, radius);
-    }
-    const auto start = to_px(trajectory.front().translation().x(), trajectory.front().translation().y());
-    image.draw_disc(start.x(), start.y(), 4 * radius, {0, 255, 0});
-  }
-  image.save_png(png);
+  TopDownCanvas canvas(lo - Eigen::Vector2d(5, 5), hi + Eigen::Vector2d(5, 5), options);
+  canvas.add(map);
+  return canvas.save(png, trajectory);
 }
 
 }  // namespace saloam

@@ -20,25 +20,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Rgb shade(Rgb c, double f) {
-  auto s = [&](std::uint8_t v) { return static_cast<std::uint8_t>(std::clamp(v * f, 0.0, 255.0)); };
-  return {s(c.r), s(c.g), s(c.b)};
-}
-
-void draw_line(RasterImage& img, Eigen::Vector2d a, Eigen::Vector2d b, Rgb color, int thickness) {
-  const double len = (b - a).norm();
-  const int steps = std::max(1, static_cast<int>(std::ceil(len * 2)));
-  for (int k = 0; k <= steps; ++k) {
-    const Eigen::Vector2d p = a + (b - a) * (static_cast<double>(k) / steps);
-    for (int dy = -thickness; dy <= thickness; ++dy) {
-      for (int dx = -thickness; dx <= thickness; ++dx) {
-        const int x = static_cast<int>(std::lround(p.x())) + dx, y = static_cast<int>(std::lround(p.y())) + dy;
-        if (x >= 0 && y >= 0 && x < img.width() && y < img.height()) img.set(x, y, color);
-      }
-    }
-  }
-}
-
 }  // namespace
 
 MapRenderStats render_map(const fs::path& sequence_dir, const fs::path& png, const MapRenderOptions& options) {
@@ -56,21 +37,8 @@ MapRenderStats render_map(const fs::path& sequence_dir, const fs::path& png, con
   const double margin = std::min(options.max_range, 50.0);
   lo.array() -= margin;
   hi.array() += margin;
-  double mpp = options.metres_per_pixel;
-  const double longest = std::max(hi.x() - lo.x(), hi.y() - lo.y());
-  if (longest / mpp > options.max_pixels) mpp = longest / options.max_pixels;
-  MapRenderStats stats;
-  stats.width = static_cast<int>(std::ceil((hi.x() - lo.x()) / mpp));
-  stats.height = static_cast<int>(std::ceil((hi.y() - lo.y()) / mpp));
-  stats.metres_per_pixel = mpp;
-  const auto npx = static_cast<std::size_t>(stats.width) * static_cast<std::size_t>(stats.height);
-  std::vector<float> top(npx, -std::numeric_limits<float>::infinity());
-  std::vector<std::uint16_t> label(npx, 0);
-  std::vector<float> ground_z(npx, std::numeric_limits<float>::infinity());
-
-  auto pixel = [&](const Eigen::Vector2d& p) {
-    return Eigen::Vector2d((p.x() - lo.x()) / mpp, (hi.y() - p.y()) / mpp);  // north up
-  };
+  TopDownCanvas canvas(lo, hi, options.picture);
+  std::size_t scans_used = 0;
   ProgressBar progress((n + step - 1) / step, "render map", options.show_progress);
   for (std::size_t i = 0; i < n; i += step) {
     if (stop_requested()) break;
@@ -96,43 +64,16 @@ MapRenderStats render_map(const fs::path& sequence_dir, const fs::path& png, con
       } else {
         w = T * q.cast<double>();
       }
-      const Eigen::Vector2d px = pixel(w.head<2>());
-      const int x = static_cast<int>(px.x()), y = static_cast<int>(px.y());
-      if (x < 0 || y < 0 || x >= stats.width || y >= stats.height) continue;
-      const std::size_t idx = static_cast<std::size_t>(y) * static_cast<std::size_t>(stats.width) + static_cast<std::size_t>(x);
-      const auto z = static_cast<float>(w.z());
-      if (z > top[idx]) {
-        top[idx] = z;
-        label[idx] = cloud.has_labels ? cloud.label[k] : 0;
-      }
-      ground_z[idx] = std::min(ground_z[idx], z);
-      ++stats.points_drawn;
+      canvas.add(w, cloud.has_labels ? cloud.label[k] : 0, cloud.has_labels);
     }
-    ++stats.scans_used;
+    ++scans_used;
     progress.advance();
   }
   progress.finish();
 
-  RasterImage img(stats.width, stats.height, {18, 18, 22});
-  for (int y = 0; y < stats.height; ++y) {
-    for (int x = 0; x < stats.width; ++x) {
-      const std::size_t idx = static_cast<std::size_t>(y) * static_cast<std::size_t>(stats.width) + static_cast<std::size_t>(x);
-      if (!std::isfinite(top[idx])) continue;
-      Rgb c = label[idx] == 0 ? Rgb{160, 160, 160} : class_color(label[idx]);
-      // Taller things brighter: gives the map some relief.
-      const double height = top[idx] - ground_z[idx];
-      c = shade(c, 0.75 + 0.25 * std::min(1.0, height / 8.0));
-      img.set(x, y, c);
-    }
-  }
-  for (std::size_t i = 1; i < n; ++i) {
-    draw_line(img, pixel(poses[i - 1].translation().head<2>()), pixel(poses[i].translation().head<2>()), {255, 255, 255}, 1);
-  }
-  // Start (green) and end (red) markers.
-  auto dot = [&](const Eigen::Vector2d& p, Rgb c) { draw_line(img, p, p, c, 5); };
-  dot(pixel(poses.front().translation().head<2>()), {0, 230, 0});
-  dot(pixel(poses.back().translation().head<2>()), {230, 0, 0});
-  img.save_png(png);
+  MapRenderStats stats;
+  static_cast<TopDownStats&>(stats) = canvas.save(png, poses);
+  stats.scans_used = scans_used;
   return stats;
 }
 

@@ -7,12 +7,13 @@
 #include <filesystem>
 
 #include "saloam/core/types.hpp"
+#include "saloam/mapping/map_render.hpp"
 
 namespace saloam::sim {
 
 struct MapRenderOptions {
-  double metres_per_pixel = 0.25;  ///< widened automatically to respect max_pixels
-  int max_pixels = 3200;           ///< longest image side
+  /// Picture size and trajectory drawing (the renderer is mapping's TopDownCanvas).
+  TopDownOptions picture{0.25, 3200, true};
   std::size_t frame_step = 0;      ///< use every n-th scan (0 = automatic, about 300 scans)
   double max_range = 60.0;         ///< ignore points further than this from the sensor
   bool show_progress = true;
@@ -21,16 +22,14 @@ struct MapRenderOptions {
   bool deskew = true;
 };
 
-struct MapRenderStats {
+struct MapRenderStats : TopDownStats {
   std::size_t scans_used = 0;
-  std::size_t points_drawn = 0;
-  int width = 0, height = 0;
-  double metres_per_pixel = 0;
 };
 
 /// Top-down map of the sequence at `sequence_dir` (needs poses.txt and
-/// calib.txt) written to `png`; the highest point per pixel wins, so
-/// buildings and trees show over the ground as in an aerial view.
+/// calib.txt) written to `png`: its scans, de-skewed with the poses, drawn
+/// into a TopDownCanvas (the highest point per pixel wins, so buildings and
+/// trees show over the ground as in an aerial view).
 MapRenderStats render_map(const std::filesystem::path& sequence_dir, const std::filesystem::path& png,
                           const MapRenderOptions& options = {});
 
