@@ -165,6 +165,21 @@ TEST(SemanticClasses, DynamicAndUnlabeledAreNotUsed) {
   EXPECT_NE(odometry_class(cls::kPole), odometry_class(cls::kBuilding));
 }
 
+TEST(SemanticClasses, GroupsMergeConfusableClassesWithSharedGeometry) {
+  auto c = [](std::uint16_t raw) { return static_cast<ClassIndex>(odometry_class(raw)); };
+  EXPECT_EQ(class_group(c(cls::kSidewalk)), c(cls::kRoad));
+  EXPECT_EQ(class_group(c(cls::kParking)), c(cls::kRoad));
+  EXPECT_EQ(class_group(c(cls::kTerrain)), c(cls::kRoad));
+  EXPECT_EQ(class_group(c(cls::kFence)), c(cls::kBuilding));
+  EXPECT_EQ(class_group(c(cls::kTrunk)), c(cls::kPole));
+  EXPECT_EQ(class_group(c(cls::kTrafficSign)), c(cls::kPole));
+  EXPECT_EQ(class_group(c(cls::kTruck)), c(cls::kCar));
+  EXPECT_EQ(class_group(c(cls::kVegetation)), c(cls::kVegetation));
+  EXPECT_NE(class_group(c(cls::kBuilding)), class_group(c(cls::kRoad)));
+  EXPECT_NE(class_group(c(cls::kPole)), class_group(c(cls::kVegetation)));
+  EXPECT_EQ(class_group(0), 0);
+}
+
 // A synthetic 64-beam scan of a box-shaped room with a pole, labelled.
 LabelledCloud room_scan(bool labelled) {
   LabelledCloud cloud;

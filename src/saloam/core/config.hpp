@@ -63,6 +63,15 @@ struct OdometryConfig {
   /// building/fence only if |n . z| <= sigma (normal near horizontal).
   double sigma = 0.05;
   bool use_semantics = true;     ///< false: label-agnostic FLOAM-style baseline
+  /// Match within groups of classes that networks confuse and that share a
+  /// geometry (ground, building+fence, pole-like, vehicles; see class_group())
+  /// instead of strictly within one class. Voxel size, weight and plane
+  /// constraint of a group are those of its representative (road, building,
+  /// pole, car).
+  /// On by default: with noisy labels strict per-class matching split one
+  /// surface over several submaps (simulated 05, 300 frames: t_err 0.166 %
+  /// strict vs 0.137 % grouped; 00: 0.267 % vs 0.110 % with the voxel sizes above).
+  bool match_class_groups = true;
   /// Undistort scans with the constant-velocity motion (internally to
   /// mid-sweep). On by default: it halves the error of the real KITTI scan
   /// pairs (3-4 cm -> 1-2.5 cm) and of simulated runs.
@@ -72,11 +81,12 @@ struct OdometryConfig {
   double robust_kernel_scale = 0.1;  ///< [m] Huber/Cauchy scale of the residuals
   double max_correspondence_distance = 1.0;  ///< [m] farthest map neighbour accepted
   double voxel_size = 0.4;       ///< [m] voxel size without semantics (and default class size)
-  /// Semantic downsampling: per-class voxel size [m]. Small objects keep their points.
-  ClassValueMap class_voxel_size{{"default", 0.4}, {"road", 0.8}, {"sidewalk", 0.8},
-                                 {"parking", 0.8}, {"terrain", 0.8}, {"building", 0.6},
-                                 {"vegetation", 0.8}, {"pole", 0.1}, {"trunk", 0.1},
-                                 {"traffic-sign", 0.1}, {"fence", 0.4}};
+  /// Semantic downsampling: per-class voxel size [m]. Small objects (pole,
+  /// trunk, traffic-sign) keep their points at 0.1 m; large classes use the
+  /// label-agnostic size. Measured on simulated KITTI 00/05 (300 frames):
+  /// 0.8 m for road/sidewalk/parking/terrain/vegetation and 0.6 m for building
+  /// (coarser than the baseline) lost to --no-semantics (05: 0.166 % vs 0.128 %).
+  ClassValueMap class_voxel_size{{"default", 0.4}, {"pole", 0.1}, {"trunk", 0.1}, {"traffic-sign", 0.1}};
   /// w^l of Eq. 2: per-class residual weights (equal by default).
   ClassValueMap class_weight{{"default", 1.0}};
   int threads = 1;               ///< worker threads for association (0 = all cores)
@@ -123,6 +133,7 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature");
   v("sigma", c.sigma, "sigma: plane constraint tolerance");
   v("use_semantics", c.use_semantics, "semantic assistance on/off");
+  v("match_class_groups", c.match_class_groups, "match within class groups instead of single classes");
   v("deskew", c.deskew, "constant-velocity de-skewing");
   v("max_iterations", c.max_iterations, "Gauss-Newton iterations");
   v("outer_iterations", c.outer_iterations, "re-association rounds");

@@ -202,6 +202,22 @@ int compute_odometry_class(std::uint16_t raw_label) {
 }
 }  // namespace
 
+ClassIndex class_group(ClassIndex c) {
+  static const std::array<ClassIndex, kNumClassIndices> table = [] {
+    std::array<ClassIndex, kNumClassIndices> t{};
+    for (int i = 0; i < kNumClassIndices; ++i) t[i] = static_cast<ClassIndex>(i);
+    auto group = [&](std::initializer_list<std::uint16_t> members, std::uint16_t representative) {
+      for (const auto m : members) t[to_learning_class(m)] = to_learning_class(representative);
+    };
+    group({cls::kRoad, cls::kParking, cls::kSidewalk, cls::kOtherGround, cls::kTerrain}, cls::kRoad);
+    group({cls::kBuilding, cls::kFence}, cls::kBuilding);
+    group({cls::kPole, cls::kTrunk, cls::kTrafficSign}, cls::kPole);
+    group({cls::kCar, cls::kBicycle, cls::kMotorcycle, cls::kTruck, cls::kOtherVehicle}, cls::kCar);
+    return t;
+  }();
+  return c < table.size() ? table[c] : c;
+}
+
 int odometry_class(std::uint16_t raw_label) {
   // Raw ids are below 260; a table avoids the class-table search per point.
   static const std::array<std::int8_t, 512> table = [] {

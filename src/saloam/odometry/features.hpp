@@ -102,6 +102,15 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
 /// not be used (dynamic classes, unlabeled, outlier).
 int odometry_class(std::uint16_t raw_label);
 
+/// Matching group of a class index (SemanticKITTI training class): classes
+/// that a segmentation network confuses with each other and that share a
+/// geometry are merged, named by a representative class: ground (road,
+/// parking, sidewalk, other-ground, terrain -> road), vertical structure
+/// (building, fence -> building), pole-like (pole, trunk, traffic-sign ->
+/// pole), vehicles (car, bicycle, motorcycle, truck, other-vehicle -> car).
+/// Vegetation stays alone. Index 0 (unlabeled mode) stays 0.
+ClassIndex class_group(ClassIndex c);
+
 /// Full extraction on one scan. With `use_labels` false (unlabeled scan or
 /// label-agnostic mode) every point is class 0; otherwise dynamic and
 /// unlabeled points are dropped from the features (after the roughness, which

@@ -46,6 +46,10 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
   auto t0 = Clock::now();
   const bool use_labels = config_.use_semantics && cloud.has_labels;
   ScanFeatures features = extract_features(cloud, config_.features, use_labels, settings_.parallel);
+  if (use_labels && config_.match_class_groups) {
+    for (auto& c : features.edges.classes) c = class_group(c);
+    for (auto& c : features.planars.classes) c = class_group(c);
+  }
   timing.features_ms = ms_since(t0);
 
   // Internally every scan is de-skewed to, and registered at, mid-sweep: the
