@@ -77,7 +77,12 @@ struct OdometryConfig {
   /// pairs (3-4 cm -> 1-2.5 cm) and of simulated runs.
   bool deskew = true;
   int max_iterations = 10;       ///< Gauss-Newton iterations per outer loop
-  int outer_iterations = 3;      ///< re-association rounds
+  int outer_iterations = 3;      ///< re-association rounds (at most)
+  /// A round that moved the pose less than this ends the re-association
+  /// early (0 = always all rounds). Measured on simulated 00 (300 frames):
+  /// 24 Hz instead of 18.6 Hz CPU time, t_err 0.116 % instead of 0.110 %.
+  double reassociation_min_translation = 0.01;  ///< [m]
+  double reassociation_min_rotation_deg = 0.1;  ///< [deg]
   double robust_kernel_scale = 0.1;  ///< [m] Huber/Cauchy scale of the residuals
   double max_correspondence_distance = 1.0;  ///< [m] farthest map neighbour accepted
   double voxel_size = 0.4;       ///< [m] voxel size without semantics (and default class size)
@@ -136,7 +141,9 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("match_class_groups", c.match_class_groups, "match within class groups instead of single classes");
   v("deskew", c.deskew, "constant-velocity de-skewing");
   v("max_iterations", c.max_iterations, "Gauss-Newton iterations");
-  v("outer_iterations", c.outer_iterations, "re-association rounds");
+  v("outer_iterations", c.outer_iterations, "re-association rounds (at most)");
+  v("reassociation_min_translation", c.reassociation_min_translation, "[m] smaller pose change ends re-association");
+  v("reassociation_min_rotation_deg", c.reassociation_min_rotation_deg, "[deg] smaller rotation ends re-association");
   v("robust_kernel_scale", c.robust_kernel_scale, "[m] robust kernel scale");
   v("max_correspondence_distance", c.max_correspondence_distance, "[m] max neighbour distance");
   v("voxel_size", c.voxel_size, "[m] voxel size (label-agnostic)");

@@ -17,6 +17,8 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
   s.robust_kernel_scale = config.robust_kernel_scale;
   s.max_iterations = config.max_iterations;
   s.outer_iterations = config.outer_iterations;
+  s.reassociation_min_translation = config.reassociation_min_translation;
+  s.reassociation_min_rotation = config.reassociation_min_rotation_deg * M_PI / 180.0;
   s.sigma = config.sigma;
   s.class_weight = class_weights(config);
   for (int c = 0; c < kNumClassIndices; ++c) {
@@ -86,6 +88,7 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
   const int np = std::min(settings.planar_neighbours, kMaxNeighbours);
 
   for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
+    const Pose outer_start = T;
     // Association at the current pose (the expensive part: kd-tree queries and fits).
     for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
       std::array<Eigen::Vector3d, kMaxNeighbours> nb;
@@ -154,6 +157,13 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
       T = apply_update(delta, T);
       ++result.iterations;
       if (delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6) break;  // converged
+    }
+    // Re-associating only pays when the pose moved: a shift well below the map
+    // resolution leaves the neighbour sets (nearly) unchanged.
+    const Pose moved = outer_start.inverse() * T;
+    if (moved.translation().norm() < settings.reassociation_min_translation &&
+        rotation_angle(moved) < settings.reassociation_min_rotation) {
+      break;
     }
   }
   result.pose = T;

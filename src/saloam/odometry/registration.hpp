@@ -7,6 +7,7 @@
 // outer rounds that re-associate at the new pose.
 
 #include <array>
+#include <cmath>
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
@@ -23,6 +24,9 @@ struct RegistrationSettings {
   double robust_kernel_scale = 0.1;  ///< [m] Huber scale
   int max_iterations = 10;
   int outer_iterations = 3;
+  /// An outer round that moved the pose less than this ends the re-association.
+  double reassociation_min_translation = 0.01;           ///< [m]
+  double reassociation_min_rotation = 0.1 * M_PI / 180;  ///< [rad]
   double sigma = 0.05;             ///< plane-constraint tolerance
   std::array<double, kNumClassIndices> class_weight{};          ///< w^l
   std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
