@@ -538,13 +538,14 @@ class WorldBuilder {
         const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
         const double length = rng.uniform(6, 30);
         const double pick = rng.uniform();
-        if (pick < (rural ? 0.4 : 0.1)) return length;  // open
-        const double half_w = rng.uniform(0.35, 0.8);
+        if (pick < (rural ? 0.25 : 0.1)) return length;  // open
+        // Country roads: wide belts of shrubs along the field edges.
+        const double half_w = rural ? rng.uniform(0.6, 1.8) : rng.uniform(0.35, 0.8);
         // Street side of the hedge or fence at least 0.15 m behind the sidewalk.
         const double off = edge + 0.15 + half_w + rng.uniform(0.0, rural ? 3.0 : 0.6);
         const Eigen::Vector2d c = p + 0.5 * length * dir + side * left * off;
         if (pick < (rural ? 0.72 : 0.55)) {
-          if (!add_hedge(c, dir, 0.5 * length, half_w, rng.uniform(0.8, 2.4), rng)) return 2.0;
+          if (!add_hedge(c, dir, 0.5 * length, half_w, rng.uniform(0.8, rural ? 3.5 : 2.4), rng)) return 2.0;
         } else {
           if (!add_fence(c, dir, 0.5 * length, rng.uniform(0.9, 2.0), 0.4, rng)) return 2.0;
           if (rng.chance(rural ? 0.4 : 0.7)) planting_behind(c, dir, side * left, 0.5 * length, rng);
