@@ -76,14 +76,14 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
     motion = scale * se3_log(sweep_poses_[k - 2].inverse() * sweep_poses_[k - 1]);
     prediction = orthonormalized(sweep_poses_.back() * se3_exp(motion));
   }
+  // Raw features are kept to de-skew again with the motion this frame's
+  // registration finds (and, for the first two frames, once any is known).
+  ScanFeatures raw;
+  if (deskewing) raw = features;
   if (deskewing && k >= 2) {
     deskew(features.edges, motion, period, reference_time);
     deskew(features.planars, motion, period, reference_time);
   }
-  // The second frame has no motion history: keep the raw features of the
-  // first two frames to de-skew them once the motion is known.
-  ScanFeatures raw;
-  if (deskewing && k <= 1) raw = features;
   features.edges = voxel_downsample(features.edges, voxel_sizes_);
   features.planars = voxel_downsample(features.planars, voxel_sizes_);
   timing.deskew_downsample_ms = ms_since(t0);
@@ -112,6 +112,24 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
       features.planars = voxel_downsample(raw.planars, voxel_sizes_);
       last_stats_.registration = register_scan(features.edges, features.planars, map_, pose, settings_);
       pose = last_stats_.registration.pose;
+    } else if (deskewing && k >= 2 && last_stats_.registration.ok) {
+      // The motion during this sweep is better known after registration than
+      // from the previous frame (which lags when the turn rate changes): if
+      // they differ, de-skew again with the estimate and refine. Without this
+      // the loop velocity -> de-skew -> pose can build up errors in turns.
+      const Vector6d estimated = se3_log(sweep_poses_[k - 1].inverse() * pose);
+      const Vector6d change = estimated - motion;
+      if (change.head<3>().norm() > 0.01 || change.tail<3>().norm() > 0.1 * M_PI / 180.0) {
+        deskew(raw.edges, estimated, period, reference_time);
+        deskew(raw.planars, estimated, period, reference_time);
+        features.edges = voxel_downsample(raw.edges, voxel_sizes_);
+        features.planars = voxel_downsample(raw.planars, voxel_sizes_);
+        const auto refined = register_scan(features.edges, features.planars, map_, pose, settings_);
+        if (refined.ok) {
+          last_stats_.registration = refined;
+          pose = refined.pose;
+        }
+      }
     }
   }
   if (deskewing && k == 0) first_raw_ = std::move(raw);

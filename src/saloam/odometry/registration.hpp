@@ -25,8 +25,8 @@ struct RegistrationSettings {
   int max_iterations = 10;
   int outer_iterations = 3;
   /// An outer round that moved the pose less than this ends the re-association.
-  double reassociation_min_translation = 0.01;           ///< [m]
-  double reassociation_min_rotation = 0.1 * M_PI / 180;  ///< [rad]
+  double reassociation_min_translation = 0.0;  ///< [m] (0: always all rounds)
+  double reassociation_min_rotation = 0.0;     ///< [rad]
   double sigma = 0.05;             ///< plane-constraint tolerance
   std::array<double, kNumClassIndices> class_weight{};          ///< w^l
   std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
