@@ -24,11 +24,11 @@ const saloam::LabelledCloud& simulated_scan() {
   static const saloam::LabelledCloud cloud = [] {
     const auto dir = std::filesystem::temp_directory_path() / "saloam_bench_sgpr_scan";
     std::filesystem::remove_all(dir);
-    saloam::sim::SimulationOptions options;
+    saloam::SimulationOptions options;
     options.first_frame = 40;
     options.end_frame = 41;
     options.show_progress = false;
-    saloam::sim::simulate_sequence(options, dir);
+    saloam::simulate_sequence(options, dir);
     auto scan = saloam::read_scan(dir / "velodyne/000000.bin", dir / "labels/000000.label");
     std::filesystem::remove_all(dir);
     return scan;

@@ -16,7 +16,6 @@
 namespace {
 
 using namespace saloam;
-using namespace saloam::sim;
 
 const std::vector<Pose>& urban_loop() {
   static const std::vector<Pose> poses = preset_trajectory("urban-loop");

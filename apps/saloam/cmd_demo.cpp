@@ -55,17 +55,17 @@ int run_demo(const DemoOptions& options) {
     std::cout << "reusing the existing sequence (--reuse)\n";
   } else {
     std::filesystem::remove_all(sequence);
-    sim::SimulationOptions sim_options;
+    SimulationOptions sim_options;
     sim_options.preset = options.preset;
     sim_options.beams = options.beams;
     sim_options.seed = options.seed;
-    sim_options.labels = options.gt_labels ? sim::LabelMode::kGroundTruth : sim::LabelMode::kNoisy;
+    sim_options.labels = options.gt_labels ? LabelMode::kGroundTruth : LabelMode::kNoisy;
     if (!options.frames.empty()) {
-      const auto range = parse_frame_range(options.frames, sim::source_lidar_trajectory(sim_options).size());
+      const auto range = parse_frame_range(options.frames, source_lidar_trajectory(sim_options).size());
       sim_options.first_frame = range.first;
       sim_options.end_frame = range.second;
     }
-    const auto summary = sim::simulate_sequence(sim_options, sequence);
+    const auto summary = simulate_sequence(sim_options, sequence);
     std::cout << fmt::format("{} frames, {:.0f} k points per frame, {:.1f} s", summary.frames,
                              summary.frames ? summary.points / 1000.0 / summary.frames : 0.0, summary.seconds);
     if (!std::isnan(summary.miou)) std::cout << fmt::format(", label mIoU {:.1f} %", 100.0 * summary.miou);
@@ -112,7 +112,7 @@ int run_demo(const DemoOptions& options) {
   write_ply(out / "map.ply", map);
   render_top_down(out / "map.png", map, semantic.run.lidar_poses);
   const std::size_t shown = reader.size() / 2;
-  sim::render_range_image(reader.load_scan(shown), out / fmt::format("range_{:06d}.png", shown));
+  render_range_image(reader.load_scan(shown), out / fmt::format("range_{:06d}.png", shown));
   std::cout << fmt::format("\nmap: {} ({} points), {}\n", (out / "map.ply").string(), map.size(),
                            (out / "map.png").string());
   std::cout << fmt::format("plots: {}, {}\n", (out / "eval_semantic.png").string(),

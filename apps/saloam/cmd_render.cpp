@@ -33,15 +33,15 @@ int run_render(const RenderArgs& args) {
     throw InputError(args.sequence, fmt::format("--frame {} out of range: the sequence has {} scans", args.frame, reader.size()));
   }
   const auto range_png = out / fmt::format("range_{}.png", frame_name(args.frame));
-  sim::render_range_image(reader.load_scan(args.frame), range_png);
+  render_range_image(reader.load_scan(args.frame), range_png);
   std::cout << "range image: " << range_png.string() << '\n';
 
-  sim::MapRenderOptions options;
+  MapRenderOptions options;
   options.picture.metres_per_pixel = args.resolution;
   options.frame_step = args.frame_step;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
   const auto map_png = out / "map.png";
-  const sim::MapRenderStats s = sim::render_map(args.sequence, map_png, options);
+  const MapRenderStats s = render_map(args.sequence, map_png, options);
   std::cout << fmt::format("map: {} ({}x{} px, {:.2f} m/px, {} scans, {} points)\n", map_png.string(), s.width, s.height,
                            s.metres_per_pixel, s.scans_used, s.points_drawn);
   return 0;

@@ -35,7 +35,7 @@ struct SimulateArgs {
 };
 
 // "A:B", "A:", ":B" or "A" (a single frame); B exclusive.
-void parse_frame_range(const std::string& text, sim::SimulationOptions& options) {
+void parse_frame_range(const std::string& text, SimulationOptions& options) {
   if (text.empty()) return;
   auto number = [&](const std::string& s, std::size_t& out) {
     const auto* end = s.data() + s.size();
@@ -68,7 +68,7 @@ Pose load_velo_to_cam(const std::filesystem::path& calib, const std::filesystem:
 }
 
 int run_simulate(const SimulateArgs& args) {
-  sim::SimulationOptions options;
+  SimulationOptions options;
   if (!args.trajectory.empty()) {
     if (!args.preset.empty()) throw ConfigError("give either --trajectory or --preset, not both");
     if (args.calib.empty()) throw ConfigError("--trajectory needs --calib (a KITTI calib.txt or calib_velo_to_cam.txt)");
@@ -84,7 +84,7 @@ int run_simulate(const SimulateArgs& args) {
   options.stride = args.stride;
   options.seed = args.seed;
   if (args.labels == "noisy") {
-    options.labels = sim::LabelMode::kNoisy;
+    options.labels = LabelMode::kNoisy;
   } else if (args.labels != "gt") {
     throw ConfigError(fmt::format("--labels '{}': use gt or noisy", args.labels));
   }
@@ -97,11 +97,11 @@ int run_simulate(const SimulateArgs& args) {
   const std::string source = args.trajectory.empty() ? "preset " + options.preset : args.trajectory;
   spdlog::info("simulating {} ({} beams, seed {}, skew {}, labels {}) into {}", source, options.beams, options.seed,
                options.skew ? "on" : "off", args.labels, args.out);
-  const sim::SimulationSummary s = sim::simulate_sequence(options, args.out);
+  const SimulationSummary s = simulate_sequence(options, args.out);
   std::cout << fmt::format("wrote {} frames, {} points ({:.0f} per frame) to {} in {:.1f} s ({:.2f} frames/s)\n", s.frames,
                            s.points, s.frames ? static_cast<double>(s.points) / static_cast<double>(s.frames) : 0.0, args.out,
                            s.seconds, s.seconds > 0 ? static_cast<double>(s.frames) / s.seconds : 0.0);
-  if (options.labels == sim::LabelMode::kNoisy && s.frames > 0) {
+  if (options.labels == LabelMode::kNoisy && s.frames > 0) {
     std::cout << fmt::format("noisy labels: mIoU {:.1f} %, accuracy {:.1f} % (ground truth in labels_gt/)\n",
                              100.0 * s.miou, 100.0 * s.label_accuracy);
     for (int c = 1; c < kNumLearningClasses; ++c) {
@@ -131,7 +131,7 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--calib", args->calib,
                      "KITTI calib.txt with a Tr: line, or a per-sequence list (NN: ...) picked by the pose file's name")
           ->check(CLI::ExistingFile);
-      const auto names = sim::preset_names();
+      const auto names = preset_names();
       app.add_option("--preset", args->preset, fmt::format("Built-in route: {} (default urban-loop)", fmt::join(names, ", ")))
           ->check(CLI::IsMember(names));
       app.add_option("--frames", args->frames, "Source frames A:B (B exclusive; A: or :B allowed)");

@@ -311,12 +311,12 @@ namespace {
 // Integration with the simulator: one 32-beam frame of the urban-loop preset.
 TEST(SemanticGraph, SimulatedScanGivesAPlausibleDeterministicGraph) {
   testing::TempDir dir;
-  sim::SimulationOptions options;
+  SimulationOptions options;
   options.first_frame = 40;
   options.end_frame = 41;
   options.beams = 32;
   options.show_progress = false;
-  sim::simulate_sequence(options, dir.path());
+  simulate_sequence(options, dir.path());
   const auto cloud = read_scan(dir / "velodyne/000000.bin", dir / "labels/000000.label");
   const auto graph = build_semantic_graph(cloud);
   EXPECT_GE(graph.size(), 5U);

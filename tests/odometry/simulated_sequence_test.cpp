@@ -45,12 +45,12 @@ Drift run(const std::filesystem::path& dir, bool semantics, bool deskew) {
 
 TEST(SimulatedSequence, DriftStaysSmall) {
   testing::TempDir dir("saloam_odom_sim");
-  sim::SimulationOptions options;
+  SimulationOptions options;
   options.preset = "straight";
   options.end_frame = 40;
   options.show_progress = false;
   options.seed = 5;
-  const auto summary = sim::simulate_sequence(options, dir.path());
+  const auto summary = simulate_sequence(options, dir.path());
   ASSERT_EQ(summary.frames, 40u);
   // The simulator reports each return in the sensor frame at its firing
   // instant (motion distortion) and poses at sweep start: the defaults.

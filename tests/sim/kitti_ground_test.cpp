@@ -17,7 +17,7 @@
 #include "saloam/sim/simulator.hpp"
 #include "testing/test_support.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
@@ -112,4 +112,4 @@ TEST(KittiGround, AScanWithoutPointsIsAnErrorNotAnEmptyFile) {
 }
 
 }  // namespace
-}  // namespace saloam::sim
+}  // namespace saloam

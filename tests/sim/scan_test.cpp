@@ -12,7 +12,7 @@
 #include "saloam/core/semantic_classes.hpp"
 #include "sim/sim_fixture.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 using testing::scan_at;
@@ -345,4 +345,4 @@ TEST(Skew, ReturnsAreDistortedByTheMotionDuringTheSweep) {
 }
 
 }  // namespace
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -20,7 +20,7 @@
 #include "sim/sim_fixture.hpp"
 #include "testing/test_support.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
@@ -225,4 +225,4 @@ TEST(LabelNoise, ScoreOfPerfectLabelsIsOne) {
 }
 
 }  // namespace
-}  // namespace saloam::sim
+}  // namespace saloam

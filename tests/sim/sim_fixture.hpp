@@ -10,7 +10,7 @@
 #include "saloam/sim/trajectories.hpp"
 #include "saloam/sim/world.hpp"
 
-namespace saloam::sim::testing {
+namespace saloam::testing {
 
 inline const std::vector<Pose>& urban_loop() {
   static const std::vector<Pose> poses = preset_trajectory("urban-loop");
@@ -46,4 +46,4 @@ inline std::vector<Eigen::Vector3d> to_world(const SimulatedScan& scan, std::siz
   return points_in_world(scan, lidar_model(beams, azimuth_steps), sweep_at(frame, skew, seed));
 }
 
-}  // namespace saloam::sim::testing
+}  // namespace saloam::testing

@@ -6,7 +6,7 @@
 #include "saloam/core/lie.hpp"
 #include "saloam/sim/trajectories.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 double path_length(const std::vector<Pose>& poses) {
@@ -79,4 +79,4 @@ TEST(Presets, AreDeterministicAndNamed) {
 }
 
 }  // namespace
-}  // namespace saloam::sim
+}  // namespace saloam

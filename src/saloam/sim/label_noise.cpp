@@ -5,7 +5,7 @@
 
 #include "saloam/core/error.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 // Learning class ids (SemanticKITTI order).
@@ -154,4 +154,4 @@ double SegmentationScore::accuracy() const {
   return all == 0 ? 0.0 : static_cast<double>(ok) / static_cast<double>(all);
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -10,7 +10,7 @@
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/sim/lidar.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 
 struct LabelNoiseOptions {
   double boundary_flip = 0.8;    ///< chance (times the share of other classes around) that a point takes a neighbour's class
@@ -42,4 +42,4 @@ class SegmentationScore {
   std::array<std::array<std::uint64_t, kNumLearningClasses>, kNumLearningClasses> confusion_{};
 };
 
-}  // namespace saloam::sim
+}  // namespace saloam

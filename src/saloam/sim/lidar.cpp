@@ -8,7 +8,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 }  // namespace
@@ -139,4 +139,4 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
   return scan;
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

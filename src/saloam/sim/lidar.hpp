@@ -18,7 +18,7 @@
 #include "saloam/core/types.hpp"
 #include "saloam/sim/world.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 
 struct LidarModel {
   std::vector<double> elevation_deg;  ///< beam elevations, top to bottom
@@ -73,4 +73,4 @@ std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const Li
 /// the number of threads).
 SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep);
 
-}  // namespace saloam::sim
+}  // namespace saloam

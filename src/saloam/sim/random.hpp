@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-namespace saloam::sim {
+namespace saloam {
 
 /// SplitMix64 finaliser: a good 64-bit mixing function.
 constexpr std::uint64_t mix64(std::uint64_t x) {
@@ -75,4 +75,4 @@ inline double noise_at(std::uint64_t seed, double x, double y, double wavelength
   return value_noise(seed, x / wavelength, y / wavelength);
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -15,7 +15,7 @@
 
 namespace fs = std::filesystem;
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -116,4 +116,4 @@ void render_range_image(const LabelledCloud& cloud, const fs::path& png, int col
   img.save_png(png, 1, 4);
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

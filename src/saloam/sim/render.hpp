@@ -9,7 +9,7 @@
 #include "saloam/core/types.hpp"
 #include "saloam/mapping/map_render.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 
 struct MapRenderOptions {
   /// Picture size and trajectory drawing (the renderer is mapping's TopDownCanvas).
@@ -37,4 +37,4 @@ MapRenderStats render_map(const std::filesystem::path& sequence_dir, const std::
 /// azimuth, front in the middle): class colours on top, range below.
 void render_range_image(const LabelledCloud& cloud, const std::filesystem::path& png, int columns = 1040);
 
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -19,7 +19,7 @@
 
 namespace fs = std::filesystem;
 
-namespace saloam::sim {
+namespace saloam {
 
 Pose output_velo_to_cam(const SimulationOptions& options) {
   return options.velo_to_cam_given ? options.velo_to_cam : kitti_velo_to_cam();
@@ -144,4 +144,4 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
   return summary;
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -17,7 +17,7 @@
 #include "saloam/sim/label_noise.hpp"
 #include "saloam/sim/world.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 
 enum class LabelMode { kGroundTruth, kNoisy };
 
@@ -77,4 +77,4 @@ SweepSpec sweep_for_frame(const std::vector<Pose>& lidar_trajectory, std::size_t
 /// an empty scan file.
 SimulationSummary simulate_sequence(const SimulationOptions& options, const std::filesystem::path& out_dir);
 
-}  // namespace saloam::sim
+}  // namespace saloam

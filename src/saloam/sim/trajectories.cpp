@@ -9,7 +9,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -230,4 +230,4 @@ Pose kitti_velo_to_cam() {
   return orthonormalized(pose_from_3x4(v));
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -8,7 +8,7 @@
 
 #include "saloam/core/types.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 
 /// Names of the built-in routes:
 ///  - "urban-loop": a ~1 km city loop (rounded blocks) that drives its first
@@ -25,4 +25,4 @@ std::vector<Pose> preset_trajectory(const std::string& name, double frame_period
 /// KITTI's velodyne-to-camera extrinsic of sequences 00-02 (used for presets).
 Pose kitti_velo_to_cam();
 
-}  // namespace saloam::sim
+}  // namespace saloam

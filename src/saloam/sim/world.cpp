@@ -7,7 +7,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -527,4 +527,4 @@ void World::agents_at(double t, const Eigen::Vector2d& near, double radius, std:
   }
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam

@@ -17,7 +17,7 @@
 #include "saloam/core/types.hpp"
 #include "saloam/sim/random.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 
 enum class Shape : std::uint8_t { kBox, kCylinder, kEllipsoid };
 
@@ -190,4 +190,4 @@ class World {
 /// Builds the world along the whole LiDAR trajectory (T_W<-L_i, 10 Hz).
 World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options = {});
 
-}  // namespace saloam::sim
+}  // namespace saloam

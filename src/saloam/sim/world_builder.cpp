@@ -11,7 +11,7 @@
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/sim/world.hpp"
 
-namespace saloam::sim {
+namespace saloam {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -966,4 +966,4 @@ World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed,
   return world;
 }
 
-}  // namespace saloam::sim
+}  // namespace saloam
