@@ -14,6 +14,8 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
+#include "saloam/core/frame_range.hpp"
+#include "saloam/pipeline/odometry_run.hpp"
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/progress.hpp"
@@ -31,21 +33,6 @@ struct BenchOptions {
   bool no_semantics = false;
   ConfigOptions config;
 };
-
-std::pair<std::size_t, std::size_t> parse_range(const std::string& text, std::size_t n) {
-  if (text.empty()) return {0, n};
-  const auto colon = text.find(':');
-  try {
-    const std::size_t a = std::stoul(text.substr(0, colon));
-    std::size_t b = n;
-    if (colon != std::string::npos && colon + 1 < text.size()) b = std::stoul(text.substr(colon + 1));
-    b = std::min(b, n);
-    if (a >= b) throw ConfigError(fmt::format("--frames {}: empty range (sequence has {} frames)", text, n));
-    return {a, b};
-  } catch (const std::logic_error&) {
-    throw ConfigError(fmt::format("--frames {}: expected A:B with frame indices", text));
-  }
-}
 
 struct Summary {
   double median = 0, mean = 0, max = 0;
@@ -68,7 +55,7 @@ int run_bench(const BenchOptions& options) {
   if (!options.labels.empty()) seq_options.labels_dir = options.labels;
   seq_options.ignore_labels = !config.odometry.use_semantics;
   const SequenceReader reader(options.sequence, seq_options);
-  const auto [first, last] = parse_range(options.frames, reader.size());
+  const auto [first, last] = FrameRange::parse(options.frames).clip(reader.size());
 
   OdometryPipeline odometry(config.odometry);
   std::vector<double> wall_ms, cpu_ms;

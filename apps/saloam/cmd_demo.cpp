@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
+#include "saloam/core/frame_range.hpp"
 #include "saloam/core/cancellation.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/ply.hpp"
@@ -61,9 +62,9 @@ int run_demo(const DemoOptions& options) {
     sim_options.seed = options.seed;
     sim_options.labels = options.gt_labels ? LabelMode::kGroundTruth : LabelMode::kNoisy;
     if (!options.frames.empty()) {
-      const auto range = parse_frame_range(options.frames, source_lidar_trajectory(sim_options).size());
+      const auto range = FrameRange::parse(options.frames);
       sim_options.first_frame = range.first;
-      sim_options.end_frame = range.second;
+      sim_options.end_frame = range.end;
     }
     const auto summary = simulate_sequence(sim_options, sequence);
     std::cout << fmt::format("{} frames, {:.0f} k points per frame, {:.1f} s", summary.frames,

@@ -2,13 +2,13 @@
 // ray cast in a procedural street world along a preset or KITTI trajectory).
 
 #include <cctype>
-#include <charconv>
 #include <iostream>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
+#include "saloam/core/frame_range.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/calibration.hpp"
@@ -33,26 +33,6 @@ struct SimulateArgs {
   bool no_skew = false;
   bool no_dynamic = false;
 };
-
-// "A:B", "A:", ":B" or "A" (a single frame); B exclusive.
-void parse_frame_range(const std::string& text, SimulationOptions& options) {
-  if (text.empty()) return;
-  auto number = [&](const std::string& s, std::size_t& out) {
-    const auto* end = s.data() + s.size();
-    const auto [ptr, ec] = std::from_chars(s.data(), end, out);
-    if (ec != std::errc() || ptr != end) throw ConfigError(fmt::format("--frames '{}': expected A:B with frame numbers", text));
-  };
-  const auto colon = text.find(':');
-  if (colon == std::string::npos) {
-    number(text, options.first_frame);
-    options.end_frame = options.first_frame + 1;
-    return;
-  }
-  const std::string a = text.substr(0, colon), b = text.substr(colon + 1);
-  if (!a.empty()) number(a, options.first_frame);
-  if (!b.empty()) number(b, options.end_frame);
-  if (options.end_frame <= options.first_frame) throw ConfigError(fmt::format("--frames '{}': B must be greater than A", text));
-}
 
 // Tr from a KITTI calib.txt (`Tr:` line) or from the per-sequence list
 // (`NN: ...` lines), picking the sequence from the pose file's name (00.txt).
@@ -80,7 +60,9 @@ int run_simulate(const SimulateArgs& args) {
     if (!args.calib.empty()) throw ConfigError("--calib is only used with --trajectory");
     options.preset = args.preset.empty() ? "urban-loop" : args.preset;
   }
-  parse_frame_range(args.frames, options);
+  const auto range = FrameRange::parse(args.frames);
+  options.first_frame = range.first;
+  options.end_frame = range.end;
   options.stride = args.stride;
   options.seed = args.seed;
   if (args.labels == "noisy") {

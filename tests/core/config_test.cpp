@@ -94,3 +94,4 @@ TEST(Config, ErrorsNameTheProblem) {
 
 }  // namespace
 }  // namespace saloam
+

@@ -46,23 +46,6 @@ double OdometryRunResult::worst_frame_ms() const {
   return total.empty() ? 0.0 : *std::max_element(total.begin(), total.end());
 }
 
-std::pair<std::size_t, std::size_t> parse_frame_range(const std::string& text, std::size_t n,
-                                                      const std::string& option) {
-  if (text.empty()) return {0, n};
-  const auto colon = text.find(':');
-  std::size_t a = 0, b = n;
-  try {
-    const std::string first = text.substr(0, colon);
-    if (!first.empty()) a = std::stoul(first);
-    if (colon != std::string::npos && colon + 1 < text.size()) b = std::stoul(text.substr(colon + 1));
-  } catch (const std::logic_error&) {
-    throw ConfigError(fmt::format("{} {}: expected A:B with frame indices", option, text));
-  }
-  b = std::min(b, n);
-  if (a >= b) throw ConfigError(fmt::format("{} {}: empty range (sequence has {} frames)", option, text, n));
-  return {a, b};
-}
-
 void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings) {
   std::vector<double> features, deskew, registration, map;
   for (const auto& t : timings) {

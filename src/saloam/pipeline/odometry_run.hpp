@@ -50,9 +50,4 @@ OdometryRunResult run_odometry(const SequenceReader& reader, const OdometryConfi
 /// timing.json: frames, Hz (median, worst frame) and mean/median/max per stage.
 void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings);
 
-/// Parses a frame range "A:B" (B exclusive), "A:" or ":B" against n frames.
-/// Throws ConfigError naming `option` on malformed or empty ranges.
-std::pair<std::size_t, std::size_t> parse_frame_range(const std::string& text, std::size_t n,
-                                                      const std::string& option = "--frames");
-
 }  // namespace saloam
