@@ -14,15 +14,8 @@ namespace {
 using testing::cli_path;
 using testing::run_command;
 using testing::shared_file;
+using testing::quoted;
 using testing::TempDir;
-
-/// Single-quoted for the shell (built with append: GCC 12 warns falsely on "'" + s).
-std::string quoted(const std::filesystem::path& p) {
-  std::string q(1, '\'');
-  q.append(p.string());
-  q.push_back('\'');
-  return q;
-}
 
 TEST(EvalCli, Kitti00OrbWritesJsonAndPlot) {
   TempDir dir;

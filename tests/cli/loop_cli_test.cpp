@@ -15,7 +15,7 @@
 namespace saloam {
 namespace {
 
-std::string quoted(const std::filesystem::path& p) { return fmt::format("'{}'", p.string()); }
+using testing::quoted;
 
 std::string saloam_cmd(const std::string& args) { return quoted(testing::cli_path()) + " " + args; }
 

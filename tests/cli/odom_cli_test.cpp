@@ -19,14 +19,8 @@ namespace {
 using testing::cli_path;
 using testing::run_command;
 using testing::shared_file;
+using testing::quoted;
 using testing::TempDir;
-
-std::string odom_quoted(const std::filesystem::path& p) {
-  std::string q(1, '\'');
-  q.append(p.string());
-  q.push_back('\'');
-  return q;
-}
 
 /// SEQ/velodyne/00000{0..5}.bin (symlinks), times.txt and, optionally, calib.txt.
 void make_sequence(const std::filesystem::path& seq, bool with_calib) {
@@ -47,8 +41,8 @@ TEST(OdomCli, WritesCameraFramePosesTumAndTiming) {
   TempDir dir;
   make_sequence(dir / "seq", true);
   std::string output;
-  const int code = run_command(odom_quoted(cli_path()) + " odom " + odom_quoted(dir / "seq") + " --out " +
-                                   odom_quoted(dir / "out") + " --set odometry.features.pose_time_in_sweep=0.05",
+  const int code = run_command(quoted(cli_path()) + " odom " + quoted(dir / "seq") + " --out " +
+                                   quoted(dir / "out") + " --set odometry.features.pose_time_in_sweep=0.05",
                                &output);
   ASSERT_EQ(code, 0) << output;
   const auto camera = read_kitti_poses(dir / "out" / "poses.txt");
@@ -80,8 +74,8 @@ TEST(OdomCli, FrameRangeNoSemanticsAndMissingCalib) {
   TempDir dir;
   make_sequence(dir / "seq", false);
   std::string output;
-  const int code = run_command(odom_quoted(cli_path()) + " odom " + odom_quoted(dir / "seq") + " --out " +
-                                   odom_quoted(dir / "out") + " --frames 1:4 --no-semantics",
+  const int code = run_command(quoted(cli_path()) + " odom " + quoted(dir / "seq") + " --out " +
+                                   quoted(dir / "out") + " --frames 1:4 --no-semantics",
                                &output);
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("calib.txt"), std::string::npos) << output;  // warned: LiDAR-frame poses
@@ -94,14 +88,14 @@ TEST(OdomCli, FrameRangeNoSemanticsAndMissingCalib) {
 TEST(OdomCli, BadInputFailsWithMessage) {
   TempDir dir;
   std::string output;
-  int code = run_command(odom_quoted(cli_path()) + " odom " + odom_quoted(dir / "missing") + " --out " +
-                             odom_quoted(dir / "out"),
+  int code = run_command(quoted(cli_path()) + " odom " + quoted(dir / "missing") + " --out " +
+                             quoted(dir / "out"),
                          &output);
   EXPECT_NE(code, 0);
   EXPECT_NE(output.find("missing"), std::string::npos) << output;
   make_sequence(dir / "seq", true);
-  code = run_command(odom_quoted(cli_path()) + " odom " + odom_quoted(dir / "seq") + " --out " +
-                         odom_quoted(dir / "out") + " --frames 9:12",
+  code = run_command(quoted(cli_path()) + " odom " + quoted(dir / "seq") + " --out " +
+                         quoted(dir / "out") + " --frames 9:12",
                      &output);
   EXPECT_NE(code, 0);
   EXPECT_NE(output.find("--frames"), std::string::npos) << output;
@@ -111,7 +105,7 @@ TEST(BenchCli, PrintsFrequencyStagesAndMemory) {
   TempDir dir;
   make_sequence(dir / "seq", true);
   std::string output;
-  const int code = run_command(odom_quoted(cli_path()) + " bench " + odom_quoted(dir / "seq") + " --frames 0:3", &output);
+  const int code = run_command(quoted(cli_path()) + " bench " + quoted(dir / "seq") + " --frames 0:3", &output);
   ASSERT_EQ(code, 0) << output;
   EXPECT_NE(output.find("frequency: median"), std::string::npos) << output;
   EXPECT_NE(output.find("worst frame"), std::string::npos) << output;

@@ -12,6 +12,8 @@
 namespace saloam {
 namespace {
 
+using testing::input_error_of;
+
 LabelledCloud small_cloud(std::uint16_t cls, std::size_t n = 5) {
   LabelledCloud c;
   c.has_labels = true;
@@ -29,16 +31,6 @@ void write_sequence(const std::filesystem::path& root) {
   w.write_camera_poses(poses);
   w.write_calib(read_velo_to_cam(testing::shared_file("data/kitti/calib_velo_to_cam.txt"), 0));
   w.write_times({0.0, 0.1, 0.2});
-}
-
-template <class F>
-std::string input_error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
 }
 
 TEST(Sequence, WriteThenRead) {

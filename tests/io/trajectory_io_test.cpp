@@ -11,6 +11,8 @@
 namespace saloam {
 namespace {
 
+using testing::input_error_of;
+
 std::vector<Pose> spiral(std::size_t n) {
   std::vector<Pose> poses;
   for (std::size_t i = 0; i < n; ++i) {
@@ -23,16 +25,6 @@ std::vector<Pose> spiral(std::size_t n) {
 }
 
 void write_text(const std::filesystem::path& p, const std::string& text) { std::ofstream(p) << text; }
-
-template <class F>
-std::string input_error_of(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no error";
-}
 
 TEST(TrajectoryIo, KittiRoundTrip) {
   testing::TempDir dir;

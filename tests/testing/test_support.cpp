@@ -38,6 +38,13 @@ TempDir::~TempDir() {
 
 std::filesystem::path source_dir() { return SALOAM_TEST_SOURCE_DIR; }
 
+std::string quoted(const std::filesystem::path& p) {
+  std::string q(1, '\'');  // built with append: GCC 12 warns falsely on "'" + s
+  q.append(p.string());
+  q.push_back('\'');
+  return q;
+}
+
 std::filesystem::path cli_path() { return SALOAM_CLI_PATH; }
 
 int run_command(const std::string& command, std::string* output) {

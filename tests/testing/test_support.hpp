@@ -4,6 +4,8 @@
 #include <filesystem>
 #include <string>
 
+#include "saloam/core/error.hpp"
+
 namespace saloam::testing {
 
 /// ../shared (development data). Tests that need it call require_shared_data().
@@ -31,6 +33,20 @@ std::filesystem::path source_dir();
 
 /// Path of the built `saloam` program (for end-to-end tests).
 std::filesystem::path cli_path();
+
+/// `p` single-quoted for the shell.
+std::string quoted(const std::filesystem::path& p);
+
+/// The message of the InputError that `f` throws, or "no error".
+template <class F>
+std::string input_error_of(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no error";
+}
 
 /// Runs a shell command, returns its exit status; stdout+stderr go to `output`.
 int run_command(const std::string& command, std::string* output = nullptr);
