@@ -86,7 +86,7 @@ TEST(ResidualJacobians, MatchNumericDifferentiation) {
     for (int k = 0; k < 6; ++k) {
       Vector6d d = Vector6d::Zero();
       d(k) = h;
-      const Pose Tp = se3_exp(d) * T, Tm = se3_exp(-d) * T;
+      const Pose Tp = T * se3_exp(d), Tm = T * se3_exp(-d);  // right perturbation
       const double num_p = (point_to_plane_residual(Tp, p, plane) - point_to_plane_residual(Tm, p, plane)) / (2 * h);
       const Eigen::Vector3d num_l = (point_to_line_residual(Tp, p, line) - point_to_line_residual(Tm, p, line)) / (2 * h);
       EXPECT_NEAR(Jp(0, k), num_p, 1e-5 * (1 + std::abs(num_p)));

@@ -70,8 +70,9 @@ double point_to_plane_residual(const Pose& T, const Eigen::Vector3d& p, const Pl
                                Eigen::Matrix<double, 1, 6>* jacobian) {
   const Eigen::Vector3d q = T * p;
   if (jacobian) {
-    jacobian->leftCols<3>() = plane.normal.transpose();
-    jacobian->rightCols<3>() = -plane.normal.transpose() * skew(q);
+    const Eigen::RowVector3d nR = plane.normal.transpose() * T.linear();
+    jacobian->leftCols<3>() = nR;
+    jacobian->rightCols<3>() = -nR * skew(p);
   }
   return plane.normal.dot(q - plane.point);
 }
@@ -81,12 +82,13 @@ Eigen::Vector3d point_to_line_residual(const Pose& T, const Eigen::Vector3d& p, 
   const Eigen::Vector3d q = T * p;
   const Eigen::Matrix3d P = Eigen::Matrix3d::Identity() - line.direction * line.direction.transpose();
   if (jacobian) {
-    jacobian->leftCols<3>() = P;
-    jacobian->rightCols<3>() = -P * skew(q);
+    const Eigen::Matrix3d PR = P * T.linear();
+    jacobian->leftCols<3>() = PR;
+    jacobian->rightCols<3>() = -PR * skew(p);
   }
   return P * (q - line.point);
 }
 
-Pose apply_update(const Vector6d& delta, const Pose& T) { return orthonormalized(se3_exp(delta) * T); }
+Pose apply_update(const Vector6d& delta, const Pose& T) { return orthonormalized(T * se3_exp(delta)); }
 
 }  // namespace saloam

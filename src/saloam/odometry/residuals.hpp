@@ -4,8 +4,13 @@
 // semantic plane constraint, and point-to-line / point-to-plane residuals
 // with their analytic Jacobians.
 //
-// Pose perturbation convention: T <- exp(delta) * T with delta = [rho; phi]
-// (left, world frame), so for q = T p: dq/d delta = [ I | -[q]x ].
+// Pose perturbation convention: T <- T * exp(delta) with delta = [rho; phi]
+// (right, sensor frame), so for q = T p: dq/d delta = R [ I | -[p]x ].
+// Perturbing in the sensor frame keeps the problem equally well conditioned
+// wherever the sensor is: a left (world-frame) rotation turns about the world
+// origin, hundreds of metres away after a while, which couples rotation and
+// translation through that lever arm; the damped solver then converged too
+// slowly to follow sharp turns (simulated KITTI 00, ~370 m from the origin).
 
 #include <cstdint>
 #include <optional>
@@ -57,7 +62,7 @@ double point_to_plane_residual(const Pose& T, const Eigen::Vector3d& p, const Pl
 Eigen::Vector3d point_to_line_residual(const Pose& T, const Eigen::Vector3d& p, const Line& line,
                                        Eigen::Matrix<double, 3, 6>* jacobian = nullptr);
 
-/// Applies the left update T <- exp(delta) T and re-orthonormalizes the rotation.
+/// Applies the right update T <- T exp(delta) and re-orthonormalizes the rotation.
 Pose apply_update(const Vector6d& delta, const Pose& T);
 
 }  // namespace saloam
