@@ -91,7 +91,7 @@ int run_demo(const DemoOptions& options) {
                              r.run.median_frame_ms(), 1000.0 / std::max(r.run.median_frame_ms(), 1e-9),
                              r.run.worst_frame_ms());
     r.evaluation = evaluate_trajectories(gt_camera, r.run.output_poses);
-    const EvaluationLabels labels{"ground truth", "odometry (" + name + ")"};
+    const EvaluationLabels labels{"sequence/poses.txt", "odometry_" + name + "/poses.txt"};
     write_evaluation_json(out / ("eval_" + name + ".json"), r.evaluation, labels);
     plot_evaluation(out / ("eval_" + name + ".png"), gt_camera, r.run.output_poses, r.evaluation, labels);
     results.push_back(std::move(r));
