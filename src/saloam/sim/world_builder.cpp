@@ -320,6 +320,18 @@ class WorldBuilder {
     p.remission = static_cast<float>(remission);
     return p;
   }
+  static Primitive cylinder(std::uint16_t label, const Eigen::Vector2d& c, double radius, double z0, double z1,
+                            double remission) {
+    Primitive p;
+    p.shape = Shape::kCylinder;
+    p.label = label;
+    p.center = c.cast<float>();
+    p.half_x = static_cast<float>(radius);
+    p.z_min = static_cast<float>(z0);
+    p.z_max = static_cast<float>(z1);
+    p.remission = static_cast<float>(remission);
+    return p;
+  }
   [[nodiscard]] double ground(const Eigen::Vector2d& p) const { return w_.ground_height(p.x(), p.y()); }
 
   // Walks the path in steps, calling f(position, direction, s).
@@ -567,29 +579,17 @@ class WorldBuilder {
         if (!far_from(poles_, c, 9.0) || !disc_free(c, 0.3, 0.25)) return 3.0;
         const double g = ground(c);
         if (rng.chance(0.7)) {  // street light with an arm over the road
-          Primitive pole;
-          pole.shape = Shape::kCylinder;
-          pole.label = cls::kPole;
-          pole.center = c.cast<float>();
-          pole.half_x = static_cast<float>(rng.uniform(0.09, 0.14));
-          pole.z_min = static_cast<float>(g);
+          // Draws kept in sequence (radius, height, remission): the world must not change.
+          const double radius = rng.uniform(0.09, 0.14);
           const double h = rng.uniform(6, 9);
-          pole.z_max = static_cast<float>(g + h);
-          pole.remission = static_cast<float>(rng.uniform(0.25, 0.45));
+          const Primitive pole = cylinder(cls::kPole, c, radius, g, g + h, rng.uniform(0.25, 0.45));
           w_.primitives_.push_back(pole);
           const Eigen::Vector2d arm_c = c - side * left * 0.9;
           w_.primitives_.push_back(box(cls::kPole, arm_c, left, 0.9, 0.07, g + h - 0.15, g + h, pole.remission));
         } else {  // traffic sign on a thin post, the plate facing traffic
-          Primitive post;
-          post.shape = Shape::kCylinder;
-          post.label = cls::kPole;
-          post.center = c.cast<float>();
-          post.half_x = static_cast<float>(rng.uniform(0.04, 0.06));
-          post.z_min = static_cast<float>(g);
+          const double radius = rng.uniform(0.04, 0.06);
           const double h = rng.uniform(2.0, 2.8);
-          post.z_max = static_cast<float>(g + h);
-          post.remission = 0.35f;
-          w_.primitives_.push_back(post);
+          w_.primitives_.push_back(cylinder(cls::kPole, c, radius, g, g + h, 0.35));
           const double plate = rng.uniform(0.3, 0.45);
           Primitive sign = box(cls::kTrafficSign, c, dir, 0.025, plate, g + h, g + h + 2 * plate, rng.uniform(0.75, 0.95));
           w_.primitives_.push_back(sign);
@@ -663,15 +663,8 @@ class WorldBuilder {
   void add_tree(const Eigen::Vector2d& c, double crown, Rng& rng) {
     const double g = ground(c);
     const double trunk_h = rng.uniform(1.8, 3.2);
-    Primitive trunk;
-    trunk.shape = Shape::kCylinder;
-    trunk.label = cls::kTrunk;
-    trunk.center = c.cast<float>();
-    trunk.half_x = static_cast<float>(rng.uniform(0.1, 0.25));
-    trunk.z_min = static_cast<float>(g);
-    trunk.z_max = static_cast<float>(g + trunk_h + crown * 0.8);
-    trunk.remission = static_cast<float>(rng.uniform(0.25, 0.4));
-    w_.primitives_.push_back(trunk);
+    const double radius = rng.uniform(0.1, 0.25);
+    w_.primitives_.push_back(cylinder(cls::kTrunk, c, radius, g, g + trunk_h + crown * 0.8, rng.uniform(0.25, 0.4)));
     const double rz = crown * rng.uniform(0.8, 1.4);
     Primitive leaves;
     leaves.shape = Shape::kEllipsoid;
