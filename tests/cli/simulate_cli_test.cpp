@@ -19,15 +19,10 @@ using testing::run_command;
 using testing::shared_file;
 using testing::TempDir;
 
-std::string q(const fs::path& p) {
-  std::string s(1, '\'');
-  s.append(p.string());
-  s.push_back('\'');
-  return s;
-}
+using testing::quoted;
 
 std::string simulate(const fs::path& out, const std::string& extra) {
-  return q(cli_path()) + " simulate --out " + q(out) + " --beams 16 --azimuth-steps 600 " + extra;
+  return quoted(cli_path()) + " simulate --out " + quoted(out) + " --beams 16 --azimuth-steps 600 " + extra;
 }
 
 TEST(SimulateCli, PresetWritesAReadableSequence) {
@@ -53,7 +48,7 @@ TEST(SimulateCli, Kitti08StartHasNoEmptyScans) {
   const auto poses = shared_file("data/kitti/poses/08.txt");
   const auto calib = shared_file("data/kitti/calib_velo_to_cam.txt");
   std::string output;
-  ASSERT_EQ(run_command(simulate(seq, "--trajectory " + q(poses) + " --calib " + q(calib) + " --frames 0:40 --stride 5"),
+  ASSERT_EQ(run_command(simulate(seq, "--trajectory " + quoted(poses) + " --calib " + quoted(calib) + " --frames 0:40 --stride 5"),
                         &output),
             0)
       << output;
@@ -73,7 +68,7 @@ TEST(SimulateCli, KittiTrajectoryWithPerSequenceCalibList) {
   const auto poses = shared_file("data/kitti/poses/04.txt");
   const auto calib = shared_file("data/kitti/calib_velo_to_cam.txt");
   std::string output;
-  ASSERT_EQ(run_command(simulate(seq, "--trajectory " + q(poses) + " --calib " + q(calib) + " --frames 0:2"), &output), 0)
+  ASSERT_EQ(run_command(simulate(seq, "--trajectory " + quoted(poses) + " --calib " + quoted(calib) + " --frames 0:2"), &output), 0)
       << output;
   // The sequence number comes from the pose file's name: Tr of line 04.
   const SequenceReader reader(seq);
@@ -81,7 +76,7 @@ TEST(SimulateCli, KittiTrajectoryWithPerSequenceCalibList) {
   EXPECT_FALSE(reader.velo_to_cam().isApprox(read_velo_to_cam(calib, 0), 1e-6));
   // A KITTI calib.txt (with a Tr: line) works as well: use the one just written.
   const fs::path seq2 = dir / "seq2";
-  ASSERT_EQ(run_command(simulate(seq2, "--trajectory " + q(poses) + " --calib " + q(seq / "calib.txt") + " --frames 0:1"),
+  ASSERT_EQ(run_command(simulate(seq2, "--trajectory " + quoted(poses) + " --calib " + quoted(seq / "calib.txt") + " --frames 0:1"),
                         &output),
             0)
       << output;
@@ -105,15 +100,15 @@ TEST(SimulateCli, BadOptionsGiveClearErrors) {
   EXPECT_NE(run_command(simulate(dir / "b", "--frames 99999:100000"), &output), 0);
   EXPECT_NE(output.find("selects nothing"), std::string::npos) << output;
   const auto poses = shared_file("data/kitti/poses/00.txt");
-  EXPECT_NE(run_command(simulate(dir / "c", "--trajectory " + q(poses)), &output), 0);
+  EXPECT_NE(run_command(simulate(dir / "c", "--trajectory " + quoted(poses)), &output), 0);
   EXPECT_NE(output.find("--calib"), std::string::npos) << output;
   EXPECT_NE(run_command(simulate(dir / "d", "--preset nowhere"), &output), 0);
   EXPECT_NE(run_command(simulate(dir / "e", "--labels maybe"), &output), 0);
   // A calibration list without a line for the pose file's sequence.
   const fs::path renamed = dir / "42.txt";
   fs::copy_file(poses, renamed);
-  EXPECT_NE(run_command(simulate(dir / "f", "--trajectory " + q(renamed) + " --calib " +
-                                             q(shared_file("data/kitti/calib_velo_to_cam.txt"))),
+  EXPECT_NE(run_command(simulate(dir / "f", "--trajectory " + quoted(renamed) + " --calib " +
+                                             quoted(shared_file("data/kitti/calib_velo_to_cam.txt"))),
                         &output),
             0);
   EXPECT_NE(output.find("42"), std::string::npos) << output;
@@ -124,11 +119,11 @@ TEST(RenderCli, WritesMapAndRangeImage) {
   const fs::path seq = dir / "seq";
   std::string output;
   ASSERT_EQ(run_command(simulate(seq, "--frames 0:3"), &output), 0) << output;
-  ASSERT_EQ(run_command(q(cli_path()) + " render " + q(seq) + " --out " + q(dir / "png") + " --frame 2", &output), 0)
+  ASSERT_EQ(run_command(quoted(cli_path()) + " render " + quoted(seq) + " --out " + quoted(dir / "png") + " --frame 2", &output), 0)
       << output;
   EXPECT_GT(fs::file_size(dir / "png" / "map.png"), 5000u);
   EXPECT_GT(fs::file_size(dir / "png" / "range_000002.png"), 2000u);
-  EXPECT_NE(run_command(q(cli_path()) + " render " + q(seq) + " --out " + q(dir / "png") + " --frame 7", &output), 0);
+  EXPECT_NE(run_command(quoted(cli_path()) + " render " + quoted(seq) + " --out " + quoted(dir / "png") + " --frame 7", &output), 0);
   EXPECT_NE(output.find("out of range"), std::string::npos) << output;
 }
 
