@@ -73,7 +73,7 @@ void BM_LocalMapUpdate(benchmark::State& state) {
     f.planars = voxel_downsample(f.planars, sizes);
     features.push_back(std::move(f));
   }
-  SemanticLocalMap map(config.local_map_frames, sizes);
+  SemanticLocalMap map(config.local_map_frames, sizes, config.max_correspondence_distance);
   // Fill the map with 20 frames (shifted copies) before timing.
   for (int k = 0; k < config.local_map_frames; ++k) {
     auto f = features[k % features.size()];
@@ -108,15 +108,17 @@ struct PointStore {
 std::vector<Eigen::Vector3d> random_frame(std::mt19937& rng, int k) {
   std::uniform_real_distribution<double> u(-40.0, 40.0);
   std::vector<Eigen::Vector3d> f(2000);
-  for (auto& p : f) p = Eigen::Vector3d(u(rng) + 0.7 * k, u(rng), 0.05 * u(rng));
+  for (auto& p : f) p = Eigen::Vector3d(u(rng) + 0.7 * k, u(rng), 0.005 * u(rng));  // a 0.4 m thick slab
   return f;
 }
-void run_queries(benchmark::State& state, const auto& tree, std::mt19937& rng) {
+// Queries spread over the current window (frames move 0.7 m along x each).
+void run_queries(benchmark::State& state, const auto& tree, std::mt19937& rng, int frame) {
   std::uniform_real_distribution<double> u(-40.0, 40.0);
+  const double x0 = 0.7 * (frame - 10);
   std::uint32_t idx[5];
   double d2[5];
   for (int q = 0; q < 6000; ++q) {
-    const Eigen::Vector3d p(u(rng), u(rng), 0.0);
+    const Eigen::Vector3d p(x0 + u(rng), u(rng), 0.0);
     nanoflann::KNNResultSet<double, std::uint32_t> result(5);
     result.init(idx, d2);
     tree.findNeighbors(result, p.data(), nanoflann::SearchParams());
@@ -138,7 +140,7 @@ void BM_MapTreeRebuild(benchmark::State& state) {
     nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, PointStore>, PointStore, 3, std::uint32_t>
         tree(3, store, nanoflann::KDTreeSingleIndexAdaptorParams(10));
     tree.buildIndex();
-    run_queries(state, tree, rng);
+    run_queries(state, tree, rng, k);
   }
 }
 BENCHMARK(BM_MapTreeRebuild)->Unit(benchmark::kMillisecond);
@@ -163,10 +165,40 @@ void BM_MapTreeDynamic(benchmark::State& state) {
     const auto start = static_cast<std::uint32_t>(store.pts.size());
     store.pts.insert(store.pts.end(), f.begin(), f.end());
     tree.addPoints(start, static_cast<std::uint32_t>(store.pts.size() - 1));
-    run_queries(state, tree, rng);
+    run_queries(state, tree, rng, k);
   }
 }
 BENCHMARK(BM_MapTreeDynamic)->Unit(benchmark::kMillisecond);
+// The structure the local map uses: points hashed into 1 m cells, updated
+// point by point (insert the new frame, erase the oldest), 5-NN within 1 m.
+void BM_NeighbourGrid(benchmark::State& state) {
+  std::mt19937 rng(1);
+  std::deque<std::vector<Eigen::Vector3d>> frames;
+  NeighbourGrid grid(1.0);
+  int k = 0;
+  for (; k < 20; ++k) {
+    frames.push_back(random_frame(rng, k));
+    for (const auto& p : frames.back()) grid.insert(p, 0);
+  }
+  std::uniform_real_distribution<double> u(-40.0, 40.0);
+  std::array<Eigen::Vector3d, 5> nb;
+  std::array<double, 5> d2{};
+  std::size_t found = 0;
+  for (auto _ : state) {
+    for (const auto& p : frames.front()) grid.erase(p, 0);
+    frames.pop_front();
+    frames.push_back(random_frame(rng, k++));
+    for (const auto& p : frames.back()) grid.insert(p, 0);
+    const double x0 = 0.7 * (k - 10);
+    for (int q = 0; q < 6000; ++q) {
+      const Eigen::Vector3d p(x0 + u(rng), u(rng), 0.0);
+      found += static_cast<std::size_t>(grid.nearest(p, 0, 5, 1.0, nb.data(), d2.data()) == 5);
+      benchmark::DoNotOptimize(d2[0]);
+    }
+  }
+  state.counters["found_5_within_1m"] = static_cast<double>(found) / (6000.0 * static_cast<double>(state.iterations()));
+}
+BENCHMARK(BM_NeighbourGrid)->Unit(benchmark::kMillisecond);
 
 // The whole pipeline per frame (features, de-skew, registration, map
 // update) over the six real scans, fresh pipeline each pass (so the local map

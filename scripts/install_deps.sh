@@ -8,6 +8,7 @@ packages=(
   libeigen3-dev libceres-dev libnanoflann-dev libtbb-dev
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libcairo2-dev libgtest-dev libgmock-dev libbenchmark-dev
+  robin-map-dev
 )
 
 missing=()

@@ -104,32 +104,6 @@ TEST(ResidualJacobians, UpdateStaysOnTheManifold) {
   EXPECT_NEAR(T.linear().determinant(), 1.0, 1e-12);
 }
 
-TEST(VoxelDownsample, ClassesKeepTheirOwnVoxels) {
-  FeatureCloud cloud;
-  for (int i = 0; i < 100; ++i) {
-    cloud.push_back(Eigen::Vector3d(0.01 * i, 0, 0), 1, 0.0f);  // 1 m of class 1
-    cloud.push_back(Eigen::Vector3d(0.01 * i, 0, 0), 2, 0.0f);  // same points, class 2
-  }
-  ClassVoxelSizes sizes{};
-  sizes.fill(1.0);
-  sizes[2] = 0.1;
-  const auto down = voxel_downsample(cloud, sizes);
-  int n1 = 0, n2 = 0;
-  for (auto c : down.classes) (c == 1 ? n1 : n2)++;
-  EXPECT_EQ(n1, 1);
-  EXPECT_EQ(n2, 10);
-}
-
-TEST(VoxelDownsample, SemanticSizesFineForSmallObjects) {
-  OdometryConfig config;
-  const auto sizes = class_voxel_sizes(config);
-  EXPECT_LT(sizes[to_learning_class(cls::kPole)], sizes[to_learning_class(cls::kRoad)]);
-  EXPECT_LT(sizes[to_learning_class(cls::kTrafficSign)], sizes[to_learning_class(cls::kBuilding)]);
-  config.use_semantics = false;
-  const auto plain = class_voxel_sizes(config);
-  for (double s : plain) EXPECT_EQ(s, config.voxel_size);
-}
-
 // A structured scene as features: ground, walls, poles, with classes.
 ScanFeatures scene(std::mt19937& rng) {
   ScanFeatures f;
@@ -151,7 +125,7 @@ TEST(Registration, RecoversKnownTransformOfItself) {
   std::mt19937 rng(3);
   const ScanFeatures f = scene(rng);
   OdometryConfig config;
-  SemanticLocalMap map(20, class_voxel_sizes(config));
+  SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
   map.add_frame(f.edges, f.planars);
   Vector6d xi;
   xi << 0.4, -0.3, 0.05, 0.01, -0.01, 0.05;  // 0.5 m, ~3 deg
@@ -194,7 +168,7 @@ TEST(Registration, ConvergesAsWellFarFromTheOrigin) {
     ScanFeatures world = local;
     for (auto& p : world.edges.points) p = place * p;
     for (auto& p : world.planars.points) p = place * p;
-    SemanticLocalMap map(20, class_voxel_sizes(config));
+    SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
     map.add_frame(world.edges, world.planars);
     // The sensor sits at place * motion; the registration starts at `place`.
     const Pose truth = place * motion;
@@ -220,7 +194,7 @@ TEST(Registration, PlaneConstraintRejectsMislabelledPlanes) {
     for (int j = 0; j < 20; ++j) wall.push_back({10.0, -2.0 + 0.2 * i, -1.0 + 0.2 * j}, road, 0.0f);
   }
   OdometryConfig config;
-  SemanticLocalMap map(20, class_voxel_sizes(config));
+  SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
   map.add_frame(FeatureCloud{}, wall);
   auto settings = RegistrationSettings::from_config(config);
   auto result = register_scan(FeatureCloud{}, wall, map, Pose::Identity(), settings);
@@ -231,6 +205,61 @@ TEST(Registration, PlaneConstraintRejectsMislabelledPlanes) {
   result = register_scan(FeatureCloud{}, wall, map, Pose::Identity(), settings);
   EXPECT_EQ(result.rejected_by_constraint, 0);
   EXPECT_GT(result.planar_matches, 0);
+}
+
+TEST(Registration, RefreshedFeaturesAreReassociated) {
+  // The scan starts distorted (as if de-skewed with a wrong motion: every
+  // point 0.2 m off); the refresh hook replaces it with the true scan after
+  // the first round. Re-association thresholds are huge, so only the refresh
+  // can cause a second round.
+  std::mt19937 rng(7);
+  const ScanFeatures f = scene(rng);
+  OdometryConfig config;
+  SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
+  map.add_frame(f.edges, f.planars);
+  Vector6d xi;
+  xi << 0.3, -0.2, 0.02, 0.0, 0.01, 0.03;
+  const Pose truth = se3_exp(xi);
+  ScanFeatures correct = f;
+  for (auto& p : correct.edges.points) p = truth.inverse() * p;
+  for (auto& p : correct.planars.points) p = truth.inverse() * p;
+  ScanFeatures distorted = correct;
+  for (auto& p : distorted.edges.points) p.x() += 0.2;
+  for (auto& p : distorted.planars.points) p.x() += 0.2;
+  auto settings = RegistrationSettings::from_config(config);
+  settings.outer_iterations = 3;
+  settings.reassociation_min_translation = 10.0;
+  settings.reassociation_min_rotation = 1.0;
+
+  ScanFeatures scan = distorted;
+  int calls = 0;
+  const auto refreshed = register_scan(scan, map, Pose::Identity(), settings, [&](const Pose&, ScanFeatures& s) {
+    ++calls;
+    if (calls > 1) return false;
+    s = correct;
+    return true;
+  });
+  ASSERT_TRUE(refreshed.ok);
+  EXPECT_EQ(calls, 2);  // after round 1 (refreshed) and round 2 (not: the small move ends it)
+  EXPECT_EQ(refreshed.associations, 2);
+  const Pose err = truth.inverse() * refreshed.pose;
+  EXPECT_LT(err.translation().norm(), 2e-3);
+  EXPECT_LT(rotation_angle(err), 5e-4);
+
+  // Without the refresh the distorted scan stays 0.2 m off after one round.
+  const auto plain = register_scan(distorted.edges, distorted.planars, map, Pose::Identity(), settings);
+  ASSERT_TRUE(plain.ok);
+  EXPECT_EQ(plain.associations, 1);
+  EXPECT_GT((truth.inverse() * plain.pose).translation().norm(), 0.1);
+
+  // A refresh may move points but not add or drop any.
+  scan = distorted;
+  EXPECT_THROW(register_scan(scan, map, Pose::Identity(), settings,
+                             [](const Pose&, ScanFeatures& s) {
+                               s.planars.push_back(Eigen::Vector3d::Zero(), 0, 0.0f);
+                               return true;
+                             }),
+               std::logic_error);
 }
 
 }  // namespace

@@ -10,6 +10,11 @@ namespace saloam {
 
 namespace {
 using Clock = std::chrono::steady_clock;
+// A registered sweep motion that differs from the one the scan was de-skewed
+// with by more than this moves points by more than ~1 cm: de-skew again.
+constexpr double kRedeskewTranslation = 0.01;           // [m per frame]
+constexpr double kRedeskewRotation = 0.1 * M_PI / 180;  // [rad per frame]
+
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -25,7 +30,7 @@ OdometryPipeline::OdometryPipeline(OdometryConfig config)
     : config_(std::move(config)),
       settings_(RegistrationSettings::from_config(config_)),
       voxel_sizes_(class_voxel_sizes(config_)),
-      map_(config_.local_map_frames, voxel_sizes_) {
+      map_(config_.local_map_frames, voxel_sizes_, config_.max_correspondence_distance) {
   if (config_.threads != 1) {
     const int threads = config_.threads > 0 ? config_.threads
                                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -76,16 +81,22 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
     motion = scale * se3_log(sweep_poses_[k - 2].inverse() * sweep_poses_[k - 1]);
     prediction = orthonormalized(sweep_poses_.back() * se3_exp(motion));
   }
-  // Raw features are kept to de-skew again with the motion this frame's
-  // registration finds (and, for the first two frames, once any is known).
-  ScanFeatures raw;
-  if (deskewing) raw = features;
-  if (deskewing && k >= 2) {
-    deskew(features.edges, motion, period, reference_time);
-    deskew(features.planars, motion, period, reference_time);
-  }
+  // Features are downsampled as measured and de-skewed afterwards, so that
+  // de-skewing again (below) moves the same points. The raw (distorted)
+  // features are kept for that, and for the first two frames, which are
+  // de-skewed only once a motion is known.
   features.edges = voxel_downsample(features.edges, voxel_sizes_);
   features.planars = voxel_downsample(features.planars, voxel_sizes_);
+  ScanFeatures raw;
+  if (deskewing) raw = features;
+  auto deskewed = [&](const ScanFeatures& scan, const Vector6d& frame_motion) {
+    ScanFeatures out = scan;
+    deskew(out.edges, frame_motion, period, reference_time);
+    deskew(out.planars, frame_motion, period, reference_time);
+    return out;
+  };
+  Vector6d deskew_motion = motion;
+  if (deskewing && k >= 2) features = deskewed(raw, deskew_motion);
   timing.deskew_downsample_ms = ms_since(t0);
 
   t0 = Clock::now();
@@ -93,43 +104,42 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
   last_stats_.edge_features = features.edges.size();
   last_stats_.planar_features = features.planars.size();
   Pose pose = prediction;
+  // The motion during this sweep is better known from the registration's
+  // current estimate than from the previous frame (which lags when the turn
+  // rate changes): between rounds, when the two differ, the scan is de-skewed
+  // again with the estimate. Without this the loop velocity -> de-skew -> pose
+  // builds up errors in turns.
+  FeatureRefresh refresh;
+  if (deskewing && k >= 2) {
+    refresh = [&](const Pose& current, ScanFeatures& scan) {
+      const Vector6d estimated = se3_log(sweep_poses_[k - 1].inverse() * current);
+      const Vector6d change = estimated - deskew_motion;
+      if (change.head<3>().norm() <= kRedeskewTranslation && change.tail<3>().norm() <= kRedeskewRotation) {
+        return false;
+      }
+      deskew_motion = estimated;
+      scan = deskewed(raw, deskew_motion);
+      return true;
+    };
+  }
+  auto register_features = [&](const Pose& initial) {
+    RegistrationResult result = register_scan(features, map_, initial, settings_, refresh);
+    last_stats_.association_rounds += result.associations;
+    return result;
+  };
   if (!map_.empty()) {
-    last_stats_.registration = register_scan(features.edges, features.planars, map_, prediction, settings_);
+    last_stats_.registration = register_features(prediction);
     pose = last_stats_.registration.pose;
     if (deskewing && k == 1 && last_stats_.registration.ok) {
       // Bootstrap: de-skew the first two frames with the motion just
       // estimated, rebuild the map from the first and register again.
       const Vector6d first_motion = se3_log(sweep_poses_[0].inverse() * pose);
-      ScanFeatures first = first_raw_;
-      deskew(first.edges, first_motion, period, reference_time);
-      deskew(first.planars, first_motion, period, reference_time);
-      map_ = SemanticLocalMap(config_.local_map_frames, voxel_sizes_);
-      map_.add_frame(transformed(voxel_downsample(first.edges, voxel_sizes_), sweep_poses_[0]),
-                     transformed(voxel_downsample(first.planars, voxel_sizes_), sweep_poses_[0]), settings_.parallel);
-      deskew(raw.edges, first_motion, period, reference_time);
-      deskew(raw.planars, first_motion, period, reference_time);
-      features.edges = voxel_downsample(raw.edges, voxel_sizes_);
-      features.planars = voxel_downsample(raw.planars, voxel_sizes_);
-      last_stats_.registration = register_scan(features.edges, features.planars, map_, pose, settings_);
+      const ScanFeatures first = deskewed(first_raw_, first_motion);
+      map_ = SemanticLocalMap(config_.local_map_frames, voxel_sizes_, config_.max_correspondence_distance);
+      map_.add_frame(transformed(first.edges, sweep_poses_[0]), transformed(first.planars, sweep_poses_[0]));
+      features = deskewed(raw, first_motion);
+      last_stats_.registration = register_features(pose);
       pose = last_stats_.registration.pose;
-    } else if (deskewing && k >= 2 && last_stats_.registration.ok) {
-      // The motion during this sweep is better known after registration than
-      // from the previous frame (which lags when the turn rate changes): if
-      // they differ, de-skew again with the estimate and refine. Without this
-      // the loop velocity -> de-skew -> pose can build up errors in turns.
-      const Vector6d estimated = se3_log(sweep_poses_[k - 1].inverse() * pose);
-      const Vector6d change = estimated - motion;
-      if (change.head<3>().norm() > 0.01 || change.tail<3>().norm() > 0.1 * M_PI / 180.0) {
-        deskew(raw.edges, estimated, period, reference_time);
-        deskew(raw.planars, estimated, period, reference_time);
-        features.edges = voxel_downsample(raw.edges, voxel_sizes_);
-        features.planars = voxel_downsample(raw.planars, voxel_sizes_);
-        const auto refined = register_scan(features.edges, features.planars, map_, pose, settings_);
-        if (refined.ok) {
-          last_stats_.registration = refined;
-          pose = refined.pose;
-        }
-      }
     }
   }
   if (deskewing && k == 0) first_raw_ = std::move(raw);
@@ -140,8 +150,10 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
   t0 = Clock::now();
   last_world_.edges = transformed(features.edges, pose);
   last_world_.planars = transformed(features.planars, pose);
-  map_.add_frame(last_world_.edges, last_world_.planars, settings_.parallel);
+  map_.add_frame(last_world_.edges, last_world_.planars);
   timing.map_update_ms = ms_since(t0);
+  last_stats_.map_edge_points = map_.num_edge_points();
+  last_stats_.map_planar_points = map_.num_planar_points();
 
   sweep_poses_.push_back(pose);
   timestamps_.push_back(timestamp);

@@ -31,7 +31,10 @@ struct FrameTimings {
 struct FrameStats {
   std::size_t edge_features = 0;    ///< after downsampling
   std::size_t planar_features = 0;  ///< after downsampling
-  RegistrationResult registration;
+  RegistrationResult registration;  ///< the final registration of the frame
+  int association_rounds = 0;       ///< over all registrations of the frame (refinements included)
+  std::size_t map_edge_points = 0;    ///< local map after the update
+  std::size_t map_planar_points = 0;  ///< local map after the update
 };
 
 class OdometryPipeline {

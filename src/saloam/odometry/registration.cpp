@@ -1,6 +1,7 @@
 #include "saloam/odometry/registration.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include <Eigen/Cholesky>
 #include <tbb/parallel_for.h>
@@ -55,18 +56,12 @@ void for_each_index(std::size_t n, bool parallel, Body&& body) {
   }
 }
 
-// Gathers the k nearest neighbours of q in a class submap; false if too few
-// or the farthest is beyond the correspondence distance.
-bool gather(const ClassSubmap& submap, const Eigen::Vector3d& q, int k, double max_distance,
+// Gathers the k nearest neighbours of q among the map points of class c;
+// false unless all k lie within the correspondence distance.
+bool gather(const NeighbourGrid& grid, const Eigen::Vector3d& q, ClassIndex c, int k, double max_distance,
             std::array<Eigen::Vector3d, kMaxNeighbours>& out) {
-  std::array<std::uint32_t, kMaxNeighbours> idx{};
   std::array<double, kMaxNeighbours> d2{};
-  const int kk = std::min(k, kMaxNeighbours);
-  if (submap.size() < static_cast<std::size_t>(kk)) return false;
-  const std::size_t found = submap.nearest(q, static_cast<std::size_t>(kk), idx.data(), d2.data());
-  if (found < static_cast<std::size_t>(kk) || d2[kk - 1] > max_distance * max_distance) return false;
-  for (int i = 0; i < kk; ++i) out[i] = submap.points()[idx[i]];
-  return true;
+  return grid.nearest(q, c, k, max_distance, out.data(), d2.data()) == k;
 }
 
 double huber_weight(double r, double k) {
@@ -74,11 +69,9 @@ double huber_weight(double r, double k) {
   return a <= k ? 1.0 : k / a;
 }
 
-}  // namespace
-
-RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& planars,
-                                 const SemanticLocalMap& map, const Pose& initial,
-                                 const RegistrationSettings& settings) {
+RegistrationResult register_features(const FeatureCloud& edges, const FeatureCloud& planars,
+                                     const SemanticLocalMap& map, const Pose& initial,
+                                     const RegistrationSettings& settings, const std::function<bool(const Pose&)>& refresh) {
   RegistrationResult result;
   result.pose = initial;
   Pose T = initial;
@@ -89,12 +82,13 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
 
   for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
     const Pose outer_start = T;
+    ++result.associations;
     // Association at the current pose (the expensive part: kd-tree queries and fits).
     for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
       std::array<Eigen::Vector3d, kMaxNeighbours> nb;
       EdgeMatch m;
       const Eigen::Vector3d q = T * edges.points[i];
-      if (gather(map.edges(edges.classes[i]), q, ne, settings.max_correspondence_distance, nb)) {
+      if (gather(map.edges(), q, edges.classes[i], ne, settings.max_correspondence_distance, nb)) {
         if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
           m.line = *line;
           m.valid = true;
@@ -107,7 +101,7 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
       PlaneMatch m;
       const Eigen::Vector3d q = T * planars.points[i];
       const ClassIndex c = planars.classes[i];
-      if (gather(map.planars(c), q, np, settings.max_correspondence_distance, nb)) {
+      if (gather(map.planars(), q, c, np, settings.max_correspondence_distance, nb)) {
         if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
           if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.sigma)) {
             m.plane = *plane;
@@ -158,10 +152,12 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
       ++result.iterations;
       if (delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6) break;  // converged
     }
-    // Re-associating only pays when the pose moved: a shift well below the map
-    // resolution leaves the neighbour sets (nearly) unchanged.
+    if (outer + 1 >= settings.outer_iterations) break;
+    const bool refreshed = refresh && refresh(T);
+    // Re-associating only pays when the pose or the points moved: a shift
+    // well below the map resolution leaves the neighbour sets (nearly) unchanged.
     const Pose moved = outer_start.inverse() * T;
-    if (moved.translation().norm() < settings.reassociation_min_translation &&
+    if (!refreshed && moved.translation().norm() < settings.reassociation_min_translation &&
         rotation_angle(moved) < settings.reassociation_min_rotation) {
       break;
     }
@@ -169,6 +165,30 @@ RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& 
   result.pose = T;
   result.ok = true;
   return result;
+}
+
+}  // namespace
+
+RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& planars,
+                                 const SemanticLocalMap& map, const Pose& initial,
+                                 const RegistrationSettings& settings) {
+  return register_features(edges, planars, map, initial, settings, {});
+}
+
+RegistrationResult register_scan(ScanFeatures& scan, const SemanticLocalMap& map, const Pose& initial,
+                                 const RegistrationSettings& settings, const FeatureRefresh& refresh) {
+  std::function<bool(const Pose&)> hook;
+  if (refresh) {
+    hook = [&](const Pose& pose) {
+      const std::size_t edges = scan.edges.size(), planars = scan.planars.size();
+      const bool changed = refresh(pose, scan);
+      if (scan.edges.size() != edges || scan.planars.size() != planars) {
+        throw std::logic_error("register_scan: a feature refresh must keep the number of points");
+      }
+      return changed;
+    };
+  }
+  return register_features(scan.edges, scan.planars, map, initial, settings, hook);
 }
 
 }  // namespace saloam

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
@@ -42,6 +43,7 @@ struct RegistrationResult {
   int planar_matches = 0;
   int rejected_by_constraint = 0;  ///< planes dropped by the semantic plane constraint
   int iterations = 0;
+  int associations = 0;  ///< association rounds (neighbour search and fit for every feature)
   bool ok = false;  ///< false: too few correspondences, pose = initial guess
 };
 
@@ -49,5 +51,15 @@ struct RegistrationResult {
 RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& planars,
                                  const SemanticLocalMap& map, const Pose& initial,
                                  const RegistrationSettings& settings);
+
+/// Called between outer rounds with the current pose: may move the scan's
+/// points (keeping their number and order), e.g. de-skew them again with the
+/// motion that the pose implies; returns whether it did. A refreshed scan is
+/// always re-associated, however little the pose moved.
+using FeatureRefresh = std::function<bool(const Pose& pose, ScanFeatures& scan)>;
+
+/// As above, with `refresh` run before every re-association.
+RegistrationResult register_scan(ScanFeatures& scan, const SemanticLocalMap& map, const Pose& initial,
+                                 const RegistrationSettings& settings, const FeatureRefresh& refresh);
 
 }  // namespace saloam
