@@ -1,5 +1,6 @@
 // Odometry speed on the real KITTI scans (shared/data/kitti/scans_00):
-// feature extraction, local-map update (rebuild of the per-class kd-trees),
+// feature extraction, local-map update (incremental neighbour grid; kd-tree
+// rebuild and nanoflann's dynamic index for comparison),
 // registration and the whole pipeline per frame, single-threaded unless
 // stated. Peak memory is reported as a counter (max RSS, getrusage).
 
@@ -62,7 +63,7 @@ void BM_ExtractFeatures(benchmark::State& state) {
 }
 BENCHMARK(BM_ExtractFeatures)->Unit(benchmark::kMillisecond);
 
-// Local map of N_m = 20 frames: voxel downsampling of all frames + kd-tree rebuild.
+// Local map of N_m = 20 frames: adding one frame (and dropping the oldest).
 void BM_LocalMapUpdate(benchmark::State& state) {
   const auto config = kitti_config();
   const auto sizes = class_voxel_sizes(config);
@@ -93,11 +94,12 @@ void BM_LocalMapUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_LocalMapUpdate)->Unit(benchmark::kMillisecond);
 
-// Rebuild vs incremental kd-tree for the local map: a map of 20 frames of
+// Local-map neighbour search, three ways: a map of 20 frames of
 // ~2000 planar points; per frame one frame is added and the oldest removed,
 // then 6000 5-NN queries (the registration's load for one outer iteration).
-// Static: rebuild the tree from scratch each frame. Dynamic: nanoflann's
-// KDTreeSingleIndexDynamicAdaptor (addPoints, lazy removePoint, log(n) trees).
+// Static: rebuild a nanoflann kd-tree from scratch each frame. Dynamic:
+// nanoflann's KDTreeSingleIndexDynamicAdaptor (addPoints, lazy removePoint,
+// log(n) trees). Grid: the NeighbourGrid the local map uses (below).
 struct PointStore {
   std::vector<Eigen::Vector3d> pts;
   [[nodiscard]] std::size_t kdtree_get_point_count() const { return pts.size(); }

@@ -83,7 +83,7 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
     const Pose outer_start = T;
     ++result.associations;
-    // Association at the current pose (the expensive part: kd-tree queries and fits).
+    // Association at the current pose (the expensive part: neighbour queries and fits).
     for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
       std::array<Eigen::Vector3d, kMaxNeighbours> nb;
       EdgeMatch m;
