@@ -121,19 +121,32 @@ ScanFeatures scene(std::mt19937& rng) {
   return f;
 }
 
+// The features as a sensor at `sensor` (T_world<-sensor) measures them.
+ScanFeatures seen_from(const ScanFeatures& world, const Pose& sensor) {
+  ScanFeatures scan = world;
+  for (auto& p : scan.edges.points) p = sensor.inverse() * p;
+  for (auto& p : scan.planars.points) p = sensor.inverse() * p;
+  return scan;
+}
+
+// A local map holding one frame of world features, with the default config.
+SemanticLocalMap map_of(const FeatureCloud& edges, const FeatureCloud& planars) {
+  const OdometryConfig config;
+  SemanticLocalMap map(config.local_map_frames, class_voxel_sizes(config), config.max_correspondence_distance);
+  map.add_frame(edges, planars);
+  return map;
+}
+
 TEST(Registration, RecoversKnownTransformOfItself) {
   std::mt19937 rng(3);
   const ScanFeatures f = scene(rng);
   OdometryConfig config;
-  SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
-  map.add_frame(f.edges, f.planars);
+  const SemanticLocalMap map = map_of(f.edges, f.planars);
   Vector6d xi;
   xi << 0.4, -0.3, 0.05, 0.01, -0.01, 0.05;  // 0.5 m, ~3 deg
   const Pose truth = se3_exp(xi);
   // The scan is the scene seen from pose `truth`: p_scan = truth^-1 p_world.
-  ScanFeatures scan = f;
-  for (auto& p : scan.edges.points) p = truth.inverse() * p;
-  for (auto& p : scan.planars.points) p = truth.inverse() * p;
+  const ScanFeatures scan = seen_from(f, truth);
   for (bool semantics : {true, false}) {
     config.use_semantics = semantics;
     const auto settings = RegistrationSettings::from_config(config);
@@ -168,13 +181,10 @@ TEST(Registration, ConvergesAsWellFarFromTheOrigin) {
     ScanFeatures world = local;
     for (auto& p : world.edges.points) p = place * p;
     for (auto& p : world.planars.points) p = place * p;
-    SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
-    map.add_frame(world.edges, world.planars);
+    const SemanticLocalMap map = map_of(world.edges, world.planars);
     // The sensor sits at place * motion; the registration starts at `place`.
     const Pose truth = place * motion;
-    ScanFeatures scan = world;
-    for (auto& p : scan.edges.points) p = truth.inverse() * p;
-    for (auto& p : scan.planars.points) p = truth.inverse() * p;
+    const ScanFeatures scan = seen_from(world, truth);
     const auto result = register_scan(scan.edges, scan.planars, map, place, settings);
     ASSERT_TRUE(result.ok) << "distance " << distance;
     const Pose err = truth.inverse() * result.pose;
@@ -194,8 +204,7 @@ TEST(Registration, PlaneConstraintRejectsMislabelledPlanes) {
     for (int j = 0; j < 20; ++j) wall.push_back({10.0, -2.0 + 0.2 * i, -1.0 + 0.2 * j}, road, 0.0f);
   }
   OdometryConfig config;
-  SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
-  map.add_frame(FeatureCloud{}, wall);
+  const SemanticLocalMap map = map_of(FeatureCloud{}, wall);
   auto settings = RegistrationSettings::from_config(config);
   auto result = register_scan(FeatureCloud{}, wall, map, Pose::Identity(), settings);
   EXPECT_EQ(result.planar_matches, 0);
@@ -215,14 +224,11 @@ TEST(Registration, RefreshedFeaturesAreReassociated) {
   std::mt19937 rng(7);
   const ScanFeatures f = scene(rng);
   OdometryConfig config;
-  SemanticLocalMap map(20, class_voxel_sizes(config), config.max_correspondence_distance);
-  map.add_frame(f.edges, f.planars);
+  const SemanticLocalMap map = map_of(f.edges, f.planars);
   Vector6d xi;
   xi << 0.3, -0.2, 0.02, 0.0, 0.01, 0.03;
   const Pose truth = se3_exp(xi);
-  ScanFeatures correct = f;
-  for (auto& p : correct.edges.points) p = truth.inverse() * p;
-  for (auto& p : correct.planars.points) p = truth.inverse() * p;
+  const ScanFeatures correct = seen_from(f, truth);
   ScanFeatures distorted = correct;
   for (auto& p : distorted.edges.points) p.x() += 0.2;
   for (auto& p : distorted.planars.points) p.x() += 0.2;
