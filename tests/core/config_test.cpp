@@ -49,6 +49,15 @@ TEST(Config, ShippedFileHoldsTheDefaults) {
       << "regenerate it with: build/saloam config > config/saloam.yaml";
 }
 
+// config/real_kitti.yaml changes only the pose instant (real KITTI: mid-sweep).
+TEST(Config, ShippedRealKittiFileSetsMidSweepPoses) {
+  const auto loaded = load_config(testing::source_dir() / "config" / "real_kitti.yaml");
+  EXPECT_DOUBLE_EQ(loaded.odometry.features.pose_time_in_sweep, 0.05);
+  SaloamConfig expected;
+  expected.odometry.features.pose_time_in_sweep = 0.05;
+  EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));
+}
+
 TEST(Config, OverridesByShortAndLongName) {
   SaloamConfig c;
   apply_config_override(c, "alpha=0.3");
