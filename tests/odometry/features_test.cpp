@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/odometry/features.hpp"
 
@@ -140,6 +142,19 @@ TEST(FeatureSelection, EdgesAtCornerPlanarsOnWallsWithLimits) {
   EXPECT_TRUE(select_ring_features(ring, c, unreliable, config).edges.empty());
 }
 
+TEST(FeatureSelection, PointsMarkedNotEdgeMayStillBePlanar) {
+  const auto ring = corner_ring();
+  const auto c = ring_roughness(ring, 5);
+  const std::vector<bool> unreliable(ring.size(), false);
+  FeatureConfig config;
+  config.num_sectors = 1;
+  config.edges_per_sector = 2;
+  config.planars_per_sector = 4;
+  const auto sel = select_ring_features(ring, c, unreliable, config, std::vector<bool>(ring.size(), true));
+  EXPECT_TRUE(sel.edges.empty());
+  EXPECT_EQ(sel.planars.size(), 4u);
+}
+
 TEST(FeatureSelection, PerSectorLimits) {
   std::vector<Eigen::Vector3d> ring;
   for (int i = 0; i < 600; ++i) ring.emplace_back(10.0, -30.0 + 0.1 * i, 0.0);
@@ -228,6 +243,16 @@ TEST(ExtractFeatures, LabelledScanDropsDynamicClassesUnlabeledKeepsOneClass) {
   for (const auto& p : labelled.planars.points) {
     EXPECT_FALSE(p.x() > 4.9 && p.x() < 5.1 && std::abs(p.y()) < 1.0 && p.z() > -1.65);
   }
+
+  // By default the road gives planars only (LeGO-LOAM style); the walls'
+  // corners remain edges. With ground_edges the road gives edges too.
+  auto road_edges = [](const ScanFeatures& f) {
+    return std::count(f.edges.classes.begin(), f.edges.classes.end(), odometry_class(cls::kRoad));
+  };
+  EXPECT_EQ(road_edges(labelled), 0);
+  FeatureConfig with_ground_edges = config;
+  with_ground_edges.ground_edges = true;
+  EXPECT_GT(road_edges(extract_features(room_scan(true), with_ground_edges, true)), 0);
 
   const auto unlabelled = extract_features(room_scan(false), config, false);
   ASSERT_GT(unlabelled.planars.size(), 500u);

@@ -34,6 +34,14 @@ struct FeatureConfig {
   int edges_per_sector = 20;    ///< N_e: sharpest points kept as edges per sector
   int planars_per_sector = 50;  ///< N_p: flattest points kept as planars per sector
   int roughness_half_window = 5;  ///< neighbours on each side in Eq. 1 (LOAM uses 5)
+  /// With labels, whether points of ground classes (road, sidewalk, parking,
+  /// terrain, other-ground) may be edge features. Off by default: the ground
+  /// gives only planar features, as in LeGO-LOAM. Rough ground yields "edges"
+  /// that rarely fit a line (60 % of all edges on simulated 00, 40 % of them
+  /// matched) and take the sector slots of real ones. Measured on simulated
+  /// KITTI (1500 frames, noisy labels), t_err on / off: 00 0.134 / 0.142 %,
+  /// 05 0.136 / 0.090 %, 08 0.308 / 0.244 %; 31 -> 35 Hz.
+  bool ground_edges = false;
   double min_range = 2.5;       ///< [m] closer returns are ignored (vehicle body)
   double max_range = 120.0;     ///< [m]
   int num_beams = 0;            ///< 0 = detect 64/32/16 from the data
@@ -124,6 +132,7 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
   v("num_sectors", c.num_sectors, "N_r: sectors per ring");
   v("edges_per_sector", c.edges_per_sector, "N_e: edge features per sector");
   v("planars_per_sector", c.planars_per_sector, "N_p: planar features per sector");
+  v("ground_edges", c.ground_edges, "with labels, ground classes may give edge features");
   v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1");
   v("min_range", c.min_range, "min range [m]");
   v("max_range", c.max_range, "max range [m]");

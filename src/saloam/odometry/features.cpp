@@ -141,7 +141,8 @@ std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, in
 
 RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<double>& roughness,
-                                   const std::vector<bool>& unreliable, const FeatureConfig& config) {
+                                   const std::vector<bool>& unreliable, const FeatureConfig& config,
+                                   const std::vector<bool>& not_edge) {
   RingSelection out;
   const int n = static_cast<int>(ring.size());
   const int w = config.roughness_half_window;
@@ -188,7 +189,7 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
     for (auto it = order.rbegin(); it != order.rend() && picked < config.edges_per_sector; ++it) {
       const int i = index_of(*it);
       if (roughness[i] <= config.alpha) break;
-      if (blocked[i]) continue;
+      if (blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
       out.edges.push_back(i);
       block_neighbours(i);
       ++picked;
@@ -335,12 +336,16 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
     auto unreliable =
         unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
+    std::vector<bool> not_edge;
     if (use_labels) {  // unusable classes must not take a sector's feature slots
+      if (!config.ground_edges) not_edge.assign(bucket.size(), false);
       for (std::size_t k = 0; k < bucket.size(); ++k) {
-        if (odometry_class(cloud.label[bucket[k].index]) < 0) unreliable[k] = true;
+        const std::uint16_t label = cloud.label[bucket[k].index];
+        if (odometry_class(label) < 0) unreliable[k] = true;
+        if (!config.ground_edges && is_ground(static_class(label))) not_edge[k] = true;
       }
     }
-    const auto selection = select_ring_features(ring_points, roughness, unreliable, config);
+    const auto selection = select_ring_features(ring_points, roughness, unreliable, config, not_edge);
     auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
       for (const int k : indices) {
         const auto& e = bucket[k];

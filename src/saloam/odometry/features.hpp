@@ -87,9 +87,11 @@ struct RingSelection {
   std::vector<int> edges;
   std::vector<int> planars;
 };
+/// `not_edge` (empty or one flag per point) marks points that may only be planar.
 RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<double>& roughness,
-                                   const std::vector<bool>& unreliable, const FeatureConfig& config);
+                                   const std::vector<bool>& unreliable, const FeatureConfig& config,
+                                   const std::vector<bool>& not_edge = {});
 
 /// Rings from the storage order (KITTI and the simulator write a scan ring by
 /// ring, each in firing order: a ring ends where the sweep time jumps back).
