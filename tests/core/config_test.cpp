@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "saloam/core/config.hpp"
@@ -56,6 +57,16 @@ TEST(Config, ShippedRealKittiFileSetsMidSweepPoses) {
   SaloamConfig expected;
   expected.odometry.features.pose_time_in_sweep = 0.05;
   EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));
+}
+
+TEST(Config, InfinityRoundTrips) {
+  SaloamConfig c;
+  apply_config_override(c, "odometry.features.ground_edge_alpha=.inf");
+  EXPECT_TRUE(std::isinf(c.odometry.features.ground_edge_alpha));
+  testing::TempDir dir;
+  const auto file = dir.path() / "inf.yaml";
+  std::ofstream(file) << config_to_yaml(c);
+  EXPECT_TRUE(std::isinf(load_config(file).odometry.features.ground_edge_alpha));
 }
 
 TEST(Config, OverridesByShortAndLongName) {

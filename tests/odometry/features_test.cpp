@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/odometry/features.hpp"
@@ -244,15 +245,19 @@ TEST(ExtractFeatures, LabelledScanDropsDynamicClassesUnlabeledKeepsOneClass) {
     EXPECT_FALSE(p.x() > 4.9 && p.x() < 5.1 && std::abs(p.y()) < 1.0 && p.z() > -1.65);
   }
 
-  // By default the road gives planars only (LeGO-LOAM style); the walls'
-  // corners remain edges. With ground_edges the road gives edges too.
+  // ground_edge_alpha: with .inf the road gives planars only (LeGO-LOAM
+  // style) and the walls' corners remain edges; at alpha the road gives edges too.
   auto road_edges = [](const ScanFeatures& f) {
     return std::count(f.edges.classes.begin(), f.edges.classes.end(), odometry_class(cls::kRoad));
   };
-  EXPECT_EQ(road_edges(labelled), 0);
-  FeatureConfig with_ground_edges = config;
-  with_ground_edges.ground_edges = true;
-  EXPECT_GT(road_edges(extract_features(room_scan(true), with_ground_edges, true)), 0);
+  FeatureConfig ground_planar_only = config;
+  ground_planar_only.ground_edge_alpha = std::numeric_limits<double>::infinity();
+  const auto planar_ground = extract_features(room_scan(true), ground_planar_only, true);
+  EXPECT_EQ(road_edges(planar_ground), 0);
+  EXPECT_GT(planar_ground.edges.size(), 10u);
+  FeatureConfig ground_like_others = config;
+  ground_like_others.ground_edge_alpha = config.alpha;
+  EXPECT_GT(road_edges(extract_features(room_scan(true), ground_like_others, true)), 0);
 
   const auto unlabelled = extract_features(room_scan(false), config, false);
   ASSERT_GT(unlabelled.planars.size(), 500u);

@@ -2,6 +2,7 @@
 
 #include <fstream>
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <sstream>
 #include <type_traits>
@@ -63,7 +64,8 @@ YAML::Node to_node(const T& value) {
   if constexpr (std::is_same_v<T, ClassValueMap>) {
     for (const auto& [name, v] : value) n[name] = fmt::format("{}", v);
   } else if constexpr (std::is_floating_point_v<T>) {
-    n = fmt::format("{}", value);  // shortest text that reads back exactly
+    // Shortest text that reads back exactly; YAML spells infinity ".inf".
+    n = std::isinf(value) ? std::string(value > 0 ? ".inf" : "-.inf") : fmt::format("{}", value);
   } else {
     n = value;
   }

@@ -338,11 +338,14 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
         unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
     std::vector<bool> not_edge;
     if (use_labels) {  // unusable classes must not take a sector's feature slots
-      if (!config.ground_edges) not_edge.assign(bucket.size(), false);
+      const bool ground_threshold = config.ground_edge_alpha > config.alpha;
+      if (ground_threshold) not_edge.assign(bucket.size(), false);
       for (std::size_t k = 0; k < bucket.size(); ++k) {
         const std::uint16_t label = cloud.label[bucket[k].index];
         if (odometry_class(label) < 0) unreliable[k] = true;
-        if (!config.ground_edges && is_ground(static_class(label))) not_edge[k] = true;
+        if (ground_threshold && is_ground(static_class(label)) && !(roughness[k] > config.ground_edge_alpha)) {
+          not_edge[k] = true;
+        }
       }
     }
     const auto selection = select_ring_features(ring_points, roughness, unreliable, config, not_edge);
