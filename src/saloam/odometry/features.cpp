@@ -343,7 +343,9 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
       for (std::size_t k = 0; k < bucket.size(); ++k) {
         const std::uint16_t label = cloud.label[bucket[k].index];
         if (odometry_class(label) < 0) unreliable[k] = true;
-        if (ground_threshold && is_ground(static_class(label)) && !(roughness[k] > config.ground_edge_alpha)) {
+        // Only points rough enough to be edges at all need the class lookup.
+        if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
+            is_ground(static_class(label))) {
           not_edge[k] = true;
         }
       }
