@@ -138,22 +138,13 @@ TEST(FeatureSelection, EdgesAtCornerPlanarsOnWallsWithLimits) {
   for (std::size_t a = 0; a < sel.planars.size(); ++a) {
     for (std::size_t b = a + 1; b < sel.planars.size(); ++b) EXPECT_GT(std::abs(sel.planars[a] - sel.planars[b]), 5);
   }
+  // Points marked not-edge (rough ground) give no edges but may be planar.
+  const auto planar_only = select_ring_features(ring, c, unreliable, config, std::vector<bool>(ring.size(), true));
+  EXPECT_TRUE(planar_only.edges.empty());
+  EXPECT_EQ(planar_only.planars.size(), 4u);
   // Threshold: with alpha above every roughness there are no edges.
   config.alpha = 10.0;
   EXPECT_TRUE(select_ring_features(ring, c, unreliable, config).edges.empty());
-}
-
-TEST(FeatureSelection, PointsMarkedNotEdgeMayStillBePlanar) {
-  const auto ring = corner_ring();
-  const auto c = ring_roughness(ring, 5);
-  const std::vector<bool> unreliable(ring.size(), false);
-  FeatureConfig config;
-  config.num_sectors = 1;
-  config.edges_per_sector = 2;
-  config.planars_per_sector = 4;
-  const auto sel = select_ring_features(ring, c, unreliable, config, std::vector<bool>(ring.size(), true));
-  EXPECT_TRUE(sel.edges.empty());
-  EXPECT_EQ(sel.planars.size(), 4u);
 }
 
 TEST(FeatureSelection, PerSectorLimits) {
