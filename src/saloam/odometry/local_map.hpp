@@ -103,7 +103,6 @@ class SemanticLocalMap {
   [[nodiscard]] const NeighbourGrid& planars() const { return planars_.points; }
   [[nodiscard]] std::size_t num_edge_points() const { return edges_.points.size(); }
   [[nodiscard]] std::size_t num_planar_points() const { return planars_.points.size(); }
-  [[nodiscard]] double search_radius() const { return edges_.points.cell_size(); }
 
  private:
   struct Voxel {

@@ -122,13 +122,13 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
       return true;
     };
   }
-  auto register_features = [&](const Pose& initial) {
+  auto register_from = [&](const Pose& initial) {
     RegistrationResult result = register_scan(features, map_, initial, settings_, refresh);
     last_stats_.association_rounds += result.associations;
     return result;
   };
   if (!map_.empty()) {
-    last_stats_.registration = register_features(prediction);
+    last_stats_.registration = register_from(prediction);
     pose = last_stats_.registration.pose;
     if (deskewing && k == 1 && last_stats_.registration.ok) {
       // Bootstrap: de-skew the first two frames with the motion just
@@ -138,7 +138,7 @@ Pose OdometryPipeline::process(const LabelledCloud& cloud, double timestamp) {
       map_ = SemanticLocalMap(config_.local_map_frames, voxel_sizes_, config_.max_correspondence_distance);
       map_.add_frame(transformed(first.edges, sweep_poses_[0]), transformed(first.planars, sweep_poses_[0]));
       features = deskewed(raw, first_motion);
-      last_stats_.registration = register_features(pose);
+      last_stats_.registration = register_from(pose);
       pose = last_stats_.registration.pose;
     }
   }
