@@ -102,9 +102,9 @@ int run_demo(const DemoOptions& options) {
                "|---|---|---|---|---|---|\n";
   for (const auto& r : results) {
     const auto& e = r.evaluation;
-    std::cout << fmt::format("| {} | {:.3f} | {:.3f} | {:.3f} | {:.4f} | {:.1f} |\n", r.name, e.kitti.t_err_percent,
-                             e.kitti.r_err_deg_per_100m, e.ate.aligned.rmse, e.rpe.trans_rmse_m,
-                             1000.0 / std::max(r.run.median_frame_ms(), 1e-9));
+    std::cout << fmt::format("| {} | {} | {} | {} | {} | {:.1f} |\n", r.name, format_metric(e.kitti.t_err_percent, 3),
+                             format_metric(e.kitti.r_err_deg_per_100m, 3), format_metric(e.ate.aligned.rmse, 3),
+                             format_metric(e.rpe.trans_rmse_m, 4), 1000.0 / std::max(r.run.median_frame_ms(), 1e-9));
   }
   const auto& semantic = results.front();
   SemanticMapOptions map_options;

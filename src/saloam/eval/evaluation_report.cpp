@@ -17,11 +17,13 @@ namespace {
 /// NaN/Inf become JSON null (nlohmann would do the same, made explicit here).
 nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
 
-std::string fixed(double v, int decimals) { return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : "n/a"; }
-
 constexpr std::array<const char*, 3> kAxisNames{"x", "y", "z"};
 
 }  // namespace
+
+std::string format_metric(double value, int decimals) {
+  return std::isfinite(value) ? fmt::format("{:.{}f}", value, decimals) : "n/a";
+}
 
 nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const EvaluationLabels& labels, bool per_frame) {
   using nlohmann::json;
@@ -109,26 +111,26 @@ void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& ev
   out << "| metric | value |\n|---|---|\n";
   out << fmt::format("| poses evaluated | {} (ground truth {}, estimate {}) |\n", ev.evaluated_poses, ev.gt_poses,
                      ev.est_poses);
-  out << fmt::format("| ground-truth path length | {} m |\n", fixed(ev.gt_length_m, 1));
-  out << fmt::format("| KITTI translation error | {} % |\n", fixed(ev.kitti.t_err_percent, 5));
-  out << fmt::format("| KITTI rotation error | {} deg/100 m |\n", fixed(ev.kitti.r_err_deg_per_100m, 5));
+  out << fmt::format("| ground-truth path length | {} m |\n", format_metric(ev.gt_length_m, 1));
+  out << fmt::format("| KITTI translation error | {} % |\n", format_metric(ev.kitti.t_err_percent, 5));
+  out << fmt::format("| KITTI rotation error | {} deg/100 m |\n", format_metric(ev.kitti.r_err_deg_per_100m, 5));
   out << fmt::format("| KITTI segments (100..800 m) | {} |\n", ev.kitti.segments);
   if (ev.ate.alignment != Alignment::kNone) {
-    out << fmt::format("| ATE RMSE, {}-aligned | {} m |\n", align, fixed(ev.ate.aligned.rmse, 6));
+    out << fmt::format("| ATE RMSE, {}-aligned | {} m |\n", align, format_metric(ev.ate.aligned.rmse, 6));
     out << fmt::format("| ATE mean / median / max, {}-aligned | {} / {} / {} m |\n", align,
-                       fixed(ev.ate.aligned.mean, 4), fixed(ev.ate.aligned.median, 4), fixed(ev.ate.aligned.max, 4));
+                       format_metric(ev.ate.aligned.mean, 4), format_metric(ev.ate.aligned.median, 4), format_metric(ev.ate.aligned.max, 4));
   }
-  if (ev.ate.alignment == Alignment::kSim3) out << fmt::format("| Sim(3) scale | {} |\n", fixed(ev.ate.transform.scale, 6));
-  out << fmt::format("| ATE RMSE, unaligned | {} m |\n", fixed(ev.ate.unaligned.rmse, 6));
-  out << fmt::format("| ATE mean / median / max, unaligned | {} / {} / {} m |\n", fixed(ev.ate.unaligned.mean, 4),
-                     fixed(ev.ate.unaligned.median, 4), fixed(ev.ate.unaligned.max, 4));
-  out << fmt::format("| RPE ({}-frame) translation RMSE | {} m |\n", ev.rpe.delta, fixed(ev.rpe.trans_rmse_m, 6));
-  out << fmt::format("| RPE ({}-frame) rotation RMSE | {} deg |\n", ev.rpe.delta, fixed(ev.rpe.rot_rmse_deg, 6));
+  if (ev.ate.alignment == Alignment::kSim3) out << fmt::format("| Sim(3) scale | {} |\n", format_metric(ev.ate.transform.scale, 6));
+  out << fmt::format("| ATE RMSE, unaligned | {} m |\n", format_metric(ev.ate.unaligned.rmse, 6));
+  out << fmt::format("| ATE mean / median / max, unaligned | {} / {} / {} m |\n", format_metric(ev.ate.unaligned.mean, 4),
+                     format_metric(ev.ate.unaligned.median, 4), format_metric(ev.ate.unaligned.max, 4));
+  out << fmt::format("| RPE ({}-frame) translation RMSE | {} m |\n", ev.rpe.delta, format_metric(ev.rpe.trans_rmse_m, 6));
+  out << fmt::format("| RPE ({}-frame) rotation RMSE | {} deg |\n", ev.rpe.delta, format_metric(ev.rpe.rot_rmse_deg, 6));
 
   out << "\n| segment length [m] | t_err [%] | r_err [deg/100 m] | segments |\n|---|---|---|---|\n";
   for (const auto& l : ev.kitti.per_length) {
-    out << fmt::format("| {:.0f} | {} | {} | {} |\n", l.length_m, fixed(l.t_err_percent, 5),
-                       fixed(l.r_err_deg_per_100m, 5), l.segments);
+    out << fmt::format("| {:.0f} | {} | {} | {} |\n", l.length_m, format_metric(l.t_err_percent, 5),
+                       format_metric(l.r_err_deg_per_100m, 5), l.segments);
   }
   for (const auto& w : ev.warnings) out << "\n> warning: " << w << '\n';
 }
@@ -179,8 +181,8 @@ void plot_evaluation(const std::filesystem::path& file, const std::vector<Pose>&
   plot.fit_range(all, true);
   const std::string align = ev.ate.alignment == Alignment::kNone ? "unaligned" : alignment_name(ev.ate.alignment);
   plot.set_title(fmt::format("KITTI t_err {} %  r_err {} deg/100m  |  ATE RMSE {} m ({})  |  RPE {} m",
-                             fixed(ev.kitti.t_err_percent, 3), fixed(ev.kitti.r_err_deg_per_100m, 3),
-                             fixed(ev.ate.aligned.rmse, 3), align, fixed(ev.rpe.trans_rmse_m, 4)));
+                             format_metric(ev.kitti.t_err_percent, 3), format_metric(ev.kitti.r_err_deg_per_100m, 3),
+                             format_metric(ev.ate.aligned.rmse, 3), align, format_metric(ev.rpe.trans_rmse_m, 4)));
   plot.set_labels(fmt::format("{} [m]", kAxisNames[static_cast<std::size_t>(ax)]),
                   fmt::format("{} [m]", kAxisNames[static_cast<std::size_t>(ay)]));
 

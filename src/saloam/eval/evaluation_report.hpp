@@ -49,6 +49,10 @@ nlohmann::json evaluation_to_json(const TrajectoryEvaluation& evaluation, const 
 void write_evaluation_json(const std::filesystem::path& file, const TrajectoryEvaluation& evaluation,
                            const EvaluationLabels& labels = {});
 
+/// A metric with `decimals` digits, or "n/a" when it is undefined (NaN, e.g.
+/// the KITTI errors of a path shorter than 100 m).
+std::string format_metric(double value, int decimals);
+
 /// A Markdown summary: headline table and the KITTI per-length table.
 void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& evaluation,
                                const EvaluationLabels& labels = {});
