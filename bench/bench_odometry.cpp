@@ -22,7 +22,7 @@
 #pragma GCC diagnostic pop
 
 #include "saloam/io/scan_io.hpp"
-#include "saloam/odometry/pipeline.hpp"
+#include "saloam/odometry/semantic_odometry.hpp"
 
 namespace saloam {
 namespace {
@@ -210,7 +210,7 @@ void BM_PipelineFrame(benchmark::State& state) {
   auto config = kitti_config();
   config.threads = static_cast<int>(state.range(0));
   for (auto _ : state) {
-    OdometryPipeline odometry(config);
+    SemanticOdometry odometry(config);
     for (int i = 0; i < 6; ++i) odometry.register_frame(scans()[i], 0.1 * i);
     benchmark::DoNotOptimize(odometry.poses().back());
   }

@@ -9,10 +9,10 @@
 #include <random>
 
 #include "saloam/io/scan_io.hpp"
-#include "saloam/loop/graph_json.hpp"
-#include "saloam/loop/scan_context.hpp"
-#include "saloam/loop/semantic_graph.hpp"
-#include "saloam/loop/sgpr_network.hpp"
+#include "saloam/place/graph_json.hpp"
+#include "saloam/place/scan_context.hpp"
+#include "saloam/place/semantic_graph.hpp"
+#include "saloam/place/sgpr_network.hpp"
 #include "saloam/sim/simulator.hpp"
 
 namespace {

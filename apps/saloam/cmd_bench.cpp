@@ -15,12 +15,12 @@
 
 #include "command.hpp"
 #include "saloam/core/frame_range.hpp"
-#include "saloam/pipeline/odometry_run.hpp"
+#include "saloam/runs/odometry_run.hpp"
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/odometry/pipeline.hpp"
+#include "saloam/odometry/semantic_odometry.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -58,7 +58,7 @@ int run_bench(const BenchOptions& options) {
   const SequenceReader reader(options.sequence, seq_options);
   const auto [first, last] = FrameRange::parse(options.frames).clip(reader.size());
 
-  OdometryPipeline odometry(config.odometry);
+  SemanticOdometry odometry(config.odometry);
   std::vector<double> wall_ms, cpu_ms;
   // CPU time of this thread: on a shared machine wall time includes waiting
   // for a core; with --threads 1 the thread's CPU time is the cost of the frame.

@@ -18,8 +18,8 @@
 #include "saloam/io/ply.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/mapping/map_render.hpp"
-#include "saloam/pipeline/map_building.hpp"
-#include "saloam/pipeline/odometry_run.hpp"
+#include "saloam/runs/map_building.hpp"
+#include "saloam/runs/odometry_run.hpp"
 #include "saloam/sim/render.hpp"
 #include "saloam/sim/simulator.hpp"
 

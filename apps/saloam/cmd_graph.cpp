@@ -9,8 +9,8 @@
 #include "command.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/loop/graph_json.hpp"
-#include "saloam/loop/semantic_graph.hpp"
+#include "saloam/place/graph_json.hpp"
+#include "saloam/place/semantic_graph.hpp"
 
 namespace saloam::cli {
 namespace {

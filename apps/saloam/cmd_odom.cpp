@@ -13,7 +13,7 @@
 #include "command.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/pipeline/odometry_run.hpp"
+#include "saloam/runs/odometry_run.hpp"
 
 namespace saloam::cli {
 namespace {

@@ -21,11 +21,11 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/loop/graph_json.hpp"
-#include "saloam/loop/place_recognition.hpp"
-#include "saloam/loop/scan_context.hpp"
-#include "saloam/loop/semantic_graph.hpp"
-#include "saloam/loop/sgpr_network.hpp"
+#include "saloam/place/graph_json.hpp"
+#include "saloam/place/place_recognition.hpp"
+#include "saloam/place/scan_context.hpp"
+#include "saloam/place/semantic_graph.hpp"
+#include "saloam/place/sgpr_network.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam::cli {

@@ -5,8 +5,8 @@
 #include <fmt/format.h>
 
 #include "command.hpp"
-#include "saloam/loop/graph_json.hpp"
-#include "saloam/loop/sgpr_network.hpp"
+#include "saloam/place/graph_json.hpp"
+#include "saloam/place/sgpr_network.hpp"
 
 namespace saloam::cli {
 namespace {

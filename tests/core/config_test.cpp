@@ -20,13 +20,14 @@ TEST(Config, TableOneDefaults) {
   EXPECT_EQ(c.odometry.local_map_frames, 20);
   EXPECT_EQ(c.odometry.edge_neighbours, 5);
   EXPECT_EQ(c.odometry.planar_neighbours, 5);
-  EXPECT_DOUBLE_EQ(c.odometry.sigma, 0.05);
+  EXPECT_DOUBLE_EQ(c.odometry.plane_normal_tolerance, 0.05);
   EXPECT_DOUBLE_EQ(c.loop.delta_min, 15.0);
   EXPECT_DOUBLE_EQ(c.loop.delta_max, 100.0);
   EXPECT_EQ(c.loop.num_candidates, 64);
   EXPECT_DOUBLE_EQ(c.loop.zeta, 0.95);
-  EXPECT_EQ(c.loop.num_loop_frames, 5);
-  EXPECT_EQ(c.loop.delta_r, 100);
+  EXPECT_EQ(c.loop.num_loop, 5);
+  EXPECT_DOUBLE_EQ(c.loop.delta_r, 100.0);
+  EXPECT_DOUBLE_EQ(c.loop.sigma, 0.05);  // Table I's sigma: the drift rate of Eq. 3
 }
 
 TEST(Config, YamlRoundTripIsIdentity) {

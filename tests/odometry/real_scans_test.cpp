@@ -10,7 +10,7 @@
 #include "saloam/core/lie.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/trajectory_io.hpp"
-#include "saloam/odometry/pipeline.hpp"
+#include "saloam/odometry/semantic_odometry.hpp"
 #include "testing/test_support.hpp"
 
 namespace saloam {
@@ -49,7 +49,7 @@ TEST(RealKittiScans, EachConsecutivePairMatchesIcpReference) {
   const auto reference = read_kitti_poses(testing::shared_file("data/kitti/scans_00/relative_poses_icp.txt"));
   ASSERT_EQ(reference.size(), 5u);
   for (int i = 0; i < 5; ++i) {
-    OdometryPipeline odometry(real_kitti_config());
+    SemanticOdometry odometry(real_kitti_config());
     odometry.register_frame(scans[i], 0.0);
     const Pose estimate = odometry.register_frame(scans[i + 1], 0.1);
     const Error e = relative_error(estimate, reference[i]);
@@ -63,7 +63,7 @@ TEST(RealKittiScans, EachConsecutivePairMatchesIcpReference) {
 TEST(RealKittiScans, OdometryOverSixScansMatchesIcpReference) {
   const auto scans = load_scans();
   const auto reference = read_kitti_poses(testing::shared_file("data/kitti/scans_00/relative_poses_icp.txt"));
-  OdometryPipeline odometry(real_kitti_config());
+  SemanticOdometry odometry(real_kitti_config());
   for (int i = 0; i < 6; ++i) odometry.register_frame(scans[i], 0.1 * i);
   const auto& poses = odometry.poses();
   ASSERT_EQ(poses.size(), 6u);

@@ -8,7 +8,7 @@
 
 #include "saloam/core/lie.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/odometry/pipeline.hpp"
+#include "saloam/odometry/semantic_odometry.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "testing/test_support.hpp"
 
@@ -28,7 +28,7 @@ Drift run(const std::filesystem::path& dir, bool semantics, bool deskew) {
   SequenceOptions options;
   options.ignore_labels = !semantics;
   const SequenceReader reader(dir, options);
-  OdometryPipeline odometry(config);
+  SemanticOdometry odometry(config);
   for (std::size_t i = 0; i < reader.size(); ++i) odometry.register_frame(reader.load_scan(i), reader.times()[i]);
   const auto gt = reader.lidar_poses();
   Drift d{0, 0, 0};

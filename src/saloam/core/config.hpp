@@ -68,10 +68,11 @@ struct OdometryConfig {
   int local_map_frames = 20;     ///< N_m: frames kept in the local map
   int edge_neighbours = 5;       ///< N_ne: map points fitted to a line per edge feature
   int planar_neighbours = 5;     ///< N_np: map points fitted to a plane per planar feature
-  /// sigma: tolerance of the plane constraint. A plane of a ground class is
-  /// kept only if |n . z| >= 1 - sigma (normal near vertical), one of
-  /// building/fence only if |n . z| <= sigma (normal near horizontal).
-  double sigma = 0.05;
+  /// Tolerance of the semantic plane constraint (not a Table I parameter;
+  /// Table I's sigma is the drift rate loop.sigma). A plane of a ground class
+  /// is kept only if |n . z| >= 1 - tolerance (normal near vertical), one of
+  /// building/fence only if |n . z| <= tolerance (normal near horizontal).
+  double plane_normal_tolerance = 0.05;
   bool use_semantics = true;     ///< false: label-agnostic FLOAM-style baseline
   /// Match within groups of classes that networks confuse and that share a
   /// geometry (ground, building+fence, pole-like, vehicles; see class_group())
@@ -111,20 +112,73 @@ struct OdometryConfig {
   int threads = 1;               ///< worker threads for association (0 = all cores)
 };
 
-/// Loop closure (paper Sec. III-C).
+/// Loop closure (paper Sec. III-C): candidates (Eq. 3), similarity scoring,
+/// geometric verification by the semantic-assisted ICP.
 struct LoopClosureConfig {
-  double delta_min = 15.0;    ///< delta_min [m]: smallest candidate search radius
-  double delta_max = 100.0;   ///< delta_max [m]: largest search radius (radius grows with drift)
-  int num_candidates = 64;    ///< N_candi: candidates scored by SGPR per query
-  double zeta = 0.95;         ///< zeta: SGPR similarity threshold
-  int num_loop_frames = 5;    ///< N_loop: frames on each side forming a candidate submap
-  int delta_r = 100;          ///< delta_r: most recent frames excluded from the search
-  std::string sgpr_model;     ///< path of the .sgw weights; empty = <shared>/models/sgpr/sgpr_kitti.sgw
+  /// Place-recognition scorer: "sgpr" (the paper's), "scancontext" or
+  /// "hybrid" (mean of both scores). The default is the one measured best on
+  /// loop closure (docs/loop_closure.md): the pretrained SGPR weights
+  /// transfer poorly to simulated scans.
+  std::string detector = "scancontext";
+  double sigma = 0.05;        ///< sigma: odometry drift rate of Eq. 3 (search radius per metre travelled)
+  double delta_min = 15.0;    ///< delta_min [m]: smallest search radius of Eq. 3
+  double delta_max = 100.0;   ///< delta_max [m]: largest search radius of Eq. 3
+  int num_candidates = 64;    ///< N_candi: at most this many candidates per query, drawn at random
+  double zeta = 0.95;         ///< zeta: SGPR score threshold (score in (0, 1))
+  /// Scan Context score threshold (score = 1 - column-shift distance);
+  /// also used by "hybrid" for the mean of both scores.
+  double scancontext_zeta = 0.6;
+  int num_loop = 5;           ///< N_loop: best-scoring pairs (score > threshold) that go on to verification
+  /// delta_r: threshold on the ICP loss r of Eq. 2 (the weighted sum of
+  /// point-to-line and point-to-plane distances [m]) at the registered pose.
+  /// Depends on the number of features per scan; used when
+  /// `acceptance` = "loss".
+  double delta_r = 100.0;
+  /// Which verification test accepts a loop: "normalized" (mean residual,
+  /// inlier fraction, degeneracy; independent of the scan's feature count)
+  /// or "loss" (the paper's r < delta_r). Both are computed and written to
+  /// loops.csv either way.
+  std::string acceptance = "normalized";
+  double max_mean_residual = 0.06;     ///< [m] normalized test: mean |residual| of the inliers
+  double min_inlier_fraction = 0.45;   ///< normalized test: features with a correspondence closer than inlier_distance
+  double inlier_distance = 0.2;        ///< [m] a correspondence closer than this is an inlier
+  /// Degeneracy check: smallest eigenvalue of the translation block of the
+  /// registration Hessian per correspondence (1 = every residual constrains
+  /// that direction fully; a straight road without cross structure gives ~0).
+  double min_translation_eigenvalue = 0.02;
+  /// [m] Frames travelled less than this before the query are not
+  /// candidates: a loop needs the vehicle to leave the place and come back.
+  double exclude_recent_distance = 50.0;
+  int submap_half_width = 10;  ///< keyframes on each side of the candidate forming its submap
+  /// [m] After an accepted loop the next search waits this much travel:
+  /// consecutive queries would only confirm the same constraint.
+  double search_interval_after_loop = 5.0;
+  std::uint64_t seed = 42;     ///< random generator of the N_candi draw (deterministic output)
+  std::string sgpr_model;      ///< SGPR weights (.sgw); required when the detector uses SGPR
+};
+
+/// The SLAM back end: keyframes, pose graph and global map.
+struct SlamConfig {
+  double keyframe_distance = 1.0;   ///< [m] travel that makes a new keyframe (graph node, place descriptor)
+  double keyframe_angle_deg = 10.0; ///< [deg] rotation that makes a new keyframe
+  /// Information of an edge = scale * H / N, with H the registration's
+  /// Gauss-Newton Hessian and N its correspondence count: correspondences
+  /// are correlated, so each edge counts as `scale` [1/m^2] worth of
+  /// independent unit residuals (1e4: 100 residuals of 0.1 m).
+  double information_scale = 1e4;
+  /// Cauchy scale of loop edges in the second, robust phase of each
+  /// optimisation [whitened units, i.e. standard deviations]: a loop that
+  /// still disagrees by many times this after the plain solve loses its weight.
+  double loop_robust_scale = 10.0;
+  int max_iterations = 30;          ///< Levenberg-Marquardt iterations per optimisation
+  double map_voxel_size = 0.25;     ///< [m] global semantic map resolution
+  int map_frame_step = 2;           ///< every n-th frame goes into the global map
 };
 
 struct SaloamConfig {
   OdometryConfig odometry;
   LoopClosureConfig loop;
+  SlamConfig slam;
 };
 
 /// Calls v(name, member, description) for every scalar field.
@@ -151,7 +205,7 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("local_map_frames", c.local_map_frames, "N_m: frames in the local map");
   v("edge_neighbours", c.edge_neighbours, "N_ne: neighbours per edge feature");
   v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature");
-  v("sigma", c.sigma, "sigma: plane constraint tolerance");
+  v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . z|");
   v("use_semantics", c.use_semantics, "semantic assistance on/off");
   v("match_class_groups", c.match_class_groups, "match within class groups instead of single classes");
   v("deskew", c.deskew, "constant-velocity de-skewing");
@@ -169,13 +223,36 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
 
 template <class Visitor>
 void visit_fields(LoopClosureConfig& c, Visitor&& v) {
-  v("delta_min", c.delta_min, "delta_min [m]: min search radius");
-  v("delta_max", c.delta_max, "delta_max [m]: max search radius");
-  v("num_candidates", c.num_candidates, "N_candi: candidates per query");
+  v("detector", c.detector, "place recognition: sgpr, scancontext or hybrid");
+  v("sigma", c.sigma, "sigma: odometry drift rate of Eq. 3 [m per m travelled]");
+  v("delta_min", c.delta_min, "delta_min [m]: min search radius of Eq. 3");
+  v("delta_max", c.delta_max, "delta_max [m]: max search radius of Eq. 3");
+  v("num_candidates", c.num_candidates, "N_candi: candidates per query (random draw beyond)");
   v("zeta", c.zeta, "zeta: SGPR score threshold");
-  v("num_loop_frames", c.num_loop_frames, "N_loop: submap half-width [frames]");
-  v("delta_r", c.delta_r, "delta_r: recent frames excluded");
+  v("scancontext_zeta", c.scancontext_zeta, "Scan Context (and hybrid) score threshold");
+  v("num_loop", c.num_loop, "N_loop: best pairs verified per query");
+  v("delta_r", c.delta_r, "delta_r: ICP loss threshold (Eq. 2 sum) [m]");
+  v("acceptance", c.acceptance, "verification test: normalized or loss");
+  v("max_mean_residual", c.max_mean_residual, "[m] normalized test: max mean inlier residual");
+  v("min_inlier_fraction", c.min_inlier_fraction, "normalized test: min inlier fraction");
+  v("inlier_distance", c.inlier_distance, "[m] inlier residual bound");
+  v("min_translation_eigenvalue", c.min_translation_eigenvalue, "degeneracy: min translation eigenvalue of H/N");
+  v("exclude_recent_distance", c.exclude_recent_distance, "[m] recent travel excluded from the search");
+  v("submap_half_width", c.submap_half_width, "keyframes each side of a candidate in its submap");
+  v("search_interval_after_loop", c.search_interval_after_loop, "[m] travel before searching again after a loop");
+  v("seed", c.seed, "seed of the N_candi random draw");
   v("sgpr_model", c.sgpr_model, "SGPR weights (.sgw)");
+}
+
+template <class Visitor>
+void visit_fields(SlamConfig& c, Visitor&& v) {
+  v("keyframe_distance", c.keyframe_distance, "[m] travel between keyframes");
+  v("keyframe_angle_deg", c.keyframe_angle_deg, "[deg] rotation between keyframes");
+  v("information_scale", c.information_scale, "[1/m^2] edge information = scale * H / N");
+  v("loop_robust_scale", c.loop_robust_scale, "Cauchy scale of loop edges");
+  v("max_iterations", c.max_iterations, "pose-graph iterations per optimisation");
+  v("map_voxel_size", c.map_voxel_size, "[m] global map voxel size");
+  v("map_frame_step", c.map_frame_step, "every n-th frame goes into the global map");
 }
 
 /// Calls v(section, struct) for every section; nested sections use dots.
@@ -184,6 +261,7 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
   v("odometry", c.odometry);
   v("odometry.features", c.odometry.features);
   v("loop", c.loop);
+  v("slam", c.slam);
 }
 
 /// Loads a YAML file over the defaults. Unknown keys and wrong types are

@@ -60,7 +60,8 @@ void TopDownCanvas::add(const LabelledCloud& cloud) {
   }
 }
 
-TopDownStats TopDownCanvas::save(const std::filesystem::path& png, const std::vector<Pose>& trajectory) const {
+TopDownStats TopDownCanvas::save(const std::filesystem::path& png, const std::vector<Pose>& trajectory,
+                                 const std::vector<WorldSegment>& links) const {
   const int width = stats_.width, height = stats_.height;
   RasterImage image(width, height, {18, 18, 22});
   const float zspan = std::max(zmax_ - zmin_, 1.0f);
@@ -95,12 +96,20 @@ TopDownStats TopDownCanvas::save(const std::filesystem::path& png, const std::ve
     const auto start = pixel(trajectory.front().translation().x(), trajectory.front().translation().y());
     image.draw_disc(start.x(), start.y(), radius, {0, 230, 0});
   }
+  const int link_thickness = std::max(1, static_cast<int>(std::lround(0.8 / stats_.metres_per_pixel)));
+  for (const auto& [from, to] : links) {
+    const auto a = pixel(from.x(), from.y());
+    const auto b = pixel(to.x(), to.y());
+    image.draw_line(a.x(), a.y(), b.x(), b.y(), {255, 150, 0}, link_thickness);
+    image.draw_disc(a.x(), a.y(), link_thickness + 1, {255, 150, 0});
+    image.draw_disc(b.x(), b.y(), link_thickness + 1, {255, 150, 0});
+  }
   image.save_png(png);
   return stats_;
 }
 
 TopDownStats render_top_down(const std::filesystem::path& png, const LabelledCloud& map, const std::vector<Pose>& trajectory,
-                             const TopDownOptions& options) {
+                             const TopDownOptions& options, const std::vector<WorldSegment>& links) {
   Eigen::Vector2d lo(std::numeric_limits<double>::max(), std::numeric_limits<double>::max());
   Eigen::Vector2d hi = -lo;
   for (const auto& p : map.points) {
@@ -114,7 +123,7 @@ TopDownStats render_top_down(const std::filesystem::path& png, const LabelledClo
   if (map.empty() && trajectory.empty()) lo = hi = Eigen::Vector2d::Zero();
   TopDownCanvas canvas(lo - Eigen::Vector2d(5, 5), hi + Eigen::Vector2d(5, 5), options);
   canvas.add(map);
-  return canvas.save(png, trajectory);
+  return canvas.save(png, trajectory, links);
 }
 
 }  // namespace saloam

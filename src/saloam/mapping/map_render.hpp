@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -16,6 +17,9 @@
 #include "saloam/core/types.hpp"
 
 namespace saloam {
+
+/// A straight segment between two world points (x east, y north, z up).
+using WorldSegment = std::pair<Eigen::Vector3d, Eigen::Vector3d>;
 
 struct TopDownOptions {
   double metres_per_pixel = 0.0;  ///< 0 = fit the extent into `max_pixels`; widened if it would exceed them
@@ -42,8 +46,10 @@ class TopDownCanvas {
   /// Every point of `cloud` (already in the world frame).
   void add(const LabelledCloud& cloud);
 
-  /// Writes the PNG with the trajectory positions drawn over the points.
-  TopDownStats save(const std::filesystem::path& png, const std::vector<Pose>& trajectory) const;
+  /// Writes the PNG with the trajectory positions drawn over the points and
+  /// `links` (e.g. accepted loop closures, world frame) in orange over both.
+  TopDownStats save(const std::filesystem::path& png, const std::vector<Pose>& trajectory,
+                    const std::vector<WorldSegment>& links = {}) const;
 
   [[nodiscard]] const TopDownStats& stats() const { return stats_; }
   /// Class shown at world position (x, y): that of the highest point in its
@@ -62,9 +68,10 @@ class TopDownCanvas {
   float zmin_, zmax_;
 };
 
-/// Renders `map` (world frame, z up) and the trajectory positions to a PNG,
-/// framing both with a 5 m margin.
+/// Renders `map` (world frame, z up), the trajectory positions and `links`
+/// to a PNG, framing map and trajectory with a 5 m margin.
 TopDownStats render_top_down(const std::filesystem::path& png, const LabelledCloud& map,
-                             const std::vector<Pose>& trajectory, const TopDownOptions& options = {});
+                             const std::vector<Pose>& trajectory, const TopDownOptions& options = {},
+                             const std::vector<WorldSegment>& links = {});
 
 }  // namespace saloam

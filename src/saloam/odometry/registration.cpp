@@ -20,7 +20,7 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
   s.outer_iterations = config.outer_iterations;
   s.reassociation_min_translation = config.reassociation_min_translation;
   s.reassociation_min_rotation = config.reassociation_min_rotation_deg * M_PI / 180.0;
-  s.sigma = config.sigma;
+  s.plane_normal_tolerance = config.plane_normal_tolerance;
   s.class_weight = class_weights(config);
   for (int c = 0; c < kNumClassIndices; ++c) {
     s.orientation[c] = config.use_semantics
@@ -69,6 +69,37 @@ double huber_weight(double r, double k) {
   return a <= k ? 1.0 : k / a;
 }
 
+// Loss, inliers and Hessian of the matched features at pose T (no new association).
+void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
+                  const std::vector<PlaneMatch>& plane_matches, const Pose& T, const RegistrationSettings& settings,
+                  RegistrationResult& result) {
+  result.loss = 0;
+  result.inliers = 0;
+  result.inlier_residual_sum = 0;
+  result.hessian.setZero();
+  const double k = settings.robust_kernel_scale;
+  auto add = [&](double distance, double class_weight, const auto& J) {
+    result.loss += class_weight * distance;
+    if (distance < settings.inlier_distance) {
+      ++result.inliers;
+      result.inlier_residual_sum += distance;
+    }
+    result.hessian.noalias() += class_weight * huber_weight(distance, k) * J.transpose() * J;
+  };
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    if (!edge_matches[i].valid) continue;
+    Eigen::Matrix<double, 3, 6> J;
+    const Eigen::Vector3d r = point_to_line_residual(T, edges.points[i], edge_matches[i].line, &J);
+    add(r.norm(), settings.class_weight[edges.classes[i]], J);
+  }
+  for (std::size_t i = 0; i < planars.size(); ++i) {
+    if (!plane_matches[i].valid) continue;
+    Eigen::Matrix<double, 1, 6> J;
+    const double r = point_to_plane_residual(T, planars.points[i], plane_matches[i].plane, &J);
+    add(std::abs(r), settings.class_weight[planars.classes[i]], J);
+  }
+}
+
 RegistrationResult register_features(const FeatureCloud& edges, const FeatureCloud& planars,
                                      const SemanticLocalMap& map, const Pose& initial,
                                      const RegistrationSettings& settings, const std::function<bool(const Pose&)>& refresh) {
@@ -103,7 +134,7 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
       const ClassIndex c = planars.classes[i];
       if (gather(map.planars(), q, c, np, settings.max_correspondence_distance, nb)) {
         if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
-          if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.sigma)) {
+          if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.plane_normal_tolerance)) {
             m.plane = *plane;
             m.valid = true;
           } else {
@@ -150,7 +181,8 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
       if (!delta.allFinite()) return result;
       T = apply_update(delta, T);
       ++result.iterations;
-      if (delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6) break;  // converged
+      result.converged = delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6;
+      if (result.converged) break;
     }
     if (outer + 1 >= settings.outer_iterations) break;
     const bool refreshed = refresh && refresh(T);
@@ -164,6 +196,7 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   }
   result.pose = T;
   result.ok = true;
+  evaluate_fit(edges, planars, edge_matches, plane_matches, T, settings, result);
   return result;
 }
 

@@ -28,10 +28,12 @@ struct RegistrationSettings {
   /// An outer round that moved the pose less than this ends the re-association.
   double reassociation_min_translation = 0.0;  ///< [m] (0: always all rounds)
   double reassociation_min_rotation = 0.0;     ///< [rad]
-  double sigma = 0.05;             ///< plane-constraint tolerance
+  double plane_normal_tolerance = 0.05;  ///< plane constraint: tolerance on |n . z|
   std::array<double, kNumClassIndices> class_weight{};          ///< w^l
   std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
   bool parallel = false;           ///< associate with TBB (inside the caller's task arena)
+  /// [m] a final correspondence closer than this counts as an inlier (RegistrationResult::inliers).
+  double inlier_distance = 0.2;
 
   /// From the config; without semantics all weights are 1 and no plane constraint applies.
   static RegistrationSettings from_config(const OdometryConfig& config);
@@ -45,6 +47,21 @@ struct RegistrationResult {
   int iterations = 0;
   int associations = 0;  ///< association rounds (neighbour search and fit for every feature)
   bool ok = false;  ///< false: too few correspondences, pose = initial guess
+  bool converged = false;  ///< the last Gauss-Newton round ended on a negligible step
+
+  // The fit at the final pose over the final correspondences (what loop
+  // verification tests and the pose graph weighs):
+  /// r of Eq. 2: sum over correspondences of w^l * |residual| [m].
+  double loss = 0;
+  int inliers = 0;                  ///< correspondences with |residual| < inlier_distance
+  double inlier_residual_sum = 0;   ///< [m] sum of |residual| over the inliers
+  /// Gauss-Newton Hessian sum of w^l * huber * J^T J for the right perturbation
+  /// T * exp([rho; phi]) (sensor frame, translation first): the information
+  /// of the pose up to the residuals' noise scale.
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+
+  [[nodiscard]] int correspondences() const { return edge_matches + planar_matches; }
+  [[nodiscard]] double mean_inlier_residual() const { return inliers > 0 ? inlier_residual_sum / inliers : 0.0; }
 };
 
 /// Registers features (sensor frame) to the map starting from `initial` (T_world<-sensor).

@@ -1,0 +1,96 @@
+// `saloam slam`: the whole SA-LOAM system (semantic odometry, loop closure,
+// pose graph, global semantic map) over a sequence folder. The outputs are
+// listed in src/saloam/runs/slam_run.hpp.
+
+#include <iostream>
+#include <memory>
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include "command.hpp"
+#include "saloam/core/frame_range.hpp"
+#include "saloam/eval/evaluation_report.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/runs/slam_run.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct SlamOptions {
+  std::string sequence;
+  std::string out;
+  std::string labels;
+  std::string frames;
+  std::string detector;
+  std::string model;
+  bool no_map = false;
+  ConfigOptions config;
+};
+
+void print_summary(const SlamRunResult& r) {
+  std::cout << fmt::format("{} frames, {} keyframes; {} loops accepted of {} verified; median {:.1f} ms/frame ({:.1f} Hz), "
+                           "loop closure {:.2f} ms/frame amortised; peak memory {:.0f} MiB\n",
+                           r.frames, r.keyframes, r.loops_accepted, r.loops_verified, r.median_frame_ms,
+                           r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.mean_loop_ms, r.peak_rss_mib);
+  if (r.loop_summary) {
+    const auto& s = *r.loop_summary;
+    std::cout << fmt::format("loops vs ground truth: {} true, {} false ({} reverse); revisit stretches {} "
+                             "({} reverse), missed {} ({} reverse)\n",
+                             s.accepted_true, s.accepted_false, s.accepted_reverse, s.revisit_stretches,
+                             s.reverse_stretches, s.missed_stretches, s.missed_reverse_stretches);
+  }
+  if (r.odometry_evaluation && r.slam_evaluation) {
+    std::cout << "| trajectory | KITTI t_err [%] | r_err [deg/100 m] | ATE RMSE [m] |\n|---|---|---|---|\n";
+    for (const auto& [name, e] : {std::pair{"odometry", &*r.odometry_evaluation}, std::pair{"loop closed", &*r.slam_evaluation}}) {
+      std::cout << fmt::format("| {} | {} | {} | {} |\n", name, format_metric(e->kitti.t_err_percent, 3),
+                               format_metric(e->kitti.r_err_deg_per_100m, 3), format_metric(e->ate.aligned.rmse, 3));
+    }
+  }
+}
+
+int run_slam_command(const SlamOptions& options) {
+  SaloamConfig config = options.config.resolve();
+  if (!options.detector.empty()) config.loop.detector = options.detector;
+  if (!options.model.empty()) config.loop.sgpr_model = options.model;
+  SequenceOptions seq_options;
+  if (!options.labels.empty()) seq_options.labels_dir = options.labels;
+  seq_options.ignore_labels = !config.odometry.use_semantics && !uses_sgpr(parse_place_detector(config.loop.detector));
+  const SequenceReader reader(options.sequence, seq_options);
+  SlamRunOptions run_options;
+  std::tie(run_options.first_frame, run_options.end_frame) = FrameRange::parse(options.frames).clip(reader.size());
+  run_options.write_map = !options.no_map;
+
+  const std::filesystem::path out_dir(options.out);
+  const SlamRunResult result = run_slam(reader, config, load_loop_network(config, {}), out_dir, run_options);
+  print_summary(result);
+  std::cout << fmt::format("wrote {} (poses.txt, poses_odometry.txt, loops.csv, map.ply, map.png, trajectories.png, "
+                           "timing.json)\n",
+                           out_dir.string());
+  if (result.interrupted) {
+    spdlog::warn("interrupted: results of the {} frames processed were written", result.frames);
+    return 130;
+  }
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "slam", "SA-LOAM SLAM: semantic odometry with loop closure, pose graph and global semantic map", 25,
+    [](CLI::App& app) {
+      auto options = std::make_shared<SlamOptions>();
+      app.add_option("SEQ_DIR", options->sequence, "Sequence folder (velodyne/, labels/, calib.txt, times.txt)")
+          ->required();
+      app.add_option("--out", options->out, "Output folder")->required();
+      app.add_option("--labels", options->labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+      app.add_option("--frames", options->frames, "Frame range A:B (B exclusive; A: = to the end)");
+      app.add_option("--detector", options->detector, "Loop detector: scancontext, sgpr or hybrid (loop.detector)")
+          ->check(CLI::IsMember({"scancontext", "sgpr", "hybrid"}));
+      app.add_option("--model", options->model, "SGPR weights (.sgw) for the sgpr and hybrid detectors (loop.sgpr_model)")
+          ->check(CLI::ExistingFile);
+      app.add_flag("--no-map", options->no_map, "Skip the global map (map.ply, map.png)");
+      options->config.add_to(app);
+      return [options] { return run_slam_command(*options); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli

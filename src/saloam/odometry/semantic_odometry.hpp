@@ -1,0 +1,101 @@
+#pragma once
+// The semantic-assisted odometry (paper Sec. III-B). Per frame, a few named
+// steps: extract LOAM features with their classes; predict the motion
+// (constant velocity); downsample per class and de-skew; register to the
+// local map (semantic ICP, de-skewing again as the estimate moves); add the
+// frame to the local map; report the pose at the scan's pose instant.
+// The SLAM system feeds it frames and reads its poses and features.
+
+#include <memory>
+#include <vector>
+
+#include <tbb/task_arena.h>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/core/types.hpp"
+#include "saloam/odometry/features.hpp"
+#include "saloam/odometry/local_map.hpp"
+#include "saloam/odometry/registration.hpp"
+
+namespace saloam {
+
+/// Wall-clock time of each stage of one frame [ms].
+struct FrameTimings {
+  double features_ms = 0.0;
+  double deskew_downsample_ms = 0.0;
+  double registration_ms = 0.0;
+  double map_update_ms = 0.0;
+  [[nodiscard]] double total_ms() const {
+    return features_ms + deskew_downsample_ms + registration_ms + map_update_ms;
+  }
+};
+
+struct FrameStats {
+  std::size_t edge_features = 0;    ///< after downsampling
+  std::size_t planar_features = 0;  ///< after downsampling
+  RegistrationResult registration;  ///< the final registration of the frame
+  int association_rounds = 0;       ///< over all registrations of the frame (refinements included)
+  std::size_t map_edge_points = 0;    ///< local map after the update
+  std::size_t map_planar_points = 0;  ///< local map after the update
+};
+
+class SemanticOdometry {
+ public:
+  explicit SemanticOdometry(OdometryConfig config);
+  ~SemanticOdometry();
+  SemanticOdometry(const SemanticOdometry&) = delete;
+  SemanticOdometry& operator=(const SemanticOdometry&) = delete;
+
+  /// Registers the next scan; returns its pose T_world<-sensor (world = the
+  /// first scan's sensor frame at its pose instant). Labels are used when the
+  /// cloud has them and semantics are on; otherwise everything is one class.
+  Pose register_frame(const LabelledCloud& cloud, double timestamp);
+
+  [[nodiscard]] const std::vector<Pose>& poses() const { return poses_; }
+  [[nodiscard]] const std::vector<double>& timestamps() const { return timestamps_; }
+  [[nodiscard]] const std::vector<FrameTimings>& timings() const { return timings_; }
+  [[nodiscard]] const FrameStats& last_frame_stats() const { return last_stats_; }
+  [[nodiscard]] const SemanticLocalMap& local_map() const { return map_; }
+  /// Features of the last frame (downsampled, de-skewed, classes grouped as
+  /// matched) in its sensor frame at the reported pose instant: poses().back()
+  /// maps them into the world.
+  [[nodiscard]] const ScanFeatures& last_features() const { return last_features_; }
+  [[nodiscard]] const OdometryConfig& config() const { return config_; }
+
+ private:
+  /// Constant-velocity prediction of the next mid-sweep pose.
+  struct MotionPrediction {
+    Pose pose = Pose::Identity();
+    Vector6d motion = Vector6d::Zero();  ///< expected twist over one frame
+    double period = 0.1;                 ///< [s] time since the previous frame
+  };
+
+  Pose process(const LabelledCloud& cloud, double timestamp);
+  ScanFeatures extract_frame_features(const LabelledCloud& cloud) const;
+  MotionPrediction predict_motion(double timestamp) const;
+  /// Downsamples `measured` in place and returns it de-skewed with the predicted motion.
+  ScanFeatures downsample_and_deskew(ScanFeatures& measured, const MotionPrediction& prediction) const;
+  /// Registers `features` to the local map; de-skews them again from
+  /// `measured` as the estimate moves. Returns the mid-sweep pose.
+  Pose align(ScanFeatures& features, ScanFeatures& measured, const MotionPrediction& prediction);
+  void update_map(const ScanFeatures& features, const Pose& sweep_pose);
+  /// Stores the frame and returns its pose at the pose instant.
+  Pose record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp, const FrameTimings& timing);
+
+  OdometryConfig config_;
+  RegistrationSettings settings_;
+  ClassVoxelSizes voxel_sizes_;
+  SemanticLocalMap map_;
+  std::unique_ptr<tbb::task_arena> arena_;
+  std::vector<Pose> poses_;        ///< reported: at pose_time_in_sweep, world = first pose
+  std::vector<Pose> sweep_poses_;  ///< internal: mid-sweep poses (de-skew reference)
+  Pose world_from_first_sweep_ = Pose::Identity();
+  std::vector<double> timestamps_;
+  std::vector<FrameTimings> timings_;
+  FrameStats last_stats_;
+  ScanFeatures last_features_;
+  ScanFeatures first_raw_;  ///< first frame's features before de-skewing (bootstrap)
+};
+
+}  // namespace saloam

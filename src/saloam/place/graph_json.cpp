@@ -1,0 +1,101 @@
+#include "saloam/place/graph_json.hpp"
+
+#include <cmath>
+#include <fstream>
+
+#include "saloam/core/error.hpp"
+
+namespace saloam {
+
+nlohmann::json graph_to_json(const SemanticGraph& graph) {
+  nlohmann::json j;
+  j["nodes"] = graph.nodes;
+  auto centers = nlohmann::json::array();
+  for (const auto& c : graph.centers) centers.push_back({c.x(), c.y(), c.z()});
+  j["centers"] = std::move(centers);
+  auto edges = nlohmann::json::array();
+  for (const auto& e : graph.edges) edges.push_back({e[0], e[1]});
+  j["edges"] = std::move(edges);
+  j["weights"] = graph.weights;
+  if (graph.pose) j["pose"] = *graph.pose;
+  return j;
+}
+
+SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem::path& source) {
+  auto fail = [&](const std::string& problem) { throw InputError(source, "semantic graph: " + problem); };
+  if (!json.is_object()) fail("top level is not a JSON object");
+  auto number = [&](const nlohmann::json& v, const std::string& what) {
+    if (!v.is_number()) fail(what + " is not a number");
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) fail(what + " is not finite");
+    return d;
+  };
+  SemanticGraph graph;
+  if (!json.contains("nodes") || !json["nodes"].is_array()) fail("missing array 'nodes'");
+  if (!json.contains("centers") || !json["centers"].is_array()) fail("missing array 'centers'");
+  for (std::size_t i = 0; i < json["nodes"].size(); ++i) {
+    const auto& v = json["nodes"][i];
+    if (!v.is_number_integer()) fail("nodes[" + std::to_string(i) + "] is not an integer");
+    const int label = v.get<int>();
+    if (label < 0 || label >= kNumNodeClasses)
+      fail("nodes[" + std::to_string(i) + "] = " + std::to_string(label) + " is not a node class 0..11");
+    graph.nodes.push_back(label);
+  }
+  for (std::size_t i = 0; i < json["centers"].size(); ++i) {
+    const auto& c = json["centers"][i];
+    const std::string what = "centers[" + std::to_string(i) + "]";
+    if (!c.is_array() || c.size() != 3) fail(what + " is not [x, y, z]");
+    graph.centers.emplace_back(number(c[0], what), number(c[1], what), number(c[2], what));
+  }
+  if (graph.centers.size() != graph.nodes.size())
+    fail(std::to_string(graph.nodes.size()) + " nodes but " + std::to_string(graph.centers.size()) + " centers");
+  if (json.contains("edges")) {
+    if (!json["edges"].is_array()) fail("'edges' is not an array");
+    for (std::size_t i = 0; i < json["edges"].size(); ++i) {
+      const auto& e = json["edges"][i];
+      const std::string what = "edges[" + std::to_string(i) + "]";
+      if (!e.is_array() || e.size() != 2 || !e[0].is_number_integer() || !e[1].is_number_integer())
+        fail(what + " is not a pair of node indices");
+      const int a = e[0].get<int>(), b = e[1].get<int>();
+      const int n = static_cast<int>(graph.nodes.size());
+      if (a < 0 || b < 0 || a >= n || b >= n) fail(what + " refers to a node that does not exist");
+      graph.edges.push_back({a, b});
+    }
+  }
+  if (json.contains("weights")) {
+    if (!json["weights"].is_array()) fail("'weights' is not an array");
+    for (std::size_t i = 0; i < json["weights"].size(); ++i)
+      graph.weights.push_back(number(json["weights"][i], "weights[" + std::to_string(i) + "]"));
+  }
+  if (graph.weights.size() != graph.edges.size())
+    fail(std::to_string(graph.edges.size()) + " edges but " + std::to_string(graph.weights.size()) + " weights");
+  if (json.contains("pose") && !json["pose"].is_null()) {
+    const auto& p = json["pose"];
+    if (!p.is_array() || p.size() != 12) fail("'pose' is not a list of 12 numbers");
+    std::array<double, 12> pose{};
+    for (std::size_t i = 0; i < 12; ++i) pose[i] = number(p[i], "pose[" + std::to_string(i) + "]");
+    graph.pose = pose;
+  }
+  return graph;
+}
+
+void write_graph_json(const std::filesystem::path& file, const SemanticGraph& graph) {
+  std::ofstream out(file);
+  if (!out) throw InputError(file, "cannot create graph file");
+  out << graph_to_json(graph).dump() << '\n';
+  if (!out) throw InputError(file, "write error");
+}
+
+SemanticGraph read_graph_json(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file, "graph file not found or not readable");
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(file, std::string("not valid JSON: ") + e.what());
+  }
+  return graph_from_json(json, file);
+}
+
+}  // namespace saloam

@@ -1,0 +1,82 @@
+#include "saloam/place/place_recognizer.hpp"
+
+#include <numbers>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+
+namespace saloam {
+
+PlaceDetector parse_place_detector(std::string_view name) {
+  if (name == "sgpr") return PlaceDetector::kSgpr;
+  if (name == "scancontext") return PlaceDetector::kScanContext;
+  if (name == "hybrid") return PlaceDetector::kHybrid;
+  throw ConfigError(fmt::format("unknown place-recognition detector '{}': use sgpr, scancontext or hybrid", name));
+}
+
+std::string_view place_detector_name(PlaceDetector detector) {
+  switch (detector) {
+    case PlaceDetector::kSgpr: return "sgpr";
+    case PlaceDetector::kScanContext: return "scancontext";
+    case PlaceDetector::kHybrid: return "hybrid";
+  }
+  return "?";
+}
+
+PlaceRecognizer::PlaceRecognizer(PlaceDetector detector, std::optional<SgprNetwork> network,
+                                 GraphBuilderConfig graph_config, ScanContextConfig context_config)
+    : detector_(detector),
+      network_(std::move(network)),
+      graph_config_(graph_config),
+      context_config_(context_config) {
+  if (uses_sgpr(detector_) && !network_) {
+    throw std::invalid_argument("PlaceRecognizer: the SGPR detector needs the network's weights");
+  }
+}
+
+PlaceDescriptor PlaceRecognizer::describe(const LabelledCloud& scan) const {
+  PlaceDescriptor d;
+  if (uses_sgpr(detector_)) {
+    d.graph = build_semantic_graph(scan, graph_config_);
+    d.embedding = network_->embed(d.graph);
+  }
+  if (uses_scan_context(detector_)) d.context = make_scan_context(scan.points, context_config_);
+  return d;
+}
+
+std::vector<PlaceMatch> PlaceRecognizer::match(const PlaceDescriptor& query,
+                                               std::span<const PlaceDescriptor* const> candidates) const {
+  std::vector<PlaceMatch> matches(candidates.size());
+  if (uses_sgpr(detector_)) {
+    std::vector<SgprEmbedding> embeddings;
+    embeddings.reserve(candidates.size());
+    for (const auto* c : candidates) embeddings.push_back(c->embedding);
+    const std::vector<double> scores = network_->score_batch(query.embedding, embeddings);
+    for (std::size_t k = 0; k < candidates.size(); ++k) matches[k].sgpr_score = scores[k];
+  }
+  if (uses_scan_context(detector_)) {
+    const double sector = 2.0 * std::numbers::pi / context_config_.num_sectors;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      const ScanContextMatch m = scan_context_distance(query.context, candidates[k]->context);
+      matches[k].scancontext_score = 1.0 - m.distance;
+      // The candidate's column d = c + shift sees what the query's column c
+      // sees: directions in the candidate frame are the query's turned by
+      // +shift sectors about z.
+      double yaw = m.shift * sector;
+      if (yaw > std::numbers::pi) yaw -= 2.0 * std::numbers::pi;
+      matches[k].yaw = yaw;
+    }
+  }
+  for (auto& m : matches) {
+    switch (detector_) {
+      case PlaceDetector::kSgpr: m.score = m.sgpr_score; break;
+      case PlaceDetector::kScanContext: m.score = m.scancontext_score; break;
+      case PlaceDetector::kHybrid: m.score = 0.5 * (m.sgpr_score + m.scancontext_score); break;
+    }
+  }
+  return matches;
+}
+
+}  // namespace saloam

@@ -1,0 +1,349 @@
+#include "saloam/place/semantic_graph.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numeric>
+
+#include <nanoflann.hpp>
+
+#include "saloam/core/semantic_classes.hpp"
+
+namespace saloam {
+namespace {
+
+constexpr std::array<std::string_view, kNumNodeClasses> kNodeClassNames{
+    "car",      "truck", "other-vehicle", "sidewalk", "other-ground", "building",
+    "fence",    "vegetation", "trunk",    "terrain",  "pole",         "traffic-sign"};
+
+// ---------------------------------------------------------------- union-find
+class DisjointSets {
+ public:
+  explicit DisjointSets(std::size_t n) : parent_(n) { std::iota(parent_.begin(), parent_.end(), 0U); }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent_[x] != x) {
+      parent_[x] = parent_[parent_[x]];  // path halving
+      x = parent_[x];
+    }
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return;
+    if (a > b) std::swap(a, b);
+    parent_[b] = a;  // smaller root wins: deterministic
+  }
+
+ private:
+  std::vector<std::uint32_t> parent_;
+};
+
+// ------------------------------------------------------ voxel hash (cells)
+constexpr int kCellBits = 21;
+constexpr std::int64_t kCellOffset = std::int64_t{1} << (kCellBits - 1);
+
+inline std::uint64_t pack_cell(std::int64_t x, std::int64_t y, std::int64_t z) {
+  const auto mask = (std::uint64_t{1} << kCellBits) - 1;
+  return (static_cast<std::uint64_t>(x + kCellOffset) & mask) << (2 * kCellBits) |
+         (static_cast<std::uint64_t>(y + kCellOffset) & mask) << kCellBits |
+         (static_cast<std::uint64_t>(z + kCellOffset) & mask);
+}
+
+/// Open-addressing map from packed cell key to cell index (keys never 0 here
+/// because of the offset; 0 marks an empty slot).
+class CellTable {
+ public:
+  explicit CellTable(std::size_t cells) {
+    std::size_t capacity = 16;
+    while (capacity < 2 * cells) capacity <<= 1;
+    keys_.assign(capacity, 0);
+    values_.assign(capacity, 0);
+    mask_ = capacity - 1;
+  }
+  void insert(std::uint64_t key, std::uint32_t value) {
+    std::size_t slot = hash(key);
+    while (keys_[slot] != 0) slot = (slot + 1) & mask_;
+    keys_[slot] = key;
+    values_[slot] = value;
+  }
+  [[nodiscard]] std::int64_t find(std::uint64_t key) const {
+    std::size_t slot = hash(key);
+    while (keys_[slot] != 0) {
+      if (keys_[slot] == key) return values_[slot];
+      slot = (slot + 1) & mask_;
+    }
+    return -1;
+  }
+
+ private:
+  [[nodiscard]] std::size_t hash(std::uint64_t key) const {
+    key ^= key >> 29;
+    key *= 0xbf58476d1ce4e5b9ULL;
+    key ^= key >> 32;
+    return static_cast<std::size_t>(key) & mask_;
+  }
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint32_t> values_;
+  std::size_t mask_ = 0;
+};
+
+// ------------------------------------------------- kd-tree over a cluster
+struct ClusterPoints {
+  const LabelledCloud* cloud;
+  const std::vector<std::uint32_t>* indices;
+  [[nodiscard]] std::size_t kdtree_get_point_count() const { return indices->size(); }
+  [[nodiscard]] float kdtree_get_pt(std::size_t i, std::size_t dim) const {
+    return cloud->points[(*indices)[i]][static_cast<Eigen::Index>(dim)];
+  }
+  template <class Box>
+  bool kdtree_get_bbox(Box&) const {
+    return false;
+  }
+};
+using ClusterTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, ClusterPoints>,
+                                                        ClusterPoints, 3, std::uint32_t>;
+
+struct Box {
+  Eigen::Vector3f min = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+  Eigen::Vector3f max = Eigen::Vector3f::Constant(std::numeric_limits<float>::lowest());
+  [[nodiscard]] float distance_squared(const Eigen::Vector3f& p) const {
+    const Eigen::Vector3f d = (min - p).cwiseMax(p - max).cwiseMax(0.0F);
+    return d.squaredNorm();
+  }
+  [[nodiscard]] float distance_squared(const Box& o) const {
+    const Eigen::Vector3f d = (min - o.max).cwiseMax(o.min - max).cwiseMax(0.0F);
+    return d.squaredNorm();
+  }
+};
+
+Box bounding_box(const LabelledCloud& cloud, const Cluster& c) {
+  Box b;
+  for (const auto i : c.points) {
+    b.min = b.min.cwiseMin(cloud.points[i]);
+    b.max = b.max.cwiseMax(cloud.points[i]);
+  }
+  return b;
+}
+
+/// Exact nearest-point distance of `query` to the points in `tree`, bounded:
+/// query points are visited in order of their distance to the tree's box, and
+/// the search stops once that lower bound exceeds the best distance found.
+double bounded_cluster_distance(const LabelledCloud& cloud, const Cluster& query, const Box& tree_box,
+                                const ClusterTree& tree, double max_distance) {
+  const float limit_sq = static_cast<float>(max_distance * max_distance);
+  std::vector<std::pair<float, std::uint32_t>> order;
+  for (const auto i : query.points) {
+    const float d = tree_box.distance_squared(cloud.points[i]);
+    if (d <= limit_sq) order.emplace_back(d, i);
+  }
+  std::sort(order.begin(), order.end());
+  float best = std::numeric_limits<float>::infinity();
+  for (const auto& [bound, i] : order) {
+    if (bound >= best) break;
+    std::uint32_t nearest = 0;
+    float d_sq = 0;
+    tree.knnSearch(cloud.points[i].data(), 1, &nearest, &d_sq);
+    best = std::min(best, d_sq);
+  }
+  const double d = std::sqrt(static_cast<double>(best));
+  return d <= max_distance ? d : std::numeric_limits<double>::infinity();
+}
+
+}  // namespace
+
+std::optional<int> node_class_of(std::uint16_t raw_label) {
+  switch (to_learning_class(static_class(raw_label))) {
+    case 1: return node_class::kCar;
+    case 4: return node_class::kTruck;
+    case 5: return node_class::kOtherVehicle;  // bus, on-rails, other-vehicle
+    case 11: return node_class::kSidewalk;
+    case 12: return node_class::kOtherGround;
+    case 13: return node_class::kBuilding;
+    case 14: return node_class::kFence;
+    case 15: return node_class::kVegetation;
+    case 16: return node_class::kTrunk;
+    case 17: return node_class::kTerrain;
+    case 18: return node_class::kPole;
+    case 19: return node_class::kTrafficSign;
+    default: return std::nullopt;  // road, parking, people, two-wheelers, unlabeled
+  }
+}
+
+std::string_view node_class_name(int node_class) {
+  if (node_class < 0 || node_class >= kNumNodeClasses) return "unknown";
+  return kNodeClassNames[static_cast<std::size_t>(node_class)];
+}
+
+std::vector<std::vector<std::uint32_t>> euclidean_clusters(std::span<const Eigen::Vector3f> points,
+                                                           std::span<const std::uint32_t> indices,
+                                                           double tolerance, std::size_t min_size,
+                                                           std::size_t max_size) {
+  std::vector<std::vector<std::uint32_t>> clusters;
+  if (indices.empty() || !(tolerance > 0)) return clusters;
+  // Cells of edge tolerance / sqrt(3): two points in one cell are at most
+  // `tolerance` apart, so a cell is connected without tests and only the
+  // 5x5x5 block of cells around it can hold neighbours.
+  const double cell = tolerance / std::sqrt(3.0) * (1.0 - 1e-9);
+  const float tol_sq = static_cast<float>(tolerance * tolerance);
+  const std::size_t n = indices.size();
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);  // (cell key, position in indices)
+  for (std::size_t k = 0; k < n; ++k) {
+    const Eigen::Vector3f& p = points[indices[k]];
+    keyed[k] = {pack_cell(static_cast<std::int64_t>(std::floor(p.x() / cell)),
+                          static_cast<std::int64_t>(std::floor(p.y() / cell)),
+                          static_cast<std::int64_t>(std::floor(p.z() / cell))),
+                static_cast<std::uint32_t>(k)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> cell_start;  // cell c holds keyed[cell_start[c] .. cell_start[c+1])
+  for (std::size_t k = 0; k < n; ++k)
+    if (k == 0 || keyed[k].first != keyed[k - 1].first) cell_start.push_back(static_cast<std::uint32_t>(k));
+  const std::size_t num_cells = cell_start.size();
+  cell_start.push_back(static_cast<std::uint32_t>(n));
+  CellTable table(num_cells);
+  for (std::size_t c = 0; c < num_cells; ++c) table.insert(keyed[cell_start[c]].first, static_cast<std::uint32_t>(c));
+
+  const auto unpack = [](std::uint64_t key, int shift) {
+    const auto mask = (std::uint64_t{1} << kCellBits) - 1;
+    return static_cast<std::int64_t>((key >> shift) & mask) - kCellOffset;
+  };
+  DisjointSets sets(num_cells);
+  for (std::size_t a = 0; a < num_cells; ++a) {
+    const std::uint64_t key = keyed[cell_start[a]].first;
+    const std::int64_t cx = unpack(key, 2 * kCellBits), cy = unpack(key, kCellBits), cz = unpack(key, 0);
+    for (int dx = -2; dx <= 2; ++dx)
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dz = -2; dz <= 2; ++dz) {
+          // Visit each unordered pair of cells once (lexicographically positive offsets).
+          if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
+          const std::int64_t b = table.find(pack_cell(cx + dx, cy + dy, cz + dz));
+          if (b < 0) continue;
+          const auto cb = static_cast<std::uint32_t>(b);
+          if (sets.find(static_cast<std::uint32_t>(a)) == sets.find(cb)) continue;
+          bool joined = false;
+          for (std::uint32_t i = cell_start[a]; i < cell_start[a + 1] && !joined; ++i) {
+            const Eigen::Vector3f& p = points[indices[keyed[i].second]];
+            for (std::uint32_t j = cell_start[cb]; j < cell_start[cb + 1]; ++j) {
+              if ((points[indices[keyed[j].second]] - p).squaredNorm() <= tol_sq) {
+                joined = true;
+                break;
+              }
+            }
+          }
+          if (joined) sets.unite(static_cast<std::uint32_t>(a), cb);
+        }
+  }
+
+  // Components in order of their first input position; points in input order.
+  std::vector<std::uint32_t> cell_of(n);
+  for (std::size_t c = 0; c < num_cells; ++c)
+    for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) cell_of[keyed[k].second] = static_cast<std::uint32_t>(c);
+  std::vector<std::uint32_t> root_size(num_cells, 0);
+  for (std::size_t k = 0; k < n; ++k) ++root_size[sets.find(cell_of[k])];
+  std::vector<std::int64_t> cluster_of_root(num_cells, -1);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::uint32_t root = sets.find(cell_of[k]);
+    if (root_size[root] < min_size || root_size[root] > max_size) continue;
+    if (cluster_of_root[root] < 0) {
+      cluster_of_root[root] = static_cast<std::int64_t>(clusters.size());
+      clusters.emplace_back();
+      clusters.back().reserve(root_size[root]);
+    }
+    clusters[static_cast<std::size_t>(cluster_of_root[root])].push_back(indices[k]);
+  }
+  return clusters;
+}
+
+std::vector<Cluster> extract_clusters(const LabelledCloud& cloud, const GraphBuilderConfig& config) {
+  // Points per node class; vehicle points with an instance id go by instance.
+  std::array<std::vector<std::uint32_t>, kNumNodeClasses> geometric;
+  std::array<std::map<std::uint16_t, std::vector<std::uint32_t>>, kNumNodeClasses> instances;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const auto nc = node_class_of(cloud.label[i]);
+    if (!nc) continue;
+    const auto index = static_cast<std::uint32_t>(i);
+    const bool vehicle = *nc == node_class::kCar || *nc == node_class::kTruck || *nc == node_class::kOtherVehicle;
+    if (config.use_instances && vehicle && cloud.instance[i] != 0)
+      instances[static_cast<std::size_t>(*nc)][cloud.instance[i]].push_back(index);
+    else
+      geometric[static_cast<std::size_t>(*nc)].push_back(index);
+  }
+  std::vector<Cluster> clusters;
+  for (int c = 0; c < kNumNodeClasses; ++c) {
+    const auto uc = static_cast<std::size_t>(c);
+    for (auto& [id, members] : instances[uc]) {
+      if (members.size() <= config.min_instance_points) continue;
+      clusters.push_back({c, std::move(members), Eigen::Vector3d::Zero()});
+    }
+    for (auto& members : euclidean_clusters(cloud.points, geometric[uc], config.tolerance[uc],
+                                            config.min_cluster_size[uc], config.max_cluster_size))
+      clusters.push_back({c, std::move(members), Eigen::Vector3d::Zero()});
+  }
+  for (auto& cluster : clusters) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto i : cluster.points) sum += cloud.points[i].cast<double>();
+    cluster.centroid = sum / static_cast<double>(cluster.points.size());
+  }
+  return clusters;
+}
+
+double cluster_distance(const LabelledCloud& cloud, const Cluster& a, const Cluster& b, double max_distance) {
+  const Cluster& small = a.points.size() <= b.points.size() ? a : b;
+  const Cluster& large = a.points.size() <= b.points.size() ? b : a;
+  const ClusterPoints data{&cloud, &large.points};
+  const ClusterTree tree(3, data, nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  return bounded_cluster_distance(cloud, small, bounding_box(cloud, large), tree, max_distance);
+}
+
+SemanticGraph build_semantic_graph(const LabelledCloud& cloud, const GraphBuilderConfig& config) {
+  std::vector<Cluster> clusters = extract_clusters(cloud, config);
+  if (clusters.size() > config.max_nodes) {
+    // Deterministic cap: the largest clusters (ties: lower class, earlier cluster), original order kept.
+    std::vector<std::size_t> order(clusters.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+      if (clusters[x].points.size() != clusters[y].points.size())
+        return clusters[x].points.size() > clusters[y].points.size();
+      return clusters[x].node_class < clusters[y].node_class;
+    });
+    order.resize(config.max_nodes);
+    std::sort(order.begin(), order.end());
+    std::vector<Cluster> kept;
+    kept.reserve(order.size());
+    for (const auto k : order) kept.push_back(std::move(clusters[k]));
+    clusters = std::move(kept);
+  }
+
+  SemanticGraph graph;
+  for (const auto& c : clusters) {
+    graph.nodes.push_back(c.node_class);
+    graph.centers.push_back(c.centroid);
+  }
+  // Edges: nearest points within edge_distance, weight 1 - d / edge_distance.
+  const std::size_t n = clusters.size();
+  std::vector<Box> boxes(n);
+  for (std::size_t i = 0; i < n; ++i) boxes[i] = bounding_box(cloud, clusters[i]);
+  std::vector<std::unique_ptr<ClusterPoints>> data(n);
+  std::vector<std::unique_ptr<ClusterTree>> trees(n);  // built lazily, for the larger cluster of a pair
+  const auto limit_sq = static_cast<float>(config.edge_distance * config.edge_distance);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t j = i + 1; j < n; ++j) {
+      if (boxes[i].distance_squared(boxes[j]) > limit_sq) continue;
+      const bool i_small = clusters[i].points.size() <= clusters[j].points.size();
+      const std::size_t s = i_small ? i : j, l = i_small ? j : i;
+      if (!trees[l]) {
+        data[l] = std::make_unique<ClusterPoints>(ClusterPoints{&cloud, &clusters[l].points});
+        trees[l] = std::make_unique<ClusterTree>(3, *data[l], nanoflann::KDTreeSingleIndexAdaptorParams(16));
+      }
+      const double d = bounded_cluster_distance(cloud, clusters[s], boxes[l], *trees[l], config.edge_distance);
+      if (!std::isfinite(d)) continue;
+      graph.edges.push_back({static_cast<int>(i), static_cast<int>(j)});
+      graph.weights.push_back(1.0 - d / config.edge_distance);
+    }
+  return graph;
+}
+
+}  // namespace saloam

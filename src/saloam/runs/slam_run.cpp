@@ -1,0 +1,311 @@
+#include "saloam/runs/slam_run.hpp"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/core/progress.hpp"
+#include "saloam/eval/evaluation_report.hpp"
+#include "saloam/io/ply.hpp"
+#include "saloam/mapping/map_render.hpp"
+#include "saloam/place/graph_json.hpp"
+#include "saloam/runs/map_building.hpp"
+#include "saloam/runs/odometry_run.hpp"
+#include "saloam/runs/trajectory_writer.hpp"
+#include "saloam/viz/canvas.hpp"
+
+namespace saloam {
+
+namespace {
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+double mean_of(const std::vector<double>& v) {
+  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+}
+
+double peak_rss_mib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+std::string pose_numbers(const Pose& T) {
+  double v[12];
+  pose_to_3x4(T, v);
+  return fmt::format("{:.6f}", fmt::join(v, v + 12, " "));
+}
+
+void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, const std::vector<Pose>* gt) {
+  std::ofstream out(file);
+  if (!out) throw InputError(file, "cannot write loop file");
+  out << "query_frame,match_frame,query_keyframe,match_keyframe,travelled_m,score,sgpr_score,scancontext_score,"
+         "descriptor_yaw_deg,guess,features,correspondences,inliers,inlier_fraction,mean_residual_m,loss_r,"
+         "translation_eigenvalue,converged,passes_loss_test,passes_normalized_test,accepted,reason,"
+         "relative_pose_3x4";
+  if (gt) out << ",gt_distance_m,gt_yaw_deg,translation_error_m,rotation_error_deg,correct";
+  out << '\n';
+  for (const auto& loop : slam.loops()) {
+    const auto& v = loop.verification;
+    const auto& r = v.registration;
+    out << fmt::format("{},{},{},{},{:.2f},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{:.4f},{:.4f},{:.2f},{:.4f},{:d},{:d},{:d},{:d},\"{}\",{}",
+                       loop.query_frame, loop.match_frame, loop.query_keyframe, loop.match_keyframe, loop.travelled,
+                       loop.score.score, loop.score.sgpr_score, loop.score.scancontext_score,
+                       loop.score.yaw ? fmt::format("{:.1f}", *loop.score.yaw * 180.0 / M_PI) : std::string(),
+                       v.guess, v.features, r.correspondences(), r.inliers, v.inlier_fraction, v.mean_residual,
+                       r.loss, v.translation_eigenvalue, r.converged, v.passes_loss_test, v.passes_normalized_test,
+                       v.accepted, v.reason, pose_numbers(v.relative));
+    if (gt) {
+      const LoopTruth t = loop_truth(loop, *gt);
+      out << fmt::format(",{:.3f},{:.1f},{:.3f},{:.3f},{:d}", t.gt_distance, t.gt_yaw_deg, t.translation_error,
+                         t.rotation_error_deg, t.correct);
+    }
+    out << '\n';
+  }
+}
+
+void write_graph_map(const std::filesystem::path& file, const SlamSystem& slam) {
+  nlohmann::json keyframes = nlohmann::json::array();
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
+    const Keyframe& kf = slam.keyframes()[k];
+    nlohmann::json j = graph_to_json(kf.place.graph);
+    double pose[12];
+    pose_to_3x4(slam.keyframe_pose(k), pose);
+    j["frame"] = kf.frame;
+    j["pose"] = std::vector<double>(pose, pose + 12);
+    keyframes.push_back(std::move(j));
+  }
+  std::ofstream out(file);
+  if (!out) throw InputError(file, "cannot write graph map");
+  out << nlohmann::json{{"frame", "LiDAR, world = first frame"}, {"keyframes", keyframes}}.dump() << '\n';
+}
+
+void write_timing(const std::filesystem::path& file, const SlamSystem& slam, double seconds, double rss_mib) {
+  std::vector<double> odometry, place, search, verification, optimization, loop, total;
+  for (const auto& t : slam.timings()) {
+    odometry.push_back(t.odometry_ms);
+    place.push_back(t.place_ms);
+    search.push_back(t.search_ms);
+    verification.push_back(t.verification_ms);
+    optimization.push_back(t.optimization_ms);
+    loop.push_back(t.loop_ms());
+    total.push_back(t.total_ms());
+  }
+  auto stats = [](const std::vector<double>& ms) {
+    return nlohmann::json{{"mean_ms", mean_of(ms)},
+                          {"median_ms", median_of(ms)},
+                          {"max_ms", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())},
+                          {"total_s", std::accumulate(ms.begin(), ms.end(), 0.0) / 1000.0}};
+  };
+  const double median = median_of(total);
+  const double mean = mean_of(total);
+  const nlohmann::json j{
+      {"frames", total.size()},
+      {"keyframes", slam.keyframes().size()},
+      {"optimizations", slam.optimizations()},
+      {"wall_s", seconds},
+      {"hz_median", median > 0 ? 1000.0 / median : 0.0},
+      {"hz_mean", mean > 0 ? 1000.0 / mean : 0.0},
+      {"peak_rss_mib", rss_mib},
+      {"keyframe_store_mib", static_cast<double>(slam.keyframe_bytes()) / (1024.0 * 1024.0)},
+      {"stages",
+       {{"odometry", stats(odometry)},
+        {"place_descriptor", stats(place)},
+        {"candidates_and_scoring", stats(search)},
+        {"verification", stats(verification)},
+        {"pose_graph", stats(optimization)},
+        {"loop_closure_total", stats(loop)},
+        {"total", stats(total)}}}};
+  std::ofstream out(file);
+  if (!out) throw InputError(file, "cannot write timing file");
+  out << j.dump(2) << '\n';
+}
+
+std::vector<Eigen::Vector2d> top_down(const std::vector<Pose>& poses, std::pair<int, int> axes) {
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(poses.size());
+  for (const auto& p : poses) points.emplace_back(p.translation()[axes.first], p.translation()[axes.second]);
+  return points;
+}
+
+void plot_trajectories(const std::filesystem::path& file, const std::vector<Pose>& odometry,
+                       const std::vector<Pose>& slam, const std::vector<Pose>* gt, std::size_t loops) {
+  const auto axes = top_down_axes(gt ? *gt : slam);
+  Plot plot(1000, 900);
+  std::vector<Eigen::Vector2d> all = top_down(odometry, axes);
+  const auto slam_points = top_down(slam, axes);
+  all.insert(all.end(), slam_points.begin(), slam_points.end());
+  if (gt) {
+    const auto g = top_down(*gt, axes);
+    all.insert(all.end(), g.begin(), g.end());
+  }
+  plot.fit_range(all, true);
+  plot.set_title(fmt::format("trajectories ({} loops accepted)", loops));
+  plot.set_labels("x [m]", axes.second == 2 ? "z [m]" : "y [m]");
+  std::vector<LegendEntry> legend;
+  if (gt) {
+    plot.line(top_down(*gt, axes), Rgb{120, 120, 120}, 3.0);
+    legend.push_back({"ground truth", Rgb{120, 120, 120}});
+  }
+  plot.line(top_down(odometry, axes), Rgb{214, 39, 40}, 1.5, true);
+  legend.push_back({"odometry", Rgb{214, 39, 40}});
+  plot.line(slam_points, Rgb{31, 119, 180}, 1.8);
+  legend.push_back({"loop closed", Rgb{31, 119, 180}});
+  plot.legend(legend);
+  plot.save_png(file);
+}
+
+}  // namespace
+
+std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config, const std::filesystem::path& fallback_model) {
+  if (!uses_sgpr(parse_place_detector(config.loop.detector))) return std::nullopt;
+  const std::filesystem::path model =
+      config.loop.sgpr_model.empty() ? fallback_model : std::filesystem::path(config.loop.sgpr_model);
+  if (model.empty()) {
+    throw ConfigError(fmt::format("loop.detector '{}' needs SGPR weights: give --set loop.sgpr_model=FILE.sgw",
+                                  config.loop.detector));
+  }
+  return SgprNetwork::load(model);
+}
+
+SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
+  const std::size_t first = options.first_frame;
+  const std::size_t end = std::min(options.end_frame, reader.size());
+  if (first >= end) throw ConfigError(fmt::format("empty frame range {}:{} ({} frames)", first, end, reader.size()));
+  if (config.odometry.use_semantics && !reader.has_labels()) {
+    spdlog::warn("{}: no labels found; running with every point in one class", reader.root().string());
+  }
+  std::optional<Pose> tr;
+  if (reader.has_calib()) {
+    tr = reader.velo_to_cam();
+  } else {
+    spdlog::warn("{}: no calib.txt; pose files hold LiDAR-frame poses, not the KITTI camera convention",
+                 reader.root().string());
+  }
+  std::filesystem::create_directories(out_dir);
+
+  SlamSystem slam(config, std::move(network));
+  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  ProgressBar progress(end - first, "slam", options.show_progress);
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t i = first; i < end && !stop_requested(); ++i) {
+    const double t = reader.times().at(i);
+    odometry_writer.write(t, slam.process(reader.load_scan(i), t));
+    progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
+    progress.advance();
+  }
+  progress.finish();
+
+  SlamRunResult result;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.interrupted = stop_requested();
+  result.frames = slam.odometry_poses().size();
+  result.keyframes = slam.keyframes().size();
+  result.loops_accepted = slam.accepted_loops();
+  result.loops_verified = slam.loops().size();
+  result.peak_rss_mib = peak_rss_mib();
+  std::vector<double> totals, loops;
+  for (const auto& t : slam.timings()) {
+    totals.push_back(t.total_ms());
+    loops.push_back(t.loop_ms());
+  }
+  result.median_frame_ms = median_of(totals);
+  result.mean_loop_ms = mean_of(loops);
+
+  const std::vector<Pose> optimized = slam.optimized_poses();
+  write_trajectory(out_dir / "poses.txt", out_dir / "poses_tum.txt", slam.timestamps(), optimized, tr);
+  write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
+
+  // Ground truth of the processed frames, LiDAR frame (loops) and camera frame (trajectories).
+  std::optional<std::vector<Pose>> gt_lidar, gt_output;
+  if (reader.has_poses()) {
+    const auto& camera = reader.camera_poses();
+    std::vector<Pose> slice(camera.begin() + static_cast<std::ptrdiff_t>(first),
+                            camera.begin() + static_cast<std::ptrdiff_t>(first + result.frames));
+    const Pose rebase = slice.front().inverse();  // world = first processed frame, as the estimates
+    for (auto& p : slice) p = orthonormalized(rebase * p);
+    gt_output = slice;
+    if (tr) {
+      gt_lidar.emplace();
+      for (const auto& p : slice) gt_lidar->push_back(orthonormalized(tr->inverse() * p * *tr));
+    }
+  }
+  write_loops_csv(out_dir / "loops.csv", slam, gt_lidar ? &*gt_lidar : nullptr);
+  if (uses_sgpr(parse_place_detector(config.loop.detector))) write_graph_map(out_dir / "graph_map.json", slam);
+  const std::vector<Pose> odometry_out = output_poses(slam.odometry_poses(), tr);
+  const std::vector<Pose> slam_out = output_poses(optimized, tr);
+  plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, gt_output ? &*gt_output : nullptr,
+                    slam.accepted_loops());
+
+  nlohmann::json summary{{"frames", result.frames},
+                         {"keyframes", result.keyframes},
+                         {"detector", config.loop.detector},
+                         {"loops_verified", result.loops_verified},
+                         {"loops_accepted", result.loops_accepted},
+                         {"interrupted", result.interrupted}};
+  if (gt_output && result.frames >= 2) {
+    result.odometry_evaluation = evaluate_trajectories(*gt_output, odometry_out);
+    result.slam_evaluation = evaluate_trajectories(*gt_output, slam_out);
+    const EvaluationLabels odometry_labels{"ground truth", "poses_odometry.txt"};
+    const EvaluationLabels slam_labels{"ground truth", "poses.txt"};
+    write_evaluation_json(out_dir / "eval_odometry.json", *result.odometry_evaluation, odometry_labels);
+    write_evaluation_json(out_dir / "eval_slam.json", *result.slam_evaluation, slam_labels);
+    plot_evaluation(out_dir / "eval_odometry.png", *gt_output, odometry_out, *result.odometry_evaluation,
+                    odometry_labels);
+    plot_evaluation(out_dir / "eval_slam.png", *gt_output, slam_out, *result.slam_evaluation, slam_labels);
+    summary["odometry"] = evaluation_to_json(*result.odometry_evaluation, odometry_labels, false);
+    summary["slam"] = evaluation_to_json(*result.slam_evaluation, slam_labels, false);
+  }
+  if (gt_lidar) {
+    LoopTruthOptions truth_options;
+    truth_options.exclude_recent_distance = config.loop.exclude_recent_distance;
+    result.loop_summary = summarize_loops(slam, *gt_lidar, truth_options);
+    const LoopSummary& s = *result.loop_summary;
+    summary["loops"] = {{"accepted_true", s.accepted_true},
+                        {"accepted_false", s.accepted_false},
+                        {"accepted_reverse", s.accepted_reverse},
+                        {"rejected_but_correct", s.rejected_true},
+                        {"revisit_keyframes", s.revisit_keyframes},
+                        {"revisit_stretches", s.revisit_stretches},
+                        {"missed_stretches", s.missed_stretches},
+                        {"reverse_stretches", s.reverse_stretches},
+                        {"missed_reverse_stretches", s.missed_reverse_stretches}};
+  }
+  {
+    std::ofstream out(out_dir / "summary.json");
+    out << summary.dump(2) << '\n';
+  }
+
+  if (options.write_map && !result.interrupted) {
+    SemanticMapOptions map_options;
+    map_options.voxel_size = config.slam.map_voxel_size;
+    const LabelledCloud map = build_semantic_map(reader, optimized, first, map_options,
+                                                 static_cast<std::size_t>(std::max(1, config.slam.map_frame_step)),
+                                                 options.show_progress);
+    write_ply(out_dir / "map.ply", map);
+    std::vector<WorldSegment> links;
+    for (const auto& loop : slam.loops()) {
+      if (!loop.verification.accepted) continue;
+      links.emplace_back(optimized[loop.match_frame].translation(), optimized[loop.query_frame].translation());
+    }
+    render_top_down(out_dir / "map.png", map, optimized, {}, links);
+  }
+  return result;
+}
+
+}  // namespace saloam

@@ -1,0 +1,60 @@
+#pragma once
+// Runs the whole SLAM system over a sequence folder and writes its results:
+//   poses.txt, poses_tum.txt                    after loop closure (KITTI camera frame / TUM LiDAR frame)
+//   poses_odometry.txt, poses_odometry_tum.txt  odometry only, flushed frame by frame
+//   loops.csv        every verified candidate: scores, fit, decision, relative pose (and its truth with GT)
+//   graph_map.json   the keyframes' semantic graphs with their optimised poses (when SGPR built them)
+//   map.ply, map.png the global semantic map rebuilt from the optimised poses, with the loop edges
+//   trajectories.png odometry, loop-closed and (when known) ground-truth trajectories
+//   timing.json      per-stage timings, Hz, memory
+//   eval_odometry.{json,png}, eval_slam.{json,png}, summary.json  with SEQ/poses.txt
+// Ctrl-C ends the frame loop; everything above is still written for the
+// frames processed.
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/types.hpp"
+#include "saloam/eval/trajectory_metrics.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/runs/loop_truth.hpp"
+#include "saloam/slam/slam_system.hpp"
+
+namespace saloam {
+
+struct SlamRunOptions {
+  std::size_t first_frame = 0;
+  std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the sequence
+  bool show_progress = true;
+  bool write_map = true;  ///< map.ply / map.png (re-reads the scans)
+};
+
+struct SlamRunResult {
+  std::size_t frames = 0;
+  std::size_t keyframes = 0;
+  std::size_t loops_accepted = 0;
+  std::size_t loops_verified = 0;
+  bool interrupted = false;
+  double seconds = 0;                ///< wall time of the frame loop
+  double median_frame_ms = 0;        ///< odometry + loop closure
+  double mean_loop_ms = 0;           ///< loop closure's share per frame, amortised
+  double peak_rss_mib = 0;
+  std::optional<TrajectoryEvaluation> odometry_evaluation, slam_evaluation;
+  std::optional<LoopSummary> loop_summary;
+};
+
+/// Loads the SGPR network when the configured detector needs one: the
+/// config's loop.sgpr_model, else `fallback_model`; ConfigError when neither is set.
+std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config, const std::filesystem::path& fallback_model);
+
+/// Runs SlamSystem over frames [first_frame, end_frame) of `reader`, writing into `out_dir` (created).
+SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options = {});
+
+}  // namespace saloam

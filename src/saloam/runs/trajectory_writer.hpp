@@ -1,0 +1,40 @@
+#pragma once
+// Writes a trajectory as it is computed, in the two formats every run emits:
+//   KITTI (12 numbers a line): camera-frame convention of the ground truth,
+//     P_i = Tr Q_i Tr^-1, so `saloam eval`, the KITTI devkit and evo compare it
+//     with poses.txt directly; LiDAR-frame poses when no Tr is known
+//   TUM (timestamp x y z qx qy qz qw): LiDAR-frame poses Q_i = T_L0<-Li
+// Each line is flushed as soon as it is written: an interrupted run keeps
+// every frame it finished.
+
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <vector>
+
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+class TrajectoryWriter {
+ public:
+  /// Creates (truncates) both files; InputError when they cannot be written.
+  TrajectoryWriter(const std::filesystem::path& kitti_file, const std::filesystem::path& tum_file,
+                   std::optional<Pose> velo_to_cam);
+  /// Appends one pose (LiDAR frame) and returns the pose written to the KITTI file.
+  Pose write(double timestamp, const Pose& lidar_pose);
+
+ private:
+  std::optional<Pose> velo_to_cam_;
+  std::ofstream kitti_, tum_;
+};
+
+/// The KITTI-file poses of LiDAR-frame poses (camera convention when Tr is given).
+std::vector<Pose> output_poses(const std::vector<Pose>& lidar_poses, const std::optional<Pose>& velo_to_cam);
+
+/// Writes a whole trajectory with a TrajectoryWriter.
+void write_trajectory(const std::filesystem::path& kitti_file, const std::filesystem::path& tum_file,
+                      const std::vector<double>& timestamps, const std::vector<Pose>& lidar_poses,
+                      const std::optional<Pose>& velo_to_cam);
+
+}  // namespace saloam

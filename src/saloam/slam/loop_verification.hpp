@@ -1,0 +1,82 @@
+#pragma once
+// Geometric verification of a loop candidate (paper Sec. III-C): the
+// semantic-assisted ICP of the odometry registers the query keyframe's
+// features against a submap of the keyframes around the candidate, and the
+// registration's fit decides.
+//
+// Frames: the submap is expressed in the candidate keyframe's sensor frame;
+// the result is T_candidate<-query. Registration runs coarse to fine (a wide
+// correspondence radius first, then the odometry's), from each initial guess
+// given (the current pose estimates, which drift, and a descriptor's yaw,
+// which survives drift and reverse-direction revisits); the guess whose fine
+// fit has the most inliers wins.
+//
+// Two acceptance tests, both always computed:
+//  - "loss", the paper's: r < delta_r, r being Eq. 2's weighted sum of
+//    point-to-line and point-to-plane distances over all correspondences. It
+//    grows with the number of features a scan has.
+//  - "normalized": the mean residual of the inliers, the fraction of the
+//    query's features that found an inlier correspondence, and the smallest
+//    eigenvalue of the translation block of the Hessian per correspondence
+//    (a straight road with nothing across it constrains no translation along
+//    it: such a fit may not be trusted).
+
+#include <span>
+#include <string>
+#include <vector>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/types.hpp"
+#include "saloam/odometry/local_map.hpp"
+#include "saloam/odometry/registration.hpp"
+
+namespace saloam {
+
+struct LoopVerificationSettings {
+  RegistrationSettings coarse;  ///< wide radius, loose kernel: converges from metres off
+  RegistrationSettings fine;    ///< the odometry's settings, more iterations
+  ClassVoxelSizes voxel_size{};
+  bool loss_test = false;       ///< true: the paper's r < delta_r decides; false: the normalized test
+  double delta_r = 100.0;
+  double max_mean_residual = 0.06;
+  double min_inlier_fraction = 0.45;
+  double min_translation_eigenvalue = 0.02;
+
+  static LoopVerificationSettings from_config(const SaloamConfig& config);
+};
+
+/// Features of the keyframes around a candidate, in the candidate's sensor
+/// frame, indexed at the coarse and the fine radius.
+class LoopSubmap {
+ public:
+  explicit LoopSubmap(const LoopVerificationSettings& settings);
+  /// Adds one keyframe's features given in its own sensor frame, with
+  /// T_candidate<-keyframe.
+  void add(const ScanFeatures& features, const Pose& candidate_from_keyframe);
+  [[nodiscard]] const SemanticLocalMap& coarse() const { return coarse_; }
+  [[nodiscard]] const SemanticLocalMap& fine() const { return fine_; }
+
+ private:
+  SemanticLocalMap coarse_, fine_;
+};
+
+struct LoopVerification {
+  Pose relative = Pose::Identity();  ///< T_candidate<-query, registered
+  RegistrationResult registration;   ///< the fine registration of the winning guess
+  std::size_t guess = 0;             ///< index of the winning initial guess
+  std::size_t features = 0;          ///< features of the query
+  double inlier_fraction = 0;
+  double mean_residual = 0;          ///< [m] mean |residual| of the inliers
+  double translation_eigenvalue = 0; ///< smallest eigenvalue of H_tt / N
+  bool passes_loss_test = false;
+  bool passes_normalized_test = false;
+  bool accepted = false;
+  std::string reason;                ///< why it was rejected (empty when accepted)
+};
+
+/// Registers `query` (sensor frame) to the submap from each guess
+/// (T_candidate<-query) and applies the acceptance tests.
+LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap, std::span<const Pose> guesses,
+                             const LoopVerificationSettings& settings);
+
+}  // namespace saloam

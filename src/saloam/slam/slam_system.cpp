@@ -1,0 +1,267 @@
+#include "saloam/slam/slam_system.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "saloam/core/lie.hpp"
+
+namespace saloam {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+// Guesses closer than this to each other converge to the same fit: one is enough.
+constexpr double kSameGuessTranslation = 1.0;         // [m]
+constexpr double kSameGuessRotation = 5.0 * M_PI / 180;  // [rad]
+// Added to H / N so that a direction no correspondence constrains still has
+// a little information (the edge stays positive definite).
+constexpr double kInformationFloor = 1e-3;
+
+void append(const FeatureCloud& cloud, std::vector<Eigen::Vector3f>& points, std::vector<ClassIndex>& classes) {
+  points.reserve(cloud.size());
+  for (const auto& p : cloud.points) points.push_back(p.cast<float>());
+  classes = cloud.classes;
+}
+
+void expand_into(const std::vector<Eigen::Vector3f>& points, const std::vector<ClassIndex>& classes, FeatureCloud& out) {
+  out.points.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) out.push_back(points[i].cast<double>(), classes[i], 0.0F);
+}
+}  // namespace
+
+StoredFeatures StoredFeatures::from(const ScanFeatures& features) {
+  StoredFeatures s;
+  append(features.edges, s.edge_points, s.edge_classes);
+  append(features.planars, s.planar_points, s.planar_classes);
+  return s;
+}
+
+ScanFeatures StoredFeatures::expand() const {
+  ScanFeatures f;
+  expand_into(edge_points, edge_classes, f.edges);
+  expand_into(planar_points, planar_classes, f.planars);
+  return f;
+}
+
+std::size_t StoredFeatures::bytes() const {
+  return (edge_points.size() + planar_points.size()) * (sizeof(Eigen::Vector3f) + sizeof(ClassIndex));
+}
+
+SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> network)
+    : config_(config),
+      odometry_(config.odometry),
+      places_(parse_place_detector(config.loop.detector), std::move(network)),
+      gate_(CandidateGate::from_config(config.loop)),
+      verification_(LoopVerificationSettings::from_config(config)),
+      rng_(config.loop.seed) {
+  graph_options_.max_iterations = config.slam.max_iterations;
+  graph_options_.loop_robust_scale = config.slam.loop_robust_scale;
+  score_threshold_ = places_.detector() == PlaceDetector::kSgpr ? config.loop.zeta : config.loop.scancontext_zeta;
+}
+
+SlamSystem::~SlamSystem() = default;
+
+Pose SlamSystem::process(const LabelledCloud& scan, double timestamp) {
+  SlamFrameTimings timing;
+  const auto start = Clock::now();
+  const std::size_t previous = odometry_.poses().size();
+  const Pose odometry_pose = odometry_.register_frame(scan, timestamp);
+  timing.odometry_ms = ms_since(start);
+  if (previous > 0) travelled_ += (odometry_.poses()[previous - 1].translation() - odometry_pose.translation()).norm();
+
+  if (keyframe_due(odometry_pose)) {
+    add_keyframe(scan, odometry_pose, timestamp, timing);
+    if (search_due()) close_loops(timing);
+  }
+  frame_keyframe_.push_back(keyframes_.size() - 1);
+  timings_.push_back(timing);
+  return odometry_pose;
+}
+
+bool SlamSystem::keyframe_due(const Pose& odometry_pose) const {
+  if (keyframes_.empty()) return true;
+  const Keyframe& last = keyframes_.back();
+  const Pose moved = last.odometry_pose.inverse() * odometry_pose;
+  return travelled_ - last.travelled >= config_.slam.keyframe_distance ||
+         rotation_angle(moved) >= config_.slam.keyframe_angle_deg * M_PI / 180.0;
+}
+
+void SlamSystem::add_keyframe(const LabelledCloud& scan, const Pose& odometry_pose, double timestamp,
+                              SlamFrameTimings& timing) {
+  const auto start = Clock::now();
+  Keyframe kf;
+  kf.frame = odometry_.poses().size() - 1;
+  kf.timestamp = timestamp;
+  kf.travelled = travelled_;
+  kf.odometry_pose = odometry_pose;
+  kf.features = StoredFeatures::from(odometry_.last_features());
+  kf.place = places_.describe(scan);
+
+  if (keyframes_.empty()) {
+    graph_.add_node(odometry_pose);
+  } else {
+    // The new node continues from the previous one's current (corrected)
+    // estimate with the odometry's motion in between.
+    const std::size_t prev = keyframes_.size() - 1;
+    const Pose odometry_step = keyframes_.back().odometry_pose.inverse() * odometry_pose;
+    const std::size_t node = graph_.add_node(orthonormalized(graph_.pose(prev) * odometry_step));
+    const double frames = static_cast<double>(kf.frame - keyframes_.back().frame);
+    graph_.add_edge({prev, node, odometry_step, information_of(odometry_.last_frame_stats().registration, frames),
+                     EdgeKind::kOdometry});
+  }
+  keyframe_places_.push_back({graph_.pose(keyframes_.size()).translation(), travelled_});
+  keyframes_.push_back(std::move(kf));
+  timing.place_ms = ms_since(start);
+}
+
+bool SlamSystem::search_due() const {
+  return travelled_ - last_loop_travelled_ >= config_.loop.search_interval_after_loop;
+}
+
+void SlamSystem::close_loops(SlamFrameTimings& timing) {
+  auto start = Clock::now();
+  const std::size_t query = keyframes_.size() - 1;
+  const std::vector<std::size_t> candidates = select_candidates(query);
+  const std::vector<Proposal> proposals = score_candidates(query, candidates);
+  timing.search_ms = ms_since(start);
+
+  start = Clock::now();
+  bool closed = false;
+  // Best score first; the first accepted loop ends the search: the others
+  // would constrain the same stretch again.
+  for (const Proposal& proposal : proposals) {
+    LoopRecord record = verify(query, proposal);
+    const bool accepted = record.verification.accepted;
+    loops_.push_back(std::move(record));
+    if (accepted) {
+      add_loop_edge(loops_.back());
+      closed = true;
+      break;
+    }
+  }
+  timing.verification_ms = ms_since(start);
+  if (closed) {
+    start = Clock::now();
+    optimize();
+    timing.optimization_ms = ms_since(start);
+  }
+}
+
+std::vector<std::size_t> SlamSystem::select_candidates(std::size_t query) {
+  const std::span<const KeyframePlace> earlier(keyframe_places_.data(), query);
+  return loop_candidates(keyframe_places_[query], earlier, gate_, rng_);
+}
+
+std::vector<SlamSystem::Proposal> SlamSystem::score_candidates(std::size_t query,
+                                                               const std::vector<std::size_t>& candidates) const {
+  std::vector<const PlaceDescriptor*> descriptors;
+  descriptors.reserve(candidates.size());
+  for (const std::size_t c : candidates) descriptors.push_back(&keyframes_[c].place);
+  const std::vector<PlaceMatch> matches = places_.match(keyframes_[query].place, descriptors);
+  std::vector<Proposal> proposals;
+  for (std::size_t k = 0; k < candidates.size(); ++k) {
+    if (matches[k].score > score_threshold_) proposals.push_back({candidates[k], matches[k]});
+  }
+  // Highest score first; ties by the older keyframe (deterministic).
+  std::sort(proposals.begin(), proposals.end(), [](const Proposal& a, const Proposal& b) {
+    return a.match.score != b.match.score ? a.match.score > b.match.score : a.keyframe < b.keyframe;
+  });
+  if (proposals.size() > static_cast<std::size_t>(std::max(0, config_.loop.num_loop))) {
+    proposals.resize(static_cast<std::size_t>(std::max(0, config_.loop.num_loop)));
+  }
+  return proposals;
+}
+
+LoopRecord SlamSystem::verify(std::size_t query, const Proposal& proposal) const {
+  const std::size_t match = proposal.keyframe;
+  const Pose match_inverse = graph_.pose(match).inverse();
+  // The submap: keyframes around the match (never the query's own recent
+  // past), placed by the current estimates relative to the match.
+  LoopSubmap submap(verification_);
+  const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
+  const std::size_t first = match >= w ? match - w : 0;
+  const std::size_t last = std::min(match + w, query - 1);
+  for (std::size_t k = first; k <= last; ++k) {
+    if (keyframes_[query].travelled - keyframes_[k].travelled < 0.5 * gate_.exclude_recent_distance) continue;
+    submap.add(keyframes_[k].features.expand(), match_inverse * graph_.pose(k));
+  }
+  // Initial guesses: the current estimates, and the descriptor's yaw in place.
+  std::vector<Pose> guesses{orthonormalized(match_inverse * graph_.pose(query))};
+  if (proposal.match.yaw) {
+    Pose yaw_guess = Pose::Identity();
+    yaw_guess.linear() = Eigen::AngleAxisd(*proposal.match.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const Pose difference = guesses.front().inverse() * yaw_guess;
+    if (difference.translation().norm() > kSameGuessTranslation || rotation_angle(difference) > kSameGuessRotation) {
+      guesses.push_back(yaw_guess);
+    }
+  }
+  LoopRecord record;
+  record.query_keyframe = query;
+  record.match_keyframe = match;
+  record.query_frame = keyframes_[query].frame;
+  record.match_frame = keyframes_[match].frame;
+  record.travelled = keyframes_[query].travelled - keyframes_[match].travelled;
+  record.score = proposal.match;
+  record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses, verification_);
+  return record;
+}
+
+void SlamSystem::add_loop_edge(const LoopRecord& record) {
+  graph_.add_edge({record.match_keyframe, record.query_keyframe, record.verification.relative,
+                   information_of(record.verification.registration, 1.0), EdgeKind::kLoop});
+  ++accepted_;
+  last_loop_travelled_ = travelled_;
+}
+
+void SlamSystem::optimize() {
+  graph_.optimize(graph_options_);
+  ++optimizations_;
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) keyframe_places_[k].position = graph_.pose(k).translation();
+}
+
+Matrix6d SlamSystem::information_of(const RegistrationResult& registration, double frames) const {
+  Matrix6d per_correspondence;
+  if (registration.ok && registration.correspondences() > 0) {
+    per_correspondence = registration.hessian / registration.correspondences();
+  } else {
+    // No registration (first frames, or a failure that kept the prediction):
+    // what a typical scan gives, per correspondence.
+    per_correspondence = Matrix6d::Zero();
+    per_correspondence.diagonal() << 0.3, 0.3, 0.3, 30.0, 30.0, 30.0;
+  }
+  const double floor = kInformationFloor * std::max(1e-9, per_correspondence.trace() / 6.0);
+  per_correspondence.diagonal().array() += floor;
+  return config_.slam.information_scale / std::max(1.0, frames) * per_correspondence;
+}
+
+std::vector<Pose> SlamSystem::optimized_poses() const {
+  std::vector<Pose> poses;
+  const auto& odometry = odometry_.poses();
+  poses.reserve(odometry.size());
+  std::vector<Pose> keyframe_poses(keyframes_.size());
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) keyframe_poses[k] = graph_.pose(k);
+  for (std::size_t f = 0; f < frame_keyframe_.size(); ++f) {
+    const Keyframe& kf = keyframes_[frame_keyframe_[f]];
+    poses.push_back(orthonormalized(keyframe_poses[frame_keyframe_[f]] * (kf.odometry_pose.inverse() * odometry[f])));
+  }
+  return poses;
+}
+
+std::size_t SlamSystem::keyframe_bytes() const {
+  std::size_t bytes = 0;
+  for (const auto& kf : keyframes_) {
+    bytes += sizeof(Keyframe) + kf.features.bytes();
+    bytes += kf.place.graph.size() * (sizeof(int) + sizeof(Eigen::Vector3d));
+    bytes += static_cast<std::size_t>(kf.place.context.descriptor.size() + kf.place.context.unit_columns.size() +
+                                      kf.place.context.ring_key.size()) *
+             sizeof(float);
+  }
+  return bytes;
+}
+
+}  // namespace saloam
