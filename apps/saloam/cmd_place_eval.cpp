@@ -1,4 +1,5 @@
-// `saloam place-eval`: place-recognition evaluation of SGPR or Scan Context on
+// `saloam place-eval`: place-recognition evaluation of SGPR, Scan Context or
+// their hybrid (the loop detectors of `saloam slam`, one PlaceRecognizer) on
 // a sequence with ground-truth poses (SGPR's protocol: every frame against
 // the earlier frames except the last 50; match within 3 m, non-match beyond
 // 20 m). Prints max F1, precision at 100 % recall and recall at 100 %
@@ -23,6 +24,7 @@
 #include "saloam/io/sequence.hpp"
 #include "saloam/place/graph_json.hpp"
 #include "saloam/place/place_recognition.hpp"
+#include "saloam/place/place_recognizer.hpp"
 #include "saloam/place/scan_context.hpp"
 #include "saloam/place/semantic_graph.hpp"
 #include "saloam/place/sgpr_network.hpp"
@@ -92,9 +94,8 @@ void write_outputs(const std::filesystem::path& out, const std::string& method, 
 
 int run_place_eval(const PlaceEvalArgs& args) {
   const SaloamConfig config = args.config.resolve();
-  if (args.method != "sgpr" && args.method != "scancontext")
-    throw ConfigError(fmt::format("--method '{}': use sgpr or scancontext", args.method));
-  const bool sgpr = args.method == "sgpr";
+  const PlaceDetector detector = parse_place_detector(args.method);
+  const bool sgpr = uses_sgpr(detector);
   SequenceOptions options;
   if (!args.labels.empty()) options.labels_dir = args.labels;
   options.ignore_labels = !sgpr;
@@ -117,14 +118,13 @@ int run_place_eval(const PlaceEvalArgs& args) {
     if (model.empty()) model = shared_dir() / "models/sgpr/sgpr_kitti.sgw";
     network.emplace(SgprNetwork::load(model));
   }
-
-  // 1. One descriptor per frame (graph + pooled embedding, or Scan Context).
-  std::vector<SgprEmbedding> embeddings(sgpr ? n : 0);
-  std::vector<ScanContext> contexts(sgpr ? 0 : n);
-  std::vector<std::size_t> node_counts(n, 0);
-  std::atomic<double> describe_seconds{0};
   GraphBuilderConfig graph_config;
   graph_config.use_instances = !args.no_instances;
+  const PlaceRecognizer recognizer(detector, std::move(network), graph_config);
+
+  // 1. One descriptor per frame (graph + pooled embedding, and/or Scan Context).
+  std::vector<PlaceDescriptor> descriptors(n);
+  std::atomic<double> describe_seconds{0};
   const auto t0 = std::chrono::steady_clock::now();
   // A frame that cannot be read (missing, empty or truncated scan) is left out
   // of the evaluation with a warning instead of ending the whole run.
@@ -142,14 +142,8 @@ int run_place_eval(const PlaceEvalArgs& args) {
       return;
     }
     const auto start = std::chrono::steady_clock::now();
-    if (sgpr) {
-      const SemanticGraph graph = build_semantic_graph(cloud, graph_config);
-      embeddings[i] = network->embed(graph);
-      node_counts[i] = graph.size();
-      if (args.save_graphs) write_graph_json(out / "graphs" / (frame_name(i) + ".json"), graph);
-    } else {
-      contexts[i] = make_scan_context(cloud.points);
-    }
+    descriptors[i] = recognizer.describe(cloud);
+    if (args.save_graphs && sgpr) write_graph_json(out / "graphs" / (frame_name(i) + ".json"), descriptors[i].graph);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     double expected = describe_seconds.load();
     while (!describe_seconds.compare_exchange_weak(expected, expected + s)) {
@@ -173,16 +167,11 @@ int run_place_eval(const PlaceEvalArgs& args) {
   for_each_frame(n, "scoring pairs", [&](std::size_t i) {
     const std::size_t begin = query_start[i], end = query_start[i + 1];
     if (begin == end) return;
-    if (sgpr) {
-      std::vector<SgprEmbedding> candidates;
-      candidates.reserve(end - begin);
-      for (std::size_t k = begin; k < end; ++k) candidates.push_back(embeddings[pairs[k].candidate]);
-      const auto s = network->score_batch(embeddings[i], candidates);  // the query is the first graph
-      std::copy(s.begin(), s.end(), scores.begin() + static_cast<std::ptrdiff_t>(begin));
-    } else {
-      for (std::size_t k = begin; k < end; ++k)
-        scores[k] = 1.0 - scan_context_distance(contexts[i], contexts[pairs[k].candidate]).distance;
-    }
+    std::vector<const PlaceDescriptor*> candidates;
+    candidates.reserve(end - begin);
+    for (std::size_t k = begin; k < end; ++k) candidates.push_back(&descriptors[pairs[k].candidate]);
+    const std::vector<PlaceMatch> matches = recognizer.match(descriptors[i], candidates);  // the query is the first graph
+    for (std::size_t k = begin; k < end; ++k) scores[k] = matches[k - begin].score;
   });
   if (stop_requested()) return 130;
   const double score_wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
@@ -204,7 +193,7 @@ int run_place_eval(const PlaceEvalArgs& args) {
     info["model"] = model.string();
     info["use_instances"] = graph_config.use_instances;
     double mean_nodes = 0;
-    for (const auto c : node_counts) mean_nodes += static_cast<double>(c);
+    for (const auto& d : descriptors) mean_nodes += static_cast<double>(d.graph.size());
     const std::size_t described = n - skipped.size();
     info["mean_nodes"] = described ? mean_nodes / static_cast<double>(described) : 0.0;
   }
@@ -238,12 +227,14 @@ int run_place_eval(const PlaceEvalArgs& args) {
 }
 
 const CommandRegistration kRegistration{Command{
-    "place-eval", "Place-recognition evaluation (SGPR or Scan Context) against ground-truth poses", 42,
+    "place-eval", "Place-recognition evaluation (SGPR, Scan Context or hybrid) against ground-truth poses", 42,
     [](CLI::App& app) {
       auto args = std::make_shared<PlaceEvalArgs>();
       args->config.add_to(app);
       app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt, calib.txt)")->required();
-      app.add_option("--method", args->method, "sgpr or scancontext")->capture_default_str();
+      app.add_option("--method", args->method, "sgpr, scancontext or hybrid (mean of both scores)")
+          ->check(CLI::IsMember({"sgpr", "scancontext", "hybrid"}))
+          ->capture_default_str();
       app.add_option("--model", args->model,
                      "SGPR weights (.sgw); default: config loop.sgpr_model, else <shared>/models/sgpr/sgpr_kitti.sgw");
       app.add_option("--labels", args->labels, "Folder of .label files to use instead of labels/");

@@ -146,13 +146,17 @@ struct LoopClosureConfig {
   /// registration Hessian per correspondence (1 = every residual constrains
   /// that direction fully; a straight road without cross structure gives ~0).
   double min_translation_eigenvalue = 0.02;
+  /// Uniqueness: a distinct fit (> 0.5 m or 2 deg away) found from starts
+  /// 1.5 and 3 m along the least constrained direction may have at most this
+  /// fraction of the best fit's inliers.
+  double max_runner_up_ratio = 0.8;
   /// [m] Frames travelled less than this before the query are not
   /// candidates: a loop needs the vehicle to leave the place and come back.
   double exclude_recent_distance = 50.0;
   int submap_half_width = 10;  ///< keyframes on each side of the candidate forming its submap
   /// [m] After an accepted loop the next search waits this much travel:
   /// consecutive queries would only confirm the same constraint.
-  double search_interval_after_loop = 5.0;
+  double search_interval_after_loop = 10.0;
   std::uint64_t seed = 42;     ///< random generator of the N_candi draw (deterministic output)
   std::string sgpr_model;      ///< SGPR weights (.sgw); required when the detector uses SGPR
 };
@@ -170,7 +174,7 @@ struct SlamConfig {
   /// optimisation [whitened units, i.e. standard deviations]: a loop that
   /// still disagrees by many times this after the plain solve loses its weight.
   double loop_robust_scale = 10.0;
-  int max_iterations = 30;          ///< Levenberg-Marquardt iterations per optimisation
+  int max_iterations = 10;          ///< Levenberg-Marquardt iterations per phase of an optimisation
   double map_voxel_size = 0.25;     ///< [m] global semantic map resolution
   int map_frame_step = 2;           ///< every n-th frame goes into the global map
 };
@@ -237,6 +241,7 @@ void visit_fields(LoopClosureConfig& c, Visitor&& v) {
   v("min_inlier_fraction", c.min_inlier_fraction, "normalized test: min inlier fraction");
   v("inlier_distance", c.inlier_distance, "[m] inlier residual bound");
   v("min_translation_eigenvalue", c.min_translation_eigenvalue, "degeneracy: min translation eigenvalue of H/N");
+  v("max_runner_up_ratio", c.max_runner_up_ratio, "uniqueness: max inliers of a distinct fit / best");
   v("exclude_recent_distance", c.exclude_recent_distance, "[m] recent travel excluded from the search");
   v("submap_half_width", c.submap_half_width, "keyframes each side of a candidate in its submap");
   v("search_interval_after_loop", c.search_interval_after_loop, "[m] travel before searching again after a loop");

@@ -160,6 +160,7 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
       const ScanFeatures first = deskewed(first_raw_, first_motion, prediction.period, mid);
       map_ = SemanticLocalMap(config_.local_map_frames, voxel_sizes_, config_.max_correspondence_distance);
       map_.add_frame(transformed(first.edges, sweep_poses_[0]), transformed(first.planars, sweep_poses_[0]));
+      revised_first_ = first;  // mid-sweep frame of sweep 0; moved to its pose instant in record_frame
       features = deskewed(measured, first_motion, prediction.period, mid);
       last_stats_.registration = register_from(pose);
       pose = last_stats_.registration.pose;
@@ -196,7 +197,14 @@ Pose SemanticOdometry::record_frame(ScanFeatures features, const Pose& sweep_pos
     poses_.push_back(k == 0 ? Pose::Identity() : sweep_poses_.front().inverse() * sweep_pose);
   } else {
     const Vector6d xi = se3_log(sweep_poses_[k - 1].inverse() * sweep_pose);
-    if (k == 1) world_from_first_sweep_ = orthonormalized(se3_exp(a * xi));
+    if (k == 1) {
+      world_from_first_sweep_ = orthonormalized(se3_exp(a * xi));
+      // Frame 0's pose P_0 = I = C * exp(-a xi_0): its mid-sweep frame maps to its pose instant by C.
+      if (revised_first_) {
+        revised_first_->edges = transformed(revised_first_->edges, world_from_first_sweep_);
+        revised_first_->planars = transformed(revised_first_->planars, world_from_first_sweep_);
+      }
+    }
     pose_from_sweep = se3_exp(-a * xi);
     poses_.push_back(orthonormalized(world_from_first_sweep_ * sweep_poses_.front().inverse() * sweep_pose * pose_from_sweep));
   }

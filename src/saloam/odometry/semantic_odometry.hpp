@@ -7,6 +7,7 @@
 // The SLAM system feeds it frames and reads its poses and features.
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <tbb/task_arena.h>
@@ -61,6 +62,10 @@ class SemanticOdometry {
   /// matched) in its sensor frame at the reported pose instant: poses().back()
   /// maps them into the world.
   [[nodiscard]] const ScanFeatures& last_features() const { return last_features_; }
+  /// The first frame's features, de-skewed with the motion the second frame
+  /// revealed (frame 0 is reported before any motion is known): set by the
+  /// second frame, in frame 0's sensor frame at its pose instant.
+  [[nodiscard]] const std::optional<ScanFeatures>& revised_first_features() const { return revised_first_; }
   [[nodiscard]] const OdometryConfig& config() const { return config_; }
 
  private:
@@ -95,6 +100,7 @@ class SemanticOdometry {
   std::vector<FrameTimings> timings_;
   FrameStats last_stats_;
   ScanFeatures last_features_;
+  std::optional<ScanFeatures> revised_first_;
   ScanFeatures first_raw_;  ///< first frame's features before de-skewing (bootstrap)
 };
 

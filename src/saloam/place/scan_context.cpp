@@ -13,10 +13,14 @@ ScanContext make_scan_context(std::span<const Eigen::Vector3f> points, const Sca
   Eigen::MatrixXf grid = Eigen::MatrixXf::Constant(config.num_rings, config.num_sectors, kNoPoint);
   const double ring_width = config.max_range / config.num_rings;
   const double sector_width = 2.0 * std::numbers::pi / config.num_sectors;
+  const double max_range_squared = config.max_range * config.max_range;
   for (const auto& p : points) {
-    const double range = std::hypot(static_cast<double>(p.x()), static_cast<double>(p.y()));
-    if (!(range < config.max_range)) continue;
-    double azimuth = std::atan2(static_cast<double>(p.y()), static_cast<double>(p.x()));
+    // Range by sqrt (std::hypot's overflow care costs several times more).
+    const double x = p.x(), y = p.y();
+    const double range_squared = x * x + y * y;
+    if (!(range_squared < max_range_squared)) continue;
+    const double range = std::sqrt(range_squared);
+    double azimuth = std::atan2(y, x);
     if (azimuth < 0) azimuth += 2.0 * std::numbers::pi;
     const int ring = std::min(static_cast<int>(range / ring_width), config.num_rings - 1);
     const int sector = std::min(static_cast<int>(azimuth / sector_width), config.num_sectors - 1);

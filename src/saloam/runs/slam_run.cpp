@@ -55,19 +55,19 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
   if (!out) throw InputError(file, "cannot write loop file");
   out << "query_frame,match_frame,query_keyframe,match_keyframe,travelled_m,score,sgpr_score,scancontext_score,"
          "descriptor_yaw_deg,guess,features,correspondences,inliers,inlier_fraction,mean_residual_m,loss_r,"
-         "translation_eigenvalue,converged,passes_loss_test,passes_normalized_test,accepted,reason,"
+         "translation_eigenvalue,runner_up_inlier_ratio,converged,passes_loss_test,passes_normalized_test,accepted,reason,"
          "relative_pose_3x4";
   if (gt) out << ",gt_distance_m,gt_yaw_deg,translation_error_m,rotation_error_deg,correct";
   out << '\n';
   for (const auto& loop : slam.loops()) {
     const auto& v = loop.verification;
     const auto& r = v.registration;
-    out << fmt::format("{},{},{},{},{:.2f},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{:.4f},{:.4f},{:.2f},{:.4f},{:d},{:d},{:d},{:d},\"{}\",{}",
+    out << fmt::format("{},{},{},{},{:.2f},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{:.4f},{:.4f},{:.2f},{:.4f},{:.3f},{:d},{:d},{:d},{:d},\"{}\",{}",
                        loop.query_frame, loop.match_frame, loop.query_keyframe, loop.match_keyframe, loop.travelled,
                        loop.score.score, loop.score.sgpr_score, loop.score.scancontext_score,
                        loop.score.yaw ? fmt::format("{:.1f}", *loop.score.yaw * 180.0 / M_PI) : std::string(),
                        v.guess, v.features, r.correspondences(), r.inliers, v.inlier_fraction, v.mean_residual,
-                       r.loss, v.translation_eigenvalue, r.converged, v.passes_loss_test, v.passes_normalized_test,
+                       r.loss, v.translation_eigenvalue, v.runner_up_inlier_ratio, r.converged, v.passes_loss_test, v.passes_normalized_test,
                        v.accepted, v.reason, pose_numbers(v.relative));
     if (gt) {
       const LoopTruth t = loop_truth(loop, *gt);

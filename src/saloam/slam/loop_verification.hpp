@@ -6,7 +6,8 @@
 //
 // Frames: the submap is expressed in the candidate keyframe's sensor frame;
 // the result is T_candidate<-query. Registration runs coarse to fine (a wide
-// correspondence radius first, then the odometry's), from each initial guess
+// correspondence radius and every third feature first, then the odometry's
+// radius and all features), from each initial guess
 // given (the current pose estimates, which drift, and a descriptor's yaw,
 // which survives drift and reverse-direction revisits); the guess whose fine
 // fit has the most inliers wins.
@@ -19,7 +20,10 @@
 //    query's features that found an inlier correspondence, and the smallest
 //    eigenvalue of the translation block of the Hessian per correspondence
 //    (a straight road with nothing across it constrains no translation along
-//    it: such a fit may not be trusted).
+//    it: such a fit may not be trusted), and uniqueness: fits started a few
+//    metres along the least constrained direction must not find another
+//    solution nearly as good (rows of trees or parked cars repeat along a
+//    street; on reverse revisits such a second solution fooled the fit).
 
 #include <span>
 #include <string>
@@ -41,6 +45,7 @@ struct LoopVerificationSettings {
   double max_mean_residual = 0.06;
   double min_inlier_fraction = 0.45;
   double min_translation_eigenvalue = 0.02;
+  double max_runner_up_ratio = 0.8;
 
   static LoopVerificationSettings from_config(const SaloamConfig& config);
 };
@@ -68,6 +73,8 @@ struct LoopVerification {
   double inlier_fraction = 0;
   double mean_residual = 0;          ///< [m] mean |residual| of the inliers
   double translation_eigenvalue = 0; ///< smallest eigenvalue of H_tt / N
+  /// Inliers of the best distinct other fit over the best fit's (0: none found).
+  double runner_up_inlier_ratio = 0;
   bool passes_loss_test = false;
   bool passes_normalized_test = false;
   bool accepted = false;

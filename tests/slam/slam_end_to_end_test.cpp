@@ -1,0 +1,62 @@
+// End-to-end: the whole SLAM system on a short simulated loop (16 beams,
+// the urban-loop route every second frame: ~550 frames that drive the first
+// ~200 m again at the end). The loop must close with a lower absolute error
+// than the odometry alone and without any false loop.
+
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "saloam/core/lie.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/runs/slam_run.hpp"
+#include "saloam/sim/simulator.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+TEST(SlamEndToEnd, ShortLoopClosesWithLowerErrorAndNoFalseLoop) {
+  testing::TempDir dir("saloam_slam_e2e");
+  SimulationOptions sim;
+  sim.preset = "urban-loop";
+  sim.stride = 2;
+  sim.beams = 16;
+  sim.seed = 3;
+  sim.labels = LabelMode::kNoisy;
+  sim.show_progress = false;
+  const auto simulated = simulate_sequence(sim, dir / "sequence");
+  ASSERT_GT(simulated.frames, 300u);
+
+  const SequenceReader reader(dir / "sequence");
+  SaloamConfig config;  // the defaults: Scan Context detector, normalized acceptance
+  SlamRunOptions options;
+  options.show_progress = false;
+  options.write_map = false;
+  const SlamRunResult result = run_slam(reader, config, std::nullopt, dir / "out", options);
+
+  ASSERT_EQ(result.frames, reader.size());
+  ASSERT_TRUE(result.odometry_evaluation && result.slam_evaluation && result.loop_summary);
+  const LoopSummary& loops = *result.loop_summary;
+  const double ate_odometry = result.odometry_evaluation->ate.aligned.rmse;
+  const double ate_slam = result.slam_evaluation->ate.aligned.rmse;
+  std::printf("ATE odometry %.3f m, loop closed %.3f m; loops %zu accepted (%zu true, %zu false), %zu verified\n",
+              ate_odometry, ate_slam, loops.accepted, loops.accepted_true, loops.accepted_false, loops.verified);
+  EXPECT_GE(loops.accepted_true, 1u);
+  EXPECT_EQ(loops.accepted_false, 0u);
+  EXPECT_EQ(loops.missed_stretches, 0u);
+  EXPECT_LT(ate_slam, 0.8 * ate_odometry);
+
+  // Every output exists; poses.txt has one pose per frame.
+  for (const char* file : {"poses.txt", "poses_tum.txt", "poses_odometry.txt", "poses_odometry_tum.txt", "loops.csv",
+                           "timing.json", "trajectories.png", "eval_slam.json", "eval_odometry.json", "summary.json"}) {
+    EXPECT_TRUE(std::filesystem::exists(dir / "out" / file)) << file;
+  }
+  std::ifstream poses(dir / "out" / "poses.txt");
+  std::size_t lines = 0;
+  for (std::string line; std::getline(poses, line);) ++lines;
+  EXPECT_EQ(lines, reader.size());
+}
+
+}  // namespace
+}  // namespace saloam
