@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <limits>
 #include <map>
 #include <string>
 #include <string_view>
@@ -146,10 +147,13 @@ struct LoopClosureConfig {
   /// registration Hessian per correspondence (1 = every residual constrains
   /// that direction fully; a straight road without cross structure gives ~0).
   double min_translation_eigenvalue = 0.02;
-  /// Uniqueness: a distinct fit (> 0.5 m or 2 deg away) found from starts
-  /// 1.5 and 3 m along the least constrained direction may have at most this
-  /// fraction of the best fit's inliers.
-  double max_runner_up_ratio = 0.8;
+  /// Uniqueness test: a distinct fit (> 0.5 m or 2 deg away) found from
+  /// starts 1.5 and 3 m along the least constrained direction may have at
+  /// most this fraction of the best fit's inliers; .inf = off (the extra fits
+  /// are then skipped). Off by default: on simulated 08 it rejected 11 of 17
+  /// true loops (second-best fits reach 0.80-0.87 of the inliers on straight
+  /// streets) and no false one (docs/loop_closure.md).
+  double max_runner_up_ratio = std::numeric_limits<double>::infinity();
   /// [m] Frames travelled less than this before the query are not
   /// candidates: a loop needs the vehicle to leave the place and come back.
   double exclude_recent_distance = 50.0;

@@ -20,6 +20,7 @@ LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const 
   const Pose gt_relative = gt_match.inverse() * gt_query;
   const Pose error = gt_relative.inverse() * loop.verification.relative;
   truth.translation_error = error.translation().norm();
+  truth.horizontal_error = (loop.verification.relative.translation() - gt_relative.translation()).head<2>().norm();
   truth.rotation_error_deg = rotation_angle(error) * 180.0 / M_PI;
   truth.gt_distance = gt_relative.translation().norm();
   truth.gt_yaw_deg = heading_deg(gt_relative);

@@ -21,6 +21,10 @@ struct LoopTruthOptions {
 
 struct LoopTruth {
   double translation_error = 0;    ///< [m] |t| of (T_gt^-1 T_est) of the relative poses
+  /// [m] the same without its vertical part (in the match's frame): where a
+  /// trajectory's heights do not fit one ground surface the simulator rode
+  /// the sensor on the ground, so poses.txt is wrong in height there only.
+  double horizontal_error = 0;
   double rotation_error_deg = 0;
   double gt_distance = 0;          ///< [m] between the two keyframes' true positions
   double gt_yaw_deg = 0;           ///< true relative heading (about 180: a reverse revisit)

@@ -57,7 +57,7 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
          "descriptor_yaw_deg,guess,features,correspondences,inliers,inlier_fraction,mean_residual_m,loss_r,"
          "translation_eigenvalue,runner_up_inlier_ratio,converged,passes_loss_test,passes_normalized_test,accepted,reason,"
          "relative_pose_3x4";
-  if (gt) out << ",gt_distance_m,gt_yaw_deg,translation_error_m,rotation_error_deg,correct";
+  if (gt) out << ",gt_distance_m,gt_yaw_deg,translation_error_m,horizontal_error_m,rotation_error_deg,correct";
   out << '\n';
   for (const auto& loop : slam.loops()) {
     const auto& v = loop.verification;
@@ -71,8 +71,8 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
                        v.accepted, v.reason, pose_numbers(v.relative));
     if (gt) {
       const LoopTruth t = loop_truth(loop, *gt);
-      out << fmt::format(",{:.3f},{:.1f},{:.3f},{:.3f},{:d}", t.gt_distance, t.gt_yaw_deg, t.translation_error,
-                         t.rotation_error_deg, t.correct);
+      out << fmt::format(",{:.3f},{:.1f},{:.3f},{:.3f},{:.3f},{:d}", t.gt_distance, t.gt_yaw_deg, t.translation_error,
+                         t.horizontal_error, t.rotation_error_deg, t.correct);
     }
     out << '\n';
   }

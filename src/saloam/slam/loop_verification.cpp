@@ -1,6 +1,7 @@
 #include "saloam/slam/loop_verification.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include <Eigen/Eigenvalues>
@@ -108,6 +109,7 @@ LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap
   const Eigen::Matrix3d block = best.registration.hessian.topLeftCorner<3, 3>();
   const Eigen::Vector3d weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvectors().col(0);
   for (const double shift : kAmbiguityShifts) {
+    if (!std::isfinite(settings.max_runner_up_ratio)) break;  // test off: no extra fits
     Pose start = best.registration.pose;
     start.translation() += best.registration.pose.rotation() * (shift * weakest);
     const RegistrationResult other = register_scan(query.edges, query.planars, submap.fine(), start, settings.fine);
