@@ -35,10 +35,14 @@ void print_summary(const SlamRunResult& r) {
                            r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.mean_loop_ms, r.peak_rss_mib);
   if (r.loop_summary) {
     const auto& s = *r.loop_summary;
-    std::cout << fmt::format("loops vs ground truth: {} true, {} false ({} reverse); revisit stretches {} "
+    std::cout << fmt::format("loops vs ground truth ({}): {} true, {} false ({} reverse); revisit stretches {} "
                              "({} reverse), missed {} ({} reverse)\n",
-                             s.accepted_true, s.accepted_false, s.accepted_reverse, s.revisit_stretches,
-                             s.reverse_stretches, s.missed_stretches, s.missed_reverse_stretches);
+                             r.loop_reference, s.accepted_true, s.accepted_false, s.accepted_reverse,
+                             s.revisit_stretches, s.reverse_stretches, s.missed_stretches, s.missed_reverse_stretches);
+    if (r.loop_summary_poses_txt) {
+      std::cout << fmt::format("  against poses.txt (heights as given): {} true, {} false\n",
+                               r.loop_summary_poses_txt->accepted_true, r.loop_summary_poses_txt->accepted_false);
+    }
   }
   if (r.odometry_evaluation && r.slam_evaluation) {
     std::cout << "| trajectory | KITTI t_err [%] | r_err [deg/100 m] | ATE RMSE [m] |\n|---|---|---|---|\n";

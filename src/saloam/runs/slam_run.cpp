@@ -17,6 +17,7 @@
 #include "saloam/core/progress.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/ply.hpp"
+#include "saloam/io/trajectory_io.hpp"
 #include "saloam/mapping/map_render.hpp"
 #include "saloam/place/graph_json.hpp"
 #include "saloam/runs/map_building.hpp"
@@ -54,7 +55,7 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
   std::ofstream out(file);
   if (!out) throw InputError(file, "cannot write loop file");
   out << "query_frame,match_frame,query_keyframe,match_keyframe,travelled_m,score,sgpr_score,scancontext_score,"
-         "descriptor_yaw_deg,guess,features,correspondences,inliers,inlier_fraction,mean_residual_m,loss_r,"
+         "descriptor_yaw_deg,proposed_by,guess,features,correspondences,inliers,inlier_fraction,mean_residual_m,loss_r,"
          "translation_eigenvalue,runner_up_inlier_ratio,converged,passes_loss_test,passes_normalized_test,accepted,reason,"
          "relative_pose_3x4";
   if (gt) out << ",gt_distance_m,gt_yaw_deg,translation_error_m,horizontal_error_m,rotation_error_deg,correct";
@@ -62,11 +63,11 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
   for (const auto& loop : slam.loops()) {
     const auto& v = loop.verification;
     const auto& r = v.registration;
-    out << fmt::format("{},{},{},{},{:.2f},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{:.4f},{:.4f},{:.2f},{:.4f},{:.3f},{:d},{:d},{:d},{:d},\"{}\",{}",
+    out << fmt::format("{},{},{},{},{:.2f},{:.6f},{:.6f},{:.6f},{},{},{},{},{},{},{:.4f},{:.4f},{:.2f},{:.4f},{:.3f},{:d},{:d},{:d},{:d},\"{}\",{}",
                        loop.query_frame, loop.match_frame, loop.query_keyframe, loop.match_keyframe, loop.travelled,
                        loop.score.score, loop.score.sgpr_score, loop.score.scancontext_score,
                        loop.score.yaw ? fmt::format("{:.1f}", *loop.score.yaw * 180.0 / M_PI) : std::string(),
-                       v.guess, v.features, r.correspondences(), r.inliers, v.inlier_fraction, v.mean_residual,
+                       loop.by_proximity ? "proximity" : "score", v.guess, v.features, r.correspondences(), r.inliers, v.inlier_fraction, v.mean_residual,
                        r.loss, v.translation_eigenvalue, v.runner_up_inlier_ratio, r.converged, v.passes_loss_test, v.passes_normalized_test,
                        v.accepted, v.reason, pose_numbers(v.relative));
     if (gt) {
@@ -231,21 +232,37 @@ SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config,
   write_trajectory(out_dir / "poses.txt", out_dir / "poses_tum.txt", slam.timestamps(), optimized, tr);
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
 
-  // Ground truth of the processed frames, LiDAR frame (loops) and camera frame (trajectories).
-  std::optional<std::vector<Pose>> gt_lidar, gt_output;
-  if (reader.has_poses()) {
-    const auto& camera = reader.camera_poses();
+  // Ground truth of the processed frames, camera frame (trajectories) and
+  // LiDAR frame (loops). A simulated sequence whose given heights did not fit
+  // its ground has poses_sensor.txt, where the scans were really taken: loops
+  // are judged against it (poses.txt is wrong in height there, as KITTI's).
+  std::optional<std::vector<Pose>> gt_lidar, gt_output, gt_scan_lidar;
+  const auto slice_of = [&](const std::vector<Pose>& camera) {
     std::vector<Pose> slice(camera.begin() + static_cast<std::ptrdiff_t>(first),
                             camera.begin() + static_cast<std::ptrdiff_t>(first + result.frames));
     const Pose rebase = slice.front().inverse();  // world = first processed frame, as the estimates
     for (auto& p : slice) p = orthonormalized(rebase * p);
-    gt_output = slice;
-    if (tr) {
-      gt_lidar.emplace();
-      for (const auto& p : slice) gt_lidar->push_back(orthonormalized(tr->inverse() * p * *tr));
+    return slice;
+  };
+  const auto to_lidar = [&](const std::vector<Pose>& camera) {
+    std::vector<Pose> lidar;
+    for (const auto& p : camera) lidar.push_back(orthonormalized(tr->inverse() * p * *tr));
+    return lidar;
+  };
+  if (reader.has_poses()) {
+    gt_output = slice_of(reader.camera_poses());
+    if (tr) gt_lidar = to_lidar(*gt_output);
+    const auto sensor_file = reader.root() / "poses_sensor.txt";
+    if (tr && std::filesystem::exists(sensor_file)) {
+      const std::vector<Pose> sensor = read_kitti_poses(sensor_file);
+      if (sensor.size() != reader.size()) {
+        throw InputError(sensor_file, fmt::format("{} poses for {} scans", sensor.size(), reader.size()));
+      }
+      gt_scan_lidar = to_lidar(slice_of(sensor));
     }
   }
-  write_loops_csv(out_dir / "loops.csv", slam, gt_lidar ? &*gt_lidar : nullptr);
+  const std::vector<Pose>* loop_reference = gt_scan_lidar ? &*gt_scan_lidar : gt_lidar ? &*gt_lidar : nullptr;
+  write_loops_csv(out_dir / "loops.csv", slam, loop_reference);
   if (uses_sgpr(parse_place_detector(config.loop.detector))) write_graph_map(out_dir / "graph_map.json", slam);
   const std::vector<Pose> odometry_out = output_poses(slam.odometry_poses(), tr);
   const std::vector<Pose> slam_out = output_poses(optimized, tr);
@@ -271,11 +288,18 @@ SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config,
     summary["odometry"] = evaluation_to_json(*result.odometry_evaluation, odometry_labels, false);
     summary["slam"] = evaluation_to_json(*result.slam_evaluation, slam_labels, false);
   }
-  if (gt_lidar) {
+  if (loop_reference) {
     LoopTruthOptions truth_options;
     truth_options.exclude_recent_distance = config.loop.exclude_recent_distance;
-    result.loop_summary = summarize_loops(slam, *gt_lidar, truth_options);
+    result.loop_summary = summarize_loops(slam, *loop_reference, truth_options);
+    result.loop_reference = gt_scan_lidar ? "poses_sensor.txt" : "poses.txt";
+    if (gt_scan_lidar) result.loop_summary_poses_txt = summarize_loops(slam, *gt_lidar, truth_options);
     const LoopSummary& s = *result.loop_summary;
+    summary["loops_judged_against"] = result.loop_reference;
+    if (result.loop_summary_poses_txt) {
+      summary["loops_vs_poses_txt"] = {{"accepted_true", result.loop_summary_poses_txt->accepted_true},
+                                       {"accepted_false", result.loop_summary_poses_txt->accepted_false}};
+    }
     summary["loops"] = {{"accepted_true", s.accepted_true},
                         {"accepted_false", s.accepted_false},
                         {"accepted_reverse", s.accepted_reverse},

@@ -8,6 +8,7 @@
 //   trajectories.png odometry, loop-closed and (when known) ground-truth trajectories
 //   timing.json      per-stage timings, Hz, memory
 //   eval_odometry.{json,png}, eval_slam.{json,png}, summary.json  with SEQ/poses.txt
+//     (loops are judged against SEQ/poses_sensor.txt when a simulated sequence has it)
 // Ctrl-C ends the frame loop; everything above is still written for the
 // frames processed.
 
@@ -47,6 +48,8 @@ struct SlamRunResult {
   double peak_rss_mib = 0;
   std::optional<TrajectoryEvaluation> odometry_evaluation, slam_evaluation;
   std::optional<LoopSummary> loop_summary;
+  std::string loop_reference;  ///< file the loops were judged against: poses_sensor.txt when present, else poses.txt
+  std::optional<LoopSummary> loop_summary_poses_txt;  ///< against poses.txt, when poses_sensor.txt was used
 };
 
 /// Loads the SGPR network when the configured detector needs one: the

@@ -100,6 +100,11 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
   const bool noisy = options.labels == LabelMode::kNoisy;
   if (noisy) fs::create_directories(out_dir / "labels_gt");
 
+  // Where each sweep really started: the given pose, raised or lowered onto
+  // the ground where the trajectory's heights do not fit one surface.
+  std::vector<Pose> sensor_out;
+  sensor_out.reserve(frames.size());
+
   SimulationSummary summary;
   ProgressBar progress(frames.size(), "simulate", options.show_progress);
   for (std::size_t k = 0; k < frames.size(); ++k) {
@@ -115,6 +120,9 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
           "simulated frame {} (source pose {}, sensor at {:.2f} {:.2f} {:.2f}) has no points; not writing an empty scan to {}",
           k, frames[k], p.x(), p.y(), p.z(), (out_dir / "velodyne" / (frame_name(k) + ".bin")).string()));
     }
+    Pose sensor = sweep.start;
+    sensor.translation() = world.sensor_origin(sweep.start.translation());
+    sensor_out.push_back(orthonormalized(base_inv * sensor));
     const double offset = std::abs(static_cast<double>(scan.sensor_offset));
     summary.max_sensor_offset = std::max(summary.max_sensor_offset, offset);
     if (offset > 0.0) ++summary.reseated_frames;
@@ -135,6 +143,10 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
   if (summary.frames < frames.size()) {
     writer.write_camera_poses(std::vector<Pose>(camera_out.begin(), camera_out.begin() + static_cast<std::ptrdiff_t>(summary.frames)));
     writer.write_times(std::vector<double>(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(summary.frames)));
+  }
+  if (summary.reseated_frames > 0) {
+    sensor_out.resize(summary.frames);
+    write_kitti_poses(out_dir / "poses_sensor.txt", lidar_to_camera_poses(sensor_out, tr));
   }
   if (noisy && summary.frames > 0) {
     summary.miou = summary.score.miou();

@@ -4,6 +4,11 @@
 // the SemanticKITTI layout so every other command reads it like real data:
 //   velodyne/NNNNNN.bin  labels/NNNNNN.label  [labels_gt/NNNNNN.label]
 //   poses.txt (camera frame, P_i = Tr Q_i Tr^-1, P_0 = I)  calib.txt (Tr)  times.txt (s; 10 Hz sensor)
+//   poses_sensor.txt, only where a trajectory's heights do not fit one ground
+//     surface (the simulator then rides the sensor on the ground): where each
+//     sweep really started, in poses.txt's frame. poses.txt stays the
+//     trajectory as given, height errors included, as KITTI's ground truth;
+//     poses_sensor.txt is the truth of the scans (e.g. to judge loop closures).
 
 #include <cstddef>
 #include <cstdint>

@@ -43,9 +43,9 @@ struct LoopVerificationSettings {
   ClassVoxelSizes voxel_size{};
   bool loss_test = false;       ///< true: the paper's r < delta_r decides; false: the normalized test
   double delta_r = 100.0;
-  double max_mean_residual = 0.06;
-  double min_inlier_fraction = 0.45;
-  double min_translation_eigenvalue = 0.02;
+  double max_mean_residual = 0.05;
+  double min_inlier_fraction = 0.40;
+  double min_translation_eigenvalue = 0.05;
   double max_runner_up_ratio = std::numeric_limits<double>::infinity();  ///< .inf: test off
 
   static LoopVerificationSettings from_config(const SaloamConfig& config);

@@ -177,6 +177,26 @@ std::vector<SlamSystem::Proposal> SlamSystem::score_candidates(std::size_t query
   if (proposals.size() > static_cast<std::size_t>(std::max(0, config_.loop.num_loop))) {
     proposals.resize(static_cast<std::size_t>(std::max(0, config_.loop.num_loop)));
   }
+  // Beyond the paper: the candidate nearest to the query by the current
+  // estimate, when nearer than proximity_radius, is verified too, whatever
+  // its score (descriptors lose similarity on reverse revisits in the other
+  // lane; the estimate, corrected by earlier loops, still knows the place).
+  if (config_.loop.proximity_radius > 0 && !candidates.empty()) {
+    const Eigen::Vector3d& q = keyframe_places_[query].position;
+    std::size_t nearest = candidates.size();
+    double best = config_.loop.proximity_radius * config_.loop.proximity_radius;
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      const double d2 = (keyframe_places_[candidates[k]].position - q).squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        nearest = k;
+      }
+    }
+    const bool proposed = nearest < candidates.size() &&
+                          std::any_of(proposals.begin(), proposals.end(),
+                                      [&](const Proposal& p) { return p.keyframe == candidates[nearest]; });
+    if (nearest < candidates.size() && !proposed) proposals.push_back({candidates[nearest], matches[nearest], true});
+  }
   return proposals;
 }
 
@@ -210,6 +230,7 @@ LoopRecord SlamSystem::verify(std::size_t query, const Proposal& proposal) const
   record.match_frame = keyframes_[match].frame;
   record.travelled = keyframes_[query].travelled - keyframes_[match].travelled;
   record.score = proposal.match;
+  record.by_proximity = proposal.by_proximity;
   record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses, verification_);
   return record;
 }

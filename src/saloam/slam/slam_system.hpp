@@ -57,6 +57,7 @@ struct LoopRecord {
   std::size_t query_frame = 0, match_frame = 0;
   double travelled = 0;  ///< [m] between the two
   PlaceMatch score;
+  bool by_proximity = false;  ///< proposed because the estimate put it within loop.proximity_radius
   LoopVerification verification;
 };
 
@@ -102,6 +103,7 @@ class SlamSystem {
   struct Proposal {
     std::size_t keyframe;
     PlaceMatch match;
+    bool by_proximity = false;  ///< proposed for its estimated distance, not its score
   };
 
   [[nodiscard]] bool keyframe_due(const Pose& odometry_pose) const;
