@@ -12,23 +12,11 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/core/progress.hpp"
+#include "saloam/runs/timing_stats.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 
 namespace saloam {
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
-nlohmann::json stage_stats(const std::vector<double>& ms) {
-  const double mean = ms.empty() ? 0.0 : std::accumulate(ms.begin(), ms.end(), 0.0) / static_cast<double>(ms.size());
-  return {{"mean_ms", mean},
-          {"median_ms", median_of(ms)},
-          {"max_ms", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())}};
-}
 
 std::vector<double> totals(const std::vector<FrameTimings>& timings) {
   std::vector<double> total;

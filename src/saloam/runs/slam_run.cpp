@@ -22,22 +22,13 @@
 #include "saloam/place/graph_json.hpp"
 #include "saloam/runs/map_building.hpp"
 #include "saloam/runs/odometry_run.hpp"
+#include "saloam/runs/timing_stats.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam {
 
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
-  return v[v.size() / 2];
-}
-
-double mean_of(const std::vector<double>& v) {
-  return v.empty() ? 0.0 : std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
-}
 
 double peak_rss_mib() {
   rusage usage{};
@@ -106,12 +97,6 @@ void write_timing(const std::filesystem::path& file, const SlamSystem& slam, dou
     loop.push_back(t.loop_ms());
     total.push_back(t.total_ms());
   }
-  auto stats = [](const std::vector<double>& ms) {
-    return nlohmann::json{{"mean_ms", mean_of(ms)},
-                          {"median_ms", median_of(ms)},
-                          {"max_ms", ms.empty() ? 0.0 : *std::max_element(ms.begin(), ms.end())},
-                          {"total_s", std::accumulate(ms.begin(), ms.end(), 0.0) / 1000.0}};
-  };
   const double median = median_of(total);
   const double mean = mean_of(total);
   const nlohmann::json j{
@@ -124,13 +109,13 @@ void write_timing(const std::filesystem::path& file, const SlamSystem& slam, dou
       {"peak_rss_mib", rss_mib},
       {"keyframe_store_mib", static_cast<double>(slam.keyframe_bytes()) / (1024.0 * 1024.0)},
       {"stages",
-       {{"odometry", stats(odometry)},
-        {"place_descriptor", stats(place)},
-        {"candidates_and_scoring", stats(search)},
-        {"verification", stats(verification)},
-        {"pose_graph", stats(optimization)},
-        {"loop_closure_total", stats(loop)},
-        {"total", stats(total)}}}};
+       {{"odometry", stage_stats(odometry)},
+        {"place_descriptor", stage_stats(place)},
+        {"candidates_and_scoring", stage_stats(search)},
+        {"verification", stage_stats(verification)},
+        {"pose_graph", stage_stats(optimization)},
+        {"loop_closure_total", stage_stats(loop)},
+        {"total", stage_stats(total)}}}};
   std::ofstream out(file);
   if (!out) throw InputError(file, "cannot write timing file");
   out << j.dump(2) << '\n';
