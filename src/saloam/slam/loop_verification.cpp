@@ -26,7 +26,7 @@ constexpr std::size_t kCoarseStride = 3;
 constexpr double kAmbiguityShifts[] = {-3.0, -1.5, 1.5, 3.0};
 constexpr double kDistinctTranslation = 0.5;
 constexpr double kDistinctRotation = 2.0 * M_PI / 180;
-constexpr int kFineRounds = 4;
+constexpr int kFineRounds = 3;
 constexpr int kIterations = 15;
 
 FeatureCloud every_nth(const FeatureCloud& cloud, std::size_t n) {
@@ -74,87 +74,99 @@ void LoopSubmap::add(const ScanFeatures& features, const Pose& candidate_from_ke
   fine_.add_frame(edges, planars);
 }
 
+namespace {
+
+// The query at both stages: every third feature for the coarse fit, all for the fine one.
+struct QueryFeatures {
+  const ScanFeatures& all;
+  FeatureCloud coarse_edges, coarse_planars;
+};
+
+RegistrationResult fit_from(const Pose& guess, const QueryFeatures& query, const LoopSubmap& submap,
+                            const LoopVerificationSettings& settings) {
+  const RegistrationResult coarse =
+      register_scan(query.coarse_edges, query.coarse_planars, submap.coarse(), guess, settings.coarse);
+  if (!coarse.ok) return coarse;
+  return register_scan(query.all.edges, query.all.planars, submap.fine(), coarse.pose, settings.fine);
+}
+
+// Uniqueness: fits started a few metres along the least constrained
+// direction (along the road, where rows of trees, poles and parked cars
+// repeat); returns the inliers of the best distinct one over the fit's.
+double runner_up_ratio(const RegistrationResult& fit, const QueryFeatures& query, const LoopSubmap& submap,
+                       const LoopVerificationSettings& settings) {
+  const Eigen::Matrix3d block = fit.hessian.topLeftCorner<3, 3>();
+  const Eigen::Vector3d weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvectors().col(0);
+  double ratio = 0;
+  for (const double shift : kAmbiguityShifts) {
+    Pose start = fit.pose;
+    start.translation() += fit.pose.rotation() * (shift * weakest);
+    const RegistrationResult other =
+        register_scan(query.all.edges, query.all.planars, submap.fine(), start, settings.fine);
+    if (!other.ok) continue;
+    const Pose difference = fit.pose.inverse() * other.pose;
+    if (difference.translation().norm() > kDistinctTranslation || rotation_angle(difference) > kDistinctRotation) {
+      ratio = std::max(ratio, static_cast<double>(other.inliers) / std::max(1, fit.inliers));
+    }
+  }
+  return ratio;
+}
+
+// Fills the fit statistics, both tests and the decision.
+void judge(LoopVerification& v, const LoopVerificationSettings& settings) {
+  const RegistrationResult& r = v.registration;
+  v.relative = orthonormalized(r.pose);
+  v.inlier_fraction = v.features > 0 ? static_cast<double>(r.inliers) / static_cast<double>(v.features) : 0.0;
+  v.mean_residual = r.mean_inlier_residual();
+  const Eigen::Matrix3d translation_block = r.hessian.topLeftCorner<3, 3>() / std::max(1, r.correspondences());
+  v.translation_eigenvalue = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(translation_block).eigenvalues()(0);
+  v.passes_loss_test = r.loss < settings.delta_r;
+  v.passes_normalized_test = v.mean_residual <= settings.max_mean_residual &&
+                             v.inlier_fraction >= settings.min_inlier_fraction &&
+                             v.translation_eigenvalue >= settings.min_translation_eigenvalue &&
+                             v.runner_up_inlier_ratio < settings.max_runner_up_ratio;
+  v.accepted = settings.loss_test ? v.passes_loss_test : v.passes_normalized_test;
+  if (v.accepted) {
+    v.reason.clear();
+  } else if (settings.loss_test) {
+    v.reason = fmt::format("loss r = {:.1f} >= delta_r = {:.1f}", r.loss, settings.delta_r);
+  } else if (v.inlier_fraction < settings.min_inlier_fraction) {
+    v.reason = fmt::format("inlier fraction {:.2f} < {:.2f}", v.inlier_fraction, settings.min_inlier_fraction);
+  } else if (v.runner_up_inlier_ratio >= settings.max_runner_up_ratio) {
+    v.reason = fmt::format("ambiguous: another fit has {:.0f} % of the inliers", 100 * v.runner_up_inlier_ratio);
+  } else if (v.mean_residual > settings.max_mean_residual) {
+    v.reason = fmt::format("mean residual {:.3f} m > {:.3f} m", v.mean_residual, settings.max_mean_residual);
+  } else {
+    v.reason = fmt::format("degenerate: translation eigenvalue {:.3f} < {:.3f}", v.translation_eigenvalue,
+                           settings.min_translation_eigenvalue);
+  }
+}
+
+}  // namespace
+
 LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap, std::span<const Pose> guesses,
                              const LoopVerificationSettings& settings) {
+  const QueryFeatures features{query, every_nth(query.edges, kCoarseStride), every_nth(query.planars, kCoarseStride)};
   LoopVerification best;
   best.features = query.edges.size() + query.planars.size();
-  best.reason = "no initial guess";
-  const FeatureCloud coarse_edges = every_nth(query.edges, kCoarseStride);
-  const FeatureCloud coarse_planars = every_nth(query.planars, kCoarseStride);
-  std::vector<RegistrationResult> fits;
-  for (const Pose& guess : guesses) {
-    const RegistrationResult coarse =
-        register_scan(coarse_edges, coarse_planars, submap.coarse(), guess, settings.coarse);
-    fits.push_back(coarse.ok ? register_scan(query.edges, query.planars, submap.fine(), coarse.pose, settings.fine)
-                             : coarse);
-  }
-  auto best_of = [&] {
-    std::size_t index = fits.size();
-    for (std::size_t g = 0; g < fits.size(); ++g) {
-      if (fits[g].ok && (index == fits.size() || fits[g].inliers > fits[index].inliers)) index = g;
+  best.reason = guesses.empty() ? "no initial guess" : "registration failed (too few correspondences)";
+  bool found = false;
+  // Guesses in order; the first one whose fit is accepted ends the search
+  // (the current estimate comes first and usually is that one).
+  for (std::size_t g = 0; g < guesses.size() && !best.accepted; ++g) {
+    LoopVerification candidate;
+    candidate.features = best.features;
+    candidate.guess = g;
+    candidate.registration = fit_from(guesses[g], features, submap, settings);
+    if (!candidate.registration.ok) continue;
+    if (std::isfinite(settings.max_runner_up_ratio)) {
+      candidate.runner_up_inlier_ratio = runner_up_ratio(candidate.registration, features, submap, settings);
     }
-    return index;
-  };
-  const std::size_t winner = best_of();
-  if (winner == fits.size()) {
-    best.reason = "registration failed (too few correspondences)";
-    return best;
-  }
-  best.guess = winner;
-  best.registration = fits[winner];
-  // Uniqueness: start again a few metres along the least constrained
-  // direction (along the road, where rows of trees, poles and parked cars
-  // repeat); a different fit about as good as the best makes the place
-  // ambiguous.
-  const Eigen::Matrix3d block = best.registration.hessian.topLeftCorner<3, 3>();
-  const Eigen::Vector3d weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(block).eigenvectors().col(0);
-  for (const double shift : kAmbiguityShifts) {
-    if (!std::isfinite(settings.max_runner_up_ratio)) break;  // test off: no extra fits
-    Pose start = best.registration.pose;
-    start.translation() += best.registration.pose.rotation() * (shift * weakest);
-    const RegistrationResult other = register_scan(query.edges, query.planars, submap.fine(), start, settings.fine);
-    if (!other.ok) continue;
-    const Pose difference = best.registration.pose.inverse() * other.pose;
-    const bool distinct = difference.translation().norm() > kDistinctTranslation ||
-                          rotation_angle(difference) > kDistinctRotation;
-    if (!distinct) continue;
-    best.runner_up_inlier_ratio =
-        std::max(best.runner_up_inlier_ratio, static_cast<double>(other.inliers) / std::max(1, best.registration.inliers));
-  }
-  for (std::size_t g = 0; g < fits.size(); ++g) {
-    if (g == winner || !fits[g].ok) continue;
-    const Pose difference = best.registration.pose.inverse() * fits[g].pose;
-    if (difference.translation().norm() > kDistinctTranslation || rotation_angle(difference) > kDistinctRotation) {
-      best.runner_up_inlier_ratio = std::max(
-          best.runner_up_inlier_ratio, static_cast<double>(fits[g].inliers) / std::max(1, best.registration.inliers));
+    judge(candidate, settings);
+    if (!found || candidate.accepted || candidate.registration.inliers > best.registration.inliers) {
+      best = std::move(candidate);
+      found = true;
     }
-  }
-  const RegistrationResult& r = best.registration;
-  best.relative = orthonormalized(r.pose);
-  best.inlier_fraction = best.features > 0 ? static_cast<double>(r.inliers) / static_cast<double>(best.features) : 0.0;
-  best.mean_residual = r.mean_inlier_residual();
-  const Eigen::Matrix3d translation_block = r.hessian.topLeftCorner<3, 3>() / std::max(1, r.correspondences());
-  best.translation_eigenvalue = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(translation_block).eigenvalues()(0);
-
-  best.passes_loss_test = r.loss < settings.delta_r;
-  best.passes_normalized_test = best.mean_residual <= settings.max_mean_residual &&
-                                best.inlier_fraction >= settings.min_inlier_fraction &&
-                                best.translation_eigenvalue >= settings.min_translation_eigenvalue &&
-                                best.runner_up_inlier_ratio < settings.max_runner_up_ratio;
-  best.accepted = settings.loss_test ? best.passes_loss_test : best.passes_normalized_test;
-  if (best.accepted) {
-    best.reason.clear();
-  } else if (settings.loss_test) {
-    best.reason = fmt::format("loss r = {:.1f} >= delta_r = {:.1f}", r.loss, settings.delta_r);
-  } else if (best.inlier_fraction < settings.min_inlier_fraction) {
-    best.reason = fmt::format("inlier fraction {:.2f} < {:.2f}", best.inlier_fraction, settings.min_inlier_fraction);
-  } else if (best.runner_up_inlier_ratio >= settings.max_runner_up_ratio) {
-    best.reason = fmt::format("ambiguous: another fit has {:.0f} % of the inliers", 100 * best.runner_up_inlier_ratio);
-  } else if (best.mean_residual > settings.max_mean_residual) {
-    best.reason = fmt::format("mean residual {:.3f} m > {:.3f} m", best.mean_residual, settings.max_mean_residual);
-  } else {
-    best.reason = fmt::format("degenerate: translation eigenvalue {:.3f} < {:.3f}", best.translation_eigenvalue,
-                              settings.min_translation_eigenvalue);
   }
   return best;
 }

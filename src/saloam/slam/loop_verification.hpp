@@ -9,8 +9,8 @@
 // correspondence radius and every third feature first, then the odometry's
 // radius and all features), from each initial guess
 // given (the current pose estimates, which drift, and a descriptor's yaw,
-// which survives drift and reverse-direction revisits); the guess whose fine
-// fit has the most inliers wins.
+// which survives drift and reverse-direction revisits), in order: the first
+// accepted fit ends the search, else the fit with the most inliers is reported.
 //
 // Two acceptance tests, both always computed:
 //  - "loss", the paper's: r < delta_r, r being Eq. 2's weighted sum of
