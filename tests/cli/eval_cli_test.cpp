@@ -18,6 +18,7 @@ using testing::quoted;
 using testing::TempDir;
 
 TEST(EvalCli, Kitti00OrbWritesJsonAndPlot) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   const auto gt = shared_file("data/kitti/poses/00.txt");
   const auto est = shared_file("data/kitti/estimates/KITTI_00_ORB.txt");
@@ -54,6 +55,7 @@ TEST(EvalCli, Kitti00OrbWritesJsonAndPlot) {
 }
 
 TEST(EvalCli, Sim3AlignmentAndShorterEstimate) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   const auto gt = shared_file("data/kitti/poses/00.txt");
   // An interrupted run: only the first 1000 poses of the S-PTAM estimate.
@@ -78,6 +80,7 @@ TEST(EvalCli, Sim3AlignmentAndShorterEstimate) {
 }
 
 TEST(EvalCli, MalformedPoseFileNamesFileAndLine) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   const auto bad = dir / "bad_poses.txt";
   {
@@ -97,6 +100,7 @@ TEST(EvalCli, MalformedPoseFileNamesFileAndLine) {
 }
 
 TEST(EvalCli, MissingFileAndBadAlignmentFail) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   std::string output;
   int code = run_command(quoted(cli_path()) + " eval --gt " + quoted(dir / "nope.txt") + " --est " +

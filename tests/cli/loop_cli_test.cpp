@@ -20,6 +20,7 @@ using testing::quoted;
 std::string saloam_cmd(const std::string& args) { return quoted(testing::cli_path()) + " " + args; }
 
 TEST(LoopCli, SgprScoreReproducesTheReferencePair) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto dir = testing::shared_dir() / "models/sgpr";
   std::string output;
   const int rc = testing::run_command(
@@ -39,6 +40,7 @@ TEST(LoopCli, SgprScoreReproducesTheReferencePair) {
 }
 
 TEST(LoopCli, BadModelFilesGiveClearErrors) {
+  SALOAM_REQUIRE_SHARED_DATA();
   testing::TempDir tmp;
   const auto graph = testing::shared_dir() / "models/sgpr/graph_0.json";
   std::ofstream(tmp / "garbage.sgw") << "this is not a weights file";
@@ -102,6 +104,7 @@ std::filesystem::path write_revisit_sequence(const testing::TempDir& tmp) {
 }
 
 TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
+  SALOAM_REQUIRE_SHARED_DATA();
   testing::TempDir tmp;
   const auto seq = write_revisit_sequence(tmp);
   std::string output;

@@ -38,6 +38,7 @@ void make_sequence(const std::filesystem::path& seq, bool with_calib) {
 }
 
 TEST(OdomCli, WritesCameraFramePosesTumAndTiming) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   make_sequence(dir / "seq", true);
   std::string output;
@@ -71,6 +72,7 @@ TEST(OdomCli, WritesCameraFramePosesTumAndTiming) {
 }
 
 TEST(OdomCli, FrameRangeNoSemanticsAndMissingCalib) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   make_sequence(dir / "seq", false);
   std::string output;
@@ -86,6 +88,7 @@ TEST(OdomCli, FrameRangeNoSemanticsAndMissingCalib) {
 }
 
 TEST(OdomCli, BadInputFailsWithMessage) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   std::string output;
   int code = run_command(quoted(cli_path()) + " odom " + quoted(dir / "missing") + " --out " +
@@ -102,6 +105,7 @@ TEST(OdomCli, BadInputFailsWithMessage) {
 }
 
 TEST(BenchCli, PrintsFrequencyStagesAndMemory) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   make_sequence(dir / "seq", true);
   std::string output;

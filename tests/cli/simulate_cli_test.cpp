@@ -43,6 +43,7 @@ TEST(SimulateCli, PresetWritesAReadableSequence) {
 // shrinking and empty scans; now every scan is full and the command says
 // where the trajectory's height did not fit the ground.
 TEST(SimulateCli, Kitti08StartHasNoEmptyScans) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   const fs::path seq = dir / "seq";
   const auto poses = shared_file("data/kitti/poses/08.txt");
@@ -63,6 +64,7 @@ TEST(SimulateCli, Kitti08StartHasNoEmptyScans) {
 }
 
 TEST(SimulateCli, KittiTrajectoryWithPerSequenceCalibList) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   const fs::path seq = dir / "seq";
   const auto poses = shared_file("data/kitti/poses/04.txt");
@@ -93,6 +95,7 @@ TEST(SimulateCli, NoisyLabelsPrintMiouAndKeepTruth) {
 }
 
 TEST(SimulateCli, BadOptionsGiveClearErrors) {
+  SALOAM_REQUIRE_SHARED_DATA();
   TempDir dir;
   std::string output;
   EXPECT_NE(run_command(simulate(dir / "a", "--frames 5:2"), &output), 0);

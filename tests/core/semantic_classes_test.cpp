@@ -9,6 +9,7 @@ namespace {
 
 // The built-in table must agree with the official semantic-kitti.yaml.
 TEST(SemanticClasses, MatchesOfficialYaml) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const YAML::Node yaml = YAML::LoadFile(testing::shared_file("data/semantic-kitti.yaml").string());
   const YAML::Node labels = yaml["labels"];
   ASSERT_TRUE(labels.IsMap());

@@ -132,6 +132,7 @@ TEST(ScanIo, AllNonFiniteIsAnError) {
 }
 
 TEST(ScanIo, ReadsRealKittiScan) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto scan = read_scan(testing::shared_file("data/kitti/scans_00/000000.bin"));
   EXPECT_EQ(scan.size(), 124668u);  // the count stated in shared/data/kitti/README.md
   double max_range = 0;

@@ -4,7 +4,6 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
-#include "saloam/io/calibration.hpp"
 #include "saloam/io/ply.hpp"
 #include "saloam/io/sequence.hpp"
 #include "testing/test_support.hpp"
@@ -29,7 +28,10 @@ void write_sequence(const std::filesystem::path& root) {
   poses[1].translation() = Eigen::Vector3d(0, 0, 1);
   poses[2].translation() = Eigen::Vector3d(0, 0, 2);
   w.write_camera_poses(poses);
-  w.write_calib(read_velo_to_cam(testing::shared_file("data/kitti/calib_velo_to_cam.txt"), 0));
+  // KITTI's axes: camera x = -LiDAR y, camera y = -LiDAR z, camera z = LiDAR x.
+  Pose velo_to_cam = Pose::Identity();
+  velo_to_cam.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  w.write_calib(velo_to_cam);
   w.write_times({0.0, 0.1, 0.2});
 }
 

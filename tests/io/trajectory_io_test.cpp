@@ -54,6 +54,7 @@ TEST(TrajectoryIo, TumRoundTrip) {
 }
 
 TEST(TrajectoryIo, ReadsSharedGroundTruth) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto poses = read_kitti_poses(testing::shared_file("data/kitti/poses/00.txt"));
   EXPECT_EQ(poses.size(), 4541u);
   EXPECT_TRUE(poses.front().isApprox(Pose::Identity(), 1e-6));
@@ -98,6 +99,7 @@ TEST(TrajectoryIo, BadLinesNameTheLine) {
 // The conversion camera <-> LiDAR frame is checked against the independent
 // conversion of the official ground truth stored in shared/ (scans_00/poses_lidar.txt).
 TEST(Calibration, CameraToLidarMatchesSharedReference) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const Pose tr = read_velo_to_cam(testing::shared_file("data/kitti/calib_velo_to_cam.txt"), 0);
   auto camera = read_kitti_poses(testing::shared_file("data/kitti/poses/00.txt"));
   camera.resize(6);
@@ -115,6 +117,7 @@ TEST(Calibration, CameraToLidarMatchesSharedReference) {
 }
 
 TEST(Calibration, ReadsKittiCalibFileAndReportsMissingTr) {
+  SALOAM_REQUIRE_SHARED_DATA();
   testing::TempDir dir;
   const Pose tr = read_velo_to_cam(testing::shared_file("data/kitti/calib_velo_to_cam.txt"), 4);
   write_calib(dir / "calib.txt", tr);

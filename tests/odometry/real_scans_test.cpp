@@ -45,6 +45,7 @@ Error relative_error(const Pose& estimate, const Pose& reference) {
 }
 
 TEST(RealKittiScans, EachConsecutivePairMatchesIcpReference) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto scans = load_scans();
   const auto reference = read_kitti_poses(testing::shared_file("data/kitti/scans_00/relative_poses_icp.txt"));
   ASSERT_EQ(reference.size(), 5u);
@@ -61,6 +62,7 @@ TEST(RealKittiScans, EachConsecutivePairMatchesIcpReference) {
 }
 
 TEST(RealKittiScans, OdometryOverSixScansMatchesIcpReference) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto scans = load_scans();
   const auto reference = read_kitti_poses(testing::shared_file("data/kitti/scans_00/relative_poses_icp.txt"));
   SemanticOdometry odometry(real_kitti_config());

@@ -263,6 +263,7 @@ TEST(GraphJson, RoundTripIsExact) {
 }
 
 TEST(GraphJson, ReadsTheOriginalSgprGraphs) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto graph = read_graph_json(testing::shared_file("models/sgpr/graph_0.json"));
   EXPECT_EQ(graph.size(), 38U);
   EXPECT_EQ(graph.nodes.front(), 0);
@@ -310,6 +311,7 @@ namespace {
 
 // Integration with the simulator: one 32-beam frame of the urban-loop preset.
 TEST(SemanticGraph, SimulatedScanGivesAPlausibleDeterministicGraph) {
+  SALOAM_REQUIRE_SHARED_DATA();
   testing::TempDir dir;
   SimulationOptions options;
   options.first_frame = 40;

@@ -34,6 +34,7 @@ const SgprNetwork& kitti_network() {
 }
 
 TEST(SgprNetwork, ReproducesEveryReferenceScoreOfEveryModel) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto reference = load_json("models/sgpr/reference.json");
   std::map<std::string, SemanticGraph> graphs;
   for (const auto& [id, count] : reference["graph_node_counts"].items()) {
@@ -89,6 +90,7 @@ double relative_error(const nlohmann::json& reference, const Eigen::VectorXf& ou
 }
 
 TEST(SgprNetwork, ReproducesReferenceActivationsLayerByLayer) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto ref = load_json("models/sgpr/reference_activations.json");
   SgprActivations act;
   const SgprEmbedding pooled = kitti_network().embed(shared_graph("0"), &act);
@@ -143,6 +145,7 @@ TEST(SgprNetwork, ReproducesReferenceActivationsLayerByLayer) {
 }
 
 TEST(SgprNetwork, PaddingMattersAndOrderMatters) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto& net = kitti_network();
   const auto h0 = net.embed(shared_graph("0"));
   const auto h3 = net.embed(shared_graph("3"));
@@ -152,6 +155,7 @@ TEST(SgprNetwork, PaddingMattersAndOrderMatters) {
 }
 
 TEST(SgprNetwork, PermutingNodesLeavesTheEmbeddingUnchanged) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto& net = kitti_network();
   SemanticGraph g = shared_graph("3");
   const auto h = net.embed(g);
@@ -161,6 +165,7 @@ TEST(SgprNetwork, PermutingNodesLeavesTheEmbeddingUnchanged) {
 }
 
 TEST(SgprNetwork, BatchScoringMatchesPairScoring) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto& net = kitti_network();
   std::vector<SgprEmbedding> stored;
   for (const char* id : {"0", "3", "250"}) stored.push_back(net.embed(shared_graph(id)));
@@ -174,12 +179,14 @@ TEST(SgprNetwork, BatchScoringMatchesPairScoring) {
 }
 
 TEST(SgprNetwork, RejectsBadNodeClasses) {
+  SALOAM_REQUIRE_SHARED_DATA();
   SemanticGraph g = shared_graph("0");
   g.nodes[0] = 12;
   EXPECT_THROW((void)kitti_network().embed(g), std::invalid_argument);
 }
 
 TEST(SgprNetwork, GraphsWithMoreThan100NodesUseTheFirst100) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto& net = kitti_network();
   SemanticGraph g;
   for (int i = 0; i < 120; ++i) {

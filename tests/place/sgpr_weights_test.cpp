@@ -32,6 +32,7 @@ std::string error_of(const std::vector<std::byte>& bytes) {
 }
 
 TEST(SgprWeights, ReadsTheSharedModelWithAllTensors) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto weights = read_sgpr_weights(testing::shared_file("models/sgpr/sgpr_kitti.sgw"));
   EXPECT_EQ(weights.tensors.size(), 43U);
   const auto& wt = weights.require("tensor_network.weight_matrix", {32, 32, 16});
@@ -46,6 +47,7 @@ TEST(SgprWeights, ReadsTheSharedModelWithAllTensors) {
 }
 
 TEST(SgprWeights, SerializeRoundTripIsBitExact) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto path = testing::shared_file("models/sgpr/sgpr_kitti.sgw");
   const auto weights = read_sgpr_weights(path);
   const auto bytes = serialize_sgpr_weights(weights);
@@ -72,6 +74,7 @@ TEST(SgprWeights, MissingFileIsAClearError) {
 }
 
 TEST(SgprWeights, MalformedFilesAreClearErrors) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto good = file_bytes(testing::shared_file("models/sgpr/sgpr_kitti.sgw"));
   ASSERT_EQ(error_of(good), "");
 

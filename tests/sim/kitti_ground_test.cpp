@@ -56,18 +56,21 @@ double return_fraction(int sequence, std::size_t frame) {
 }
 
 TEST(KittiGround, Sequence08StartHasFullScans) {
+  SALOAM_REQUIRE_SHARED_DATA();
   for (std::size_t frame = 0; frame < 60; frame += 5) {
     EXPECT_GT(return_fraction(8, frame), 0.45) << "KITTI 08 source frame " << frame;
   }
 }
 
 TEST(KittiGround, Sequence08RevisitOfTheStartHasFullScans) {
+  SALOAM_REQUIRE_SHARED_DATA();
   for (std::size_t frame = 1640; frame <= 1810; frame += 10) {
     EXPECT_GT(return_fraction(8, frame), 0.45) << "KITTI 08 source frame " << frame;
   }
 }
 
 TEST(KittiGround, Sequences00And05SpotChecks) {
+  SALOAM_REQUIRE_SHARED_DATA();
   for (const std::size_t frame : {0u, 800u, 1600u, 2400u, 3300u, 4400u}) {
     EXPECT_GT(return_fraction(0, frame), 0.45) << "KITTI 00 source frame " << frame;
   }
@@ -77,6 +80,7 @@ TEST(KittiGround, Sequences00And05SpotChecks) {
 }
 
 TEST(KittiGround, SensorStaysOnACarAboveTheGroundAndAtThePoseWhereItCan) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const KittiWorld& k = kitti_world(8);
   std::size_t moved = 0;
   for (const Pose& pose : k.trajectory) {

@@ -95,6 +95,7 @@ TEST(Sequence, ReadsBackWithKittiConventions) {
 }
 
 TEST(Sequence, KittiTrajectoryInput) {
+  SALOAM_REQUIRE_SHARED_DATA();
   const auto dir_kitti = saloam::testing::shared_file("data/kitti");
   SimulationOptions options = small_options();
   options.camera_poses = read_kitti_poses(dir_kitti / "poses/00.txt");
