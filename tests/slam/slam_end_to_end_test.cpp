@@ -60,3 +60,35 @@ TEST(SlamEndToEnd, ShortLoopClosesWithLowerErrorAndNoFalseLoop) {
 
 }  // namespace
 }  // namespace saloam
+
+namespace saloam {
+namespace {
+
+// The SLAM's output does not depend on how many threads the odometry uses.
+TEST(SlamEndToEnd, OutputIndependentOfThreadCount) {
+  testing::TempDir dir("saloam_slam_threads");
+  SimulationOptions sim;
+  sim.preset = "urban-loop";
+  sim.end_frame = 60;
+  sim.beams = 16;
+  sim.seed = 4;
+  sim.labels = LabelMode::kNoisy;
+  sim.show_progress = false;
+  simulate_sequence(sim, dir.path());
+  const SequenceReader reader(dir.path());
+  auto run = [&](int threads) {
+    SaloamConfig config;
+    config.odometry.threads = threads;
+    SlamSystem slam(config, std::nullopt);
+    for (std::size_t i = 0; i < reader.size(); ++i) slam.process(reader.load_scan(i), reader.times()[i]);
+    return slam.optimized_poses();
+  };
+  const std::vector<Pose> one = run(1), two = run(2);
+  ASSERT_EQ(one.size(), two.size());
+  for (std::size_t i = 0; i < one.size(); ++i) {
+    EXPECT_TRUE(one[i].matrix() == two[i].matrix()) << "frame " << i;
+  }
+}
+
+}  // namespace
+}  // namespace saloam
