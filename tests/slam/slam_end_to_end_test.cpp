@@ -7,8 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/io/sequence.hpp"
+#include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "testing/test_support.hpp"
@@ -88,6 +90,37 @@ TEST(SlamEndToEnd, OutputIndependentOfThreadCount) {
   for (std::size_t i = 0; i < one.size(); ++i) {
     EXPECT_TRUE(one[i].matrix() == two[i].matrix()) << "frame " << i;
   }
+}
+
+}  // namespace
+}  // namespace saloam
+
+
+namespace saloam {
+namespace {
+
+// A run never writes into the sequence folder: its poses.txt is the ground truth.
+TEST(SlamEndToEnd, RefusesToWriteOverTheSequence) {
+  testing::TempDir dir("saloam_slam_out");
+  SimulationOptions sim;
+  sim.preset = "straight";
+  sim.end_frame = 3;
+  sim.beams = 16;
+  sim.show_progress = false;
+  simulate_sequence(sim, dir.path());
+  const auto before = std::filesystem::file_size(dir / "poses.txt");
+  const SequenceReader reader(dir.path());
+  SlamRunOptions options;
+  options.show_progress = false;
+  const std::string slam_error = testing::input_error_of(
+      [&] { run_slam(reader, SaloamConfig{}, std::nullopt, dir.path() / ".", options); });
+  EXPECT_NE(slam_error.find("is the sequence folder"), std::string::npos) << slam_error;
+  OdometryRunOptions odometry_options;
+  odometry_options.show_progress = false;
+  const std::string odometry_error =
+      testing::input_error_of([&] { run_odometry(reader, OdometryConfig{}, dir.path(), odometry_options); });
+  EXPECT_NE(odometry_error.find("overwrite its ground truth"), std::string::npos) << odometry_error;
+  EXPECT_EQ(std::filesystem::file_size(dir / "poses.txt"), before);
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/core/progress.hpp"
+#include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/timing_stats.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 
@@ -78,7 +79,7 @@ OdometryRunResult run_odometry(const SequenceReader& reader, const OdometryConfi
     spdlog::warn("{}: no calib.txt; poses.txt holds LiDAR-frame poses, not the KITTI camera convention",
                  reader.root().string());
   }
-  std::filesystem::create_directories(out_dir);
+  prepare_output_folder(out_dir, reader);
   TrajectoryWriter writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);
 
   SemanticOdometry odometry(config);

@@ -22,6 +22,7 @@
 #include "saloam/place/graph_json.hpp"
 #include "saloam/runs/map_building.hpp"
 #include "saloam/runs/odometry_run.hpp"
+#include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/timing_stats.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/viz/canvas.hpp"
@@ -183,7 +184,7 @@ SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config,
     spdlog::warn("{}: no calib.txt; pose files hold LiDAR-frame poses, not the KITTI camera convention",
                  reader.root().string());
   }
-  std::filesystem::create_directories(out_dir);
+  prepare_output_folder(out_dir, reader);
 
   SlamSystem slam(config, std::move(network));
   TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);

@@ -1,0 +1,21 @@
+#include "saloam/runs/output_folder.hpp"
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+
+namespace saloam {
+
+void prepare_output_folder(const std::filesystem::path& out_dir, const SequenceReader& reader) {
+  std::error_code error;
+  const auto out = std::filesystem::weakly_canonical(out_dir, error);
+  const auto root = std::filesystem::weakly_canonical(reader.root(), error);
+  if (!error && out == root) {
+    throw InputError(out_dir, fmt::format("is the sequence folder {}: the run's poses.txt would overwrite its ground "
+                                          "truth; choose another output folder",
+                                          reader.root().string()));
+  }
+  std::filesystem::create_directories(out_dir);
+}
+
+}  // namespace saloam
