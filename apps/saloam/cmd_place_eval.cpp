@@ -93,6 +93,14 @@ void write_outputs(const std::filesystem::path& out, const std::string& method, 
 }
 
 int run_place_eval(const PlaceEvalArgs& args) {
+  // Pairs between the two distances count neither way; with the distances
+  // equal or swapped a pair would be both a match and a non-match. (The
+  // options' checks reject values <= 0 and infinity; NaN fails this test.)
+  const PlaceEvalConfig& protocol = args.protocol;
+  if (!(protocol.positive_distance < protocol.negative_distance)) {
+    throw ConfigError(fmt::format("--positive {} must be less than --negative {}", protocol.positive_distance,
+                                  protocol.negative_distance));
+  }
   const SaloamConfig config = args.config.resolve();
   const PlaceDetector detector = parse_place_detector(args.method);
   const bool sgpr = uses_sgpr(detector);
@@ -240,10 +248,14 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--labels", args->labels, "Folder of .label files to use instead of labels/");
       app.add_option("--out", args->out, "Output folder (default ./place_eval_<method>)");
       app.add_option("--positive", args->protocol.positive_distance, "[m] pairs within this distance are matches")
+          ->check(CLI::PositiveNumber)
           ->capture_default_str();
-      app.add_option("--negative", args->protocol.negative_distance, "[m] pairs beyond this distance are non-matches")
+      app.add_option("--negative", args->protocol.negative_distance,
+                     "[m] pairs beyond this distance are non-matches (more than --positive)")
+          ->check(CLI::PositiveNumber)
           ->capture_default_str();
       app.add_option("--exclude", args->protocol.exclude_recent, "most recent frames not compared with a query")
+          ->check(CLI::NonNegativeNumber)
           ->capture_default_str();
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
       app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");

@@ -167,5 +167,16 @@ TEST(LoopCli, PlaceEvalLeavesOutUnreadableFrames) {
   EXPECT_EQ(summary["frames_left_out"].get<int>(), 1);
 }
 
+TEST(LoopCli, PlaceEvalRejectsInconsistentDistances) {
+  testing::TempDir tmp;  // checked before the sequence is read: no data needed
+  std::string output;
+  EXPECT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --positive 30 --negative 20", quoted(tmp.path()))),
+                                 &output),
+            2);
+  EXPECT_NE(output.find("--positive 30 must be less than --negative 20"), std::string::npos) << output;
+  EXPECT_NE(testing::run_command(saloam_cmd(fmt::format("place-eval {} --positive -3", quoted(tmp.path()))), &output), 0);
+  EXPECT_NE(output.find("--positive"), std::string::npos) << output;
+}
+
 }  // namespace
 }  // namespace saloam

@@ -1,7 +1,14 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/error.hpp"
@@ -113,6 +120,188 @@ TEST(Config, ErrorsNameTheProblem) {
   EXPECT_THROW(load_config("/nonexistent/saloam.yaml"), InputError);
 }
 
+// ---- Valid ranges (issue 13: no silently wrong results) ----
+
+// The message of the ConfigError that `apply` throws; fails the test when none is thrown.
+template <class Apply>
+std::string config_error(Apply&& apply) {
+  try {
+    apply();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no ConfigError";
+  return "";
+}
+
+std::string override_error(const std::string& assignment) {
+  SaloamConfig c;
+  return config_error([&] { apply_config_override(c, assignment); });
+}
+
+// Finite values just outside a declared range, as --set text.
+std::vector<std::string> outside(const Range& r) {
+  std::vector<std::string> values;
+  if (std::isfinite(r.lo)) values.push_back(fmt::format("{}", r.lo - 1));
+  if (std::isfinite(r.hi)) values.push_back(fmt::format("{}", r.hi + 1));
+  return values;
+}
+std::vector<std::string> outside(const AtLeast& r) { return {fmt::format("{}", r.lo - 1)}; }
+std::vector<std::string> outside(const Above& r) { return {fmt::format("{}", r.lo)}; }
+std::vector<std::string> outside(const OneOf<int>& r) {
+  return {fmt::format("{}", *std::max_element(r.values.begin(), r.values.end()) + 1)};
+}
+std::vector<std::string> outside(const OneOf<const char*>&) { return {"nope"}; }
+std::vector<std::string> outside(const Any&) { return {}; }
+
+bool admits_infinity(const Range& r) { return std::isinf(r.hi); }
+template <class R>
+bool admits_infinity(const R&) {
+  return false;
+}
+
+// Every field with a range, through --set: a value outside it, NaN and (unless
+// the range ends at .inf) infinity for real numbers are errors naming the
+// origin and the key; the config is unchanged.
+TEST(ConfigRanges, EveryFieldRejectsValuesOutsideItsRangeAndNaN) {
+  SaloamConfig fields;
+  std::vector<std::pair<std::string, std::string>> bad;  // key, value
+  visit_sections(fields, [&](std::string_view section, auto& s) {
+    visit_fields(s, [&](std::string_view name, auto& member, std::string_view, const auto&... range) {
+      using T = std::remove_cvref_t<decltype(member)>;
+      if constexpr (sizeof...(range) == 1) {
+        std::string key = fmt::format("{}.{}", section, name);
+        if constexpr (std::is_same_v<T, ClassValueMap>) key += ".pole";
+        const std::size_t before = bad.size();
+        for (const auto& value : outside(range...)) bad.emplace_back(key, value);
+        if constexpr (std::is_floating_point_v<T> || std::is_same_v<T, ClassValueMap>) {
+          bad.emplace_back(key, ".nan");
+          if (!(admits_infinity(range) && ...)) bad.emplace_back(key, ".inf");
+        }
+        if constexpr (!(std::is_same_v<std::remove_cvref_t<decltype(range)>, Any> && ...)) {
+          EXPECT_GT(bad.size(), before) << key << ": no invalid value to try";
+        }
+      }
+    });
+  });
+  EXPECT_GE(bad.size(), 100u);  // today 52 fields with a range, most of them real numbers
+  const std::string defaults = config_to_yaml(SaloamConfig{});
+  for (const auto& [key, value] : bad) {
+    SaloamConfig c;
+    const std::string assignment = key + "=" + value;
+    const std::string message = config_error([&] { apply_config_override(c, assignment); });
+    EXPECT_NE(message.find("--set " + assignment + ": '" + key + "'"), std::string::npos) << message;
+    EXPECT_NE(message.find("(valid: "), std::string::npos) << message;
+    EXPECT_EQ(config_to_yaml(c), defaults) << assignment;
+  }
+}
+
+TEST(ConfigRanges, RepresentativeValuesNameKeyValueAndRange) {
+  EXPECT_EQ(override_error("odometry.max_iterations=-5"),
+            "--set odometry.max_iterations=-5: 'odometry.max_iterations' = -5 is not allowed (valid: >= 1)");
+  EXPECT_EQ(override_error("voxel_size=0"),
+            "--set voxel_size=0: 'odometry.voxel_size' = 0 is not allowed (valid: > 0)");
+  EXPECT_EQ(override_error("alpha=-1"), "--set alpha=-1: 'odometry.features.alpha' = -1 is not allowed (valid: > 0)");
+  EXPECT_EQ(override_error("alpha=.nan"), "--set alpha=.nan: 'odometry.features.alpha' is NaN (valid: > 0)");
+  EXPECT_NE(override_error("num_sectors=0").find("'odometry.features.num_sectors' = 0"), std::string::npos);
+  EXPECT_NE(override_error("local_map_frames=0").find("(valid: >= 1)"), std::string::npos);
+  EXPECT_NE(override_error("sweep_duration=0").find("'odometry.features.sweep_duration' = 0"), std::string::npos);
+  EXPECT_NE(override_error("odometry.threads=-1").find("(valid: >= 0)"), std::string::npos);
+  EXPECT_NE(override_error("num_beams=48").find("(valid: one of 0, 16, 32, 64)"), std::string::npos);
+  EXPECT_EQ(override_error("loop.zeta=1.5"), "--set loop.zeta=1.5: 'loop.zeta' = 1.5 is not allowed (valid: [0, 1])");
+  EXPECT_EQ(override_error("loop.detector=nope"),
+            "--set loop.detector=nope: 'loop.detector' = 'nope' is not allowed "
+            "(valid: one of sgpr, scancontext, hybrid)");
+  EXPECT_NE(override_error("loop.acceptance=strict").find("(valid: one of normalized, loss)"), std::string::npos);
+  EXPECT_EQ(override_error("odometry.class_voxel_size.pole=0"),
+            "--set odometry.class_voxel_size.pole=0: 'odometry.class_voxel_size.pole' = 0 is not allowed "
+            "(valid: > 0)");
+  EXPECT_NE(override_error("odometry.class_weight={road: -1}").find("'odometry.class_weight.road' = -1"),
+            std::string::npos);
+  EXPECT_NE(override_error("loop.seed=-1").find("wrong type"), std::string::npos);
+}
+
+TEST(ConfigRanges, BoundsAndDocumentedInfinityAreAccepted) {
+  SaloamConfig c;
+  for (const char* assignment :
+       {"loop.zeta=0", "loop.zeta=1", "odometry.threads=0", "num_beams=16", "odometry.class_weight.pole=0",
+        "loop.max_runner_up_ratio=.inf", "odometry.features.ground_edge_alpha=.inf", "loop.detector=hybrid",
+        "odometry.features.pose_time_in_sweep=0.1", "loop.delta_min=100", "loop.seed=18446744073709551615"}) {
+    EXPECT_NO_THROW(apply_config_override(c, assignment)) << assignment;
+  }
+  EXPECT_TRUE(std::isinf(c.loop.max_runner_up_ratio));
+  EXPECT_EQ(c.loop.detector, "hybrid");
+  EXPECT_NE(override_error("loop.max_runner_up_ratio=-.inf").find("(valid: [0, .inf])"), std::string::npos);
+  EXPECT_NE(override_error("loop.max_runner_up_ratio=.nan").find("is NaN"), std::string::npos);
+}
+
+TEST(ConfigRanges, ContradictingPairsAreRejected) {
+  EXPECT_EQ(override_error("odometry.features.min_range=130"),
+            "--set odometry.features.min_range=130: 'odometry.features.min_range' = 130 must be less than "
+            "'odometry.features.max_range' = 120");
+  EXPECT_NE(override_error("max_range=2.5").find("must be less than"), std::string::npos);  // equal is no range
+  EXPECT_EQ(override_error("loop.delta_min=200"),
+            "--set loop.delta_min=200: 'loop.delta_min' = 200 must not exceed 'loop.delta_max' = 100");
+  EXPECT_NE(override_error("loop.delta_max=10").find("'loop.delta_min' = 15 must not exceed"), std::string::npos);
+  EXPECT_NE(override_error("pose_time_in_sweep=0.2").find("must lie within the sweep"), std::string::npos);
+
+  // An override that breaks a pair set consistently before is rejected; the other order works.
+  SaloamConfig c;
+  apply_config_override(c, "odometry.features.pose_time_in_sweep=0.05");
+  EXPECT_NE(config_error([&] { apply_config_override(c, "sweep_duration=0.04"); })
+                .find("'odometry.features.pose_time_in_sweep' = 0.05 must lie within the sweep, "
+                      "[0, 'odometry.features.sweep_duration' = 0.04]"),
+            std::string::npos);
+  EXPECT_DOUBLE_EQ(c.odometry.features.sweep_duration, 0.1);
+  apply_config_override(c, "loop.delta_max=300");
+  apply_config_override(c, "loop.delta_min=200");
+  EXPECT_DOUBLE_EQ(c.loop.delta_min, 200.0);
+}
+
+TEST(ConfigRanges, YamlFileWithBadValueNamesFileKeyAndRange) {
+  testing::TempDir dir;
+  const auto file = dir.path() / "bad.yaml";
+  std::ofstream(file) << "odometry:\n  features:\n    alpha: 0.2\n  voxel_size: -0.4\n";
+  const std::string message = config_error([&] { (void)load_config(file); });
+  EXPECT_NE(message.find(file.string() + ": 'odometry.voxel_size' = -0.4 is not allowed (valid: > 0)"),
+            std::string::npos)
+      << message;
+
+  std::ofstream(file, std::ios::trunc) << "loop:\n  delta_min: 150\n";
+  EXPECT_NE(config_error([&] { (void)load_config(file); }).find(file.string() + ": 'loop.delta_min' = 150"),
+            std::string::npos);
+  // Within one file the order does not matter: the pair is checked after the whole file.
+  std::ofstream(file, std::ios::trunc) << "loop:\n  delta_min: 150\n  delta_max: 300\n";
+  EXPECT_DOUBLE_EQ(load_config(file).loop.delta_min, 150.0);
+
+  SaloamConfig c;
+  const std::string before = config_to_yaml(c);
+  EXPECT_THROW(apply_config_yaml(c, "odometry:\n  threads: 4\n  local_map_frames: 0\n", "partial.yaml"), ConfigError);
+  EXPECT_EQ(config_to_yaml(c), before);  // nothing of a rejected file is applied
+}
+
+TEST(ConfigRanges, DefaultsAndShippedFilesAreValid) {
+  EXPECT_NO_THROW(validate_config(SaloamConfig{}));
+  EXPECT_NO_THROW(validate_config(load_config(testing::source_dir() / "config" / "real_kitti.yaml")));
+  EXPECT_NO_THROW(validate_config(load_config(testing::source_dir() / "config" / "saloam.yaml")));
+  SaloamConfig c;
+  c.odometry.local_map_frames = 0;  // set in code: validate_config still catches it
+  EXPECT_NE(config_error([&] { validate_config(c, "test"); }).find("test: 'odometry.local_map_frames' = 0"),
+            std::string::npos);
+}
+
+TEST(ConfigRanges, SavedYamlShowsEachRange) {
+  const std::string yaml = config_to_yaml(SaloamConfig{});
+  for (const char* line : {"local_map_frames: 20  # N_m: frames in the local map [>= 1]",
+                           "zeta: 0.95  # zeta: SGPR score threshold [0, 1]",
+                           "detector: scancontext  # place-recognition scorer "
+                           "[one of sgpr, scancontext, hybrid]",
+                           "max_runner_up_ratio: .inf  # uniqueness: max inliers of a distinct fit / best [0, .inf]",
+                           "use_semantics: true  # semantic assistance on/off\n",
+                           "seed: 42  # seed of the N_candi random draw\n"}) {
+    EXPECT_NE(yaml.find(line), std::string::npos) << line;
+  }
+}
+
 }  // namespace
 }  // namespace saloam
-

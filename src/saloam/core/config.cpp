@@ -28,9 +28,70 @@ namespace {
 struct Field {
   std::string key;  // "section.name"
   std::string doc;
+  std::string range;  // the valid values as text, e.g. "> 0"; empty: any
   std::function<void(const YAML::Node&, const std::string& origin)> set;
   std::function<YAML::Node()> get;
+  std::function<void(const std::string& origin)> check;  // throws ConfigError when out of range
 };
+
+// A number as YAML writes it: shortest exact text, infinity as ".inf".
+std::string number_text(double x) {
+  if (std::isinf(x)) return x > 0 ? ".inf" : "-.inf";
+  return fmt::format("{}", x);
+}
+
+bool admits(const Range& r, double x) { return x >= r.lo && x <= r.hi; }  // false for NaN
+bool admits(const AtLeast& r, double x) { return std::isfinite(x) && x >= r.lo; }
+bool admits(const Above& r, double x) { return std::isfinite(x) && x > r.lo; }
+template <class T, class V>
+bool admits(const OneOf<T>& r, const V& x) {
+  return std::find(r.values.begin(), r.values.end(), x) != r.values.end();
+}
+template <class V>
+bool admits(const Any&, const V&) {
+  return true;
+}
+
+std::string describe(const Range& r) { return fmt::format("[{}, {}]", number_text(r.lo), number_text(r.hi)); }
+std::string describe(const AtLeast& r) { return ">= " + number_text(r.lo); }
+std::string describe(const Above& r) { return "> " + number_text(r.lo); }
+template <class T>
+std::string describe(const OneOf<T>& r) {
+  return fmt::format("one of {}", fmt::join(r.values, ", "));
+}
+std::string describe(const Any&) { return ""; }
+
+template <class T>
+std::string value_text(const T& value) {
+  if constexpr (std::is_same_v<T, std::string>) {
+    return fmt::format("'{}'", value);
+  } else if constexpr (std::is_floating_point_v<T>) {
+    return number_text(value);
+  } else {
+    return fmt::format("{}", value);
+  }
+}
+
+// Throws when `value` of field `key` is outside `range`; NaN never passes.
+template <class T, class R>
+void check_value(const T& value, const R& range, const std::string& key, const std::string& origin) {
+  if constexpr (std::is_floating_point_v<T>) {
+    if (std::isnan(value)) throw ConfigError(fmt::format("{}: '{}' is NaN (valid: {})", origin, key, describe(range)));
+  }
+  if (!admits(range, value)) {
+    throw ConfigError(
+        fmt::format("{}: '{}' = {} is not allowed (valid: {})", origin, key, value_text(value), describe(range)));
+  }
+}
+
+template <class T, class R>
+void check_member(const T& member, const R& range, const std::string& key, const std::string& origin) {
+  if constexpr (std::is_same_v<T, ClassValueMap>) {
+    for (const auto& [name, value] : member) check_value(value, range, key + "." + name, origin);
+  } else {
+    check_value(member, range, key, origin);
+  }
+}
 
 template <class T>
 void assign(T& member, const YAML::Node& node, const std::string& key, const std::string& origin) {
@@ -64,23 +125,38 @@ YAML::Node to_node(const T& value) {
   if constexpr (std::is_same_v<T, ClassValueMap>) {
     for (const auto& [name, v] : value) n[name] = fmt::format("{}", v);
   } else if constexpr (std::is_floating_point_v<T>) {
-    // Shortest text that reads back exactly; YAML spells infinity ".inf".
-    n = std::isinf(value) ? std::string(value > 0 ? ".inf" : "-.inf") : fmt::format("{}", value);
+    n = number_text(value);
   } else {
     n = value;
   }
   return n;
 }
 
+template <class T, class R>
+Field field_of(const std::string& key, std::string_view doc, T& member, const R& range) {
+  return Field{key,
+               std::string(doc),
+               describe(range),
+               [&member, key](const YAML::Node& n, const std::string& origin) { assign(member, n, key, origin); },
+               [&member] { return to_node(member); },
+               [&member, range, key](const std::string& origin) { check_member(member, range, key, origin); }};
+}
+
+template <class T, class R>
+Field make_field(const std::string& key, std::string_view doc, T& member, const R& range) {
+  static_assert(!std::is_same_v<T, bool>, "a bool field takes no range");
+  return field_of(key, doc, member, range);
+}
+// Only a bool leaves out its range (a field of another type without one does not compile).
+Field make_field(const std::string& key, std::string_view doc, bool& member) {
+  return field_of(key, doc, member, Any{});
+}
+
 std::vector<Field> collect_fields(SaloamConfig& config) {
   std::vector<Field> fields;
   visit_sections(config, [&](std::string_view section, auto& s) {
-    visit_fields(s, [&](std::string_view name, auto& member, std::string_view doc) {
-      const std::string key = fmt::format("{}.{}", section, name);
-      fields.push_back(Field{
-          key, std::string(doc),
-          [&member, key](const YAML::Node& n, const std::string& origin) { assign(member, n, key, origin); },
-          [&member] { return to_node(member); }});
+    visit_fields(s, [&](std::string_view name, auto& member, std::string_view doc, const auto&... range) {
+      fields.push_back(make_field(fmt::format("{}.{}", section, name), doc, member, range...));
     });
   });
   return fields;
@@ -112,7 +188,70 @@ void apply_node(SaloamConfig& config, const YAML::Node& node, const std::string&
   }
 }
 
+// Pairs of fields whose valid values depend on each other.
+void check_consistency(const SaloamConfig& config, const std::string& origin) {
+  const FeatureConfig& f = config.odometry.features;
+  if (!(f.min_range < f.max_range)) {
+    throw ConfigError(fmt::format("{}: 'odometry.features.min_range' = {} must be less than "
+                                  "'odometry.features.max_range' = {}",
+                                  origin, number_text(f.min_range), number_text(f.max_range)));
+  }
+  if (!(config.loop.delta_min <= config.loop.delta_max)) {
+    throw ConfigError(fmt::format("{}: 'loop.delta_min' = {} must not exceed 'loop.delta_max' = {}", origin,
+                                  number_text(config.loop.delta_min), number_text(config.loop.delta_max)));
+  }
+  if (!(f.pose_time_in_sweep <= f.sweep_duration)) {
+    throw ConfigError(fmt::format("{}: 'odometry.features.pose_time_in_sweep' = {} must lie within the sweep, "
+                                  "[0, 'odometry.features.sweep_duration' = {}]",
+                                  origin, number_text(f.pose_time_in_sweep), number_text(f.sweep_duration)));
+  }
+}
+
+// The full key of a bare field name ("alpha") when exactly one section has it; else `key` as given.
+std::string resolve_short_key(const std::vector<Field>& fields, const std::string& key, const std::string& origin) {
+  if (key.find('.') != std::string::npos) return key;
+  std::vector<std::string> matches;
+  for (const auto& f : fields) {
+    if (f.key.size() > key.size() && f.key.ends_with("." + key)) matches.push_back(f.key);
+  }
+  if (matches.size() > 1) {
+    throw ConfigError(fmt::format("{}: '{}' is ambiguous ({})", origin, key, fmt::join(matches, ", ")));
+  }
+  return matches.size() == 1 ? matches.front() : key;
+}
+
+// Sets the field `key`, or one entry of a per-class map ("section.map_field.class").
+void set_by_key(const std::vector<Field>& fields, const std::string& key, const YAML::Node& value,
+                const std::string& origin) {
+  for (const auto& f : fields) {
+    if (f.key == key) {
+      f.set(value, origin);
+      return;
+    }
+    if (key.starts_with(f.key + ".") && f.get().IsMap()) {
+      YAML::Node entry;
+      entry[key.substr(f.key.size() + 1)] = value;
+      f.set(entry, origin);
+      return;
+    }
+  }
+  throw ConfigError(fmt::format("{}: unknown configuration key '{}'", origin, key));
+}
+
+// A field's doc followed by its valid values, e.g. "N_m: frames in the local map [>= 1]".
+std::string doc_with_range(const Field& f) {
+  if (f.range.empty()) return f.doc;
+  return f.doc + " " + (f.range.starts_with('[') ? f.range : "[" + f.range + "]");
+}
+
 }  // namespace
+
+void validate_config(const SaloamConfig& config_in, std::string_view origin_in) {
+  SaloamConfig config = config_in;  // the visitors need mutable access
+  const std::string origin(origin_in);
+  for (const auto& f : collect_fields(config)) f.check(origin);
+  check_consistency(config, origin);
+}
 
 void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin) {
   YAML::Node root;
@@ -121,8 +260,10 @@ void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::st
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}: invalid YAML: {}", origin, e.what()));
   }
-  if (root.IsNull()) return;  // empty file: defaults
-  apply_node(config, root, "", std::string(origin), collect_fields(config));
+  SaloamConfig updated = config;  // `config` stays as it was when anything is wrong
+  if (!root.IsNull()) apply_node(updated, root, "", std::string(origin), collect_fields(updated));  // null: empty file
+  validate_config(updated, origin);
+  config = std::move(updated);
 }
 
 SaloamConfig load_config(const std::filesystem::path& path) {
@@ -140,43 +281,18 @@ void apply_config_override(SaloamConfig& config, std::string_view assignment) {
   if (eq == std::string_view::npos || eq == 0) {
     throw ConfigError(fmt::format("--set '{}': expected key=value", assignment));
   }
-  std::string key(assignment.substr(0, eq));
-  const std::string value(assignment.substr(eq + 1));
   const std::string origin = fmt::format("--set {}", assignment);
-  const auto fields = collect_fields(config);
-
-  // A bare field name ("alpha") resolves when exactly one section has it.
-  if (key.find('.') == std::string::npos) {
-    std::vector<std::string> matches;
-    for (const auto& f : fields) {
-      if (f.key.size() > key.size() && f.key.ends_with("." + key)) matches.push_back(f.key);
-    }
-    if (matches.size() > 1) {
-      throw ConfigError(fmt::format("{}: '{}' is ambiguous ({})", origin, key, fmt::join(matches, ", ")));
-    }
-    if (matches.size() == 1) key = matches.front();
-  }
-
-  YAML::Node parsed;
+  YAML::Node value;
   try {
-    parsed = YAML::Load(value);
+    value = YAML::Load(std::string(assignment.substr(eq + 1)));
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}: cannot parse value: {}", origin, e.what()));
   }
-  for (const auto& f : fields) {
-    if (f.key == key) {
-      f.set(parsed, origin);
-      return;
-    }
-    // "section.map_field.class=value": one entry of a per-class map.
-    if (key.starts_with(f.key + ".") && f.get().IsMap()) {
-      YAML::Node entry;
-      entry[key.substr(f.key.size() + 1)] = parsed;
-      f.set(entry, origin);
-      return;
-    }
-  }
-  throw ConfigError(fmt::format("{}: unknown configuration key '{}'", origin, key));
+  SaloamConfig updated = config;  // `config` stays as it was when anything is wrong
+  const auto fields = collect_fields(updated);
+  set_by_key(fields, resolve_short_key(fields, std::string(assignment.substr(0, eq)), origin), value, origin);
+  validate_config(updated, origin);
+  config = std::move(updated);
 }
 
 std::string config_to_yaml(const SaloamConfig& config_in) {
@@ -190,7 +306,7 @@ std::string config_to_yaml(const SaloamConfig& config_in) {
     for (const auto& f : fields) {
       const auto dot = f.key.rfind('.');
       if (f.key.substr(0, dot) != section) continue;
-      out << YAML::Key << f.key.substr(dot + 1) << YAML::Value << f.get() << YAML::Comment(f.doc);
+      out << YAML::Key << f.key.substr(dot + 1) << YAML::Value << f.get() << YAML::Comment(doc_with_range(f));
     }
     for (const auto& child : section_names(config)) {
       if (child.starts_with(section + ".") && child.find('.', section.size() + 1) == std::string::npos) {

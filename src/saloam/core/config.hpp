@@ -2,14 +2,18 @@
 // The configuration of the whole system: plain structs with documented
 // defaults (the paper's Table I where it gives one), plus one generic field
 // visitor per struct so that YAML loading, saving and `--set key=value`
-// overrides share one list of names. To add a parameter: add the member with
-// its default and one line to the struct's `visit_fields`.
+// overrides share one list of names, docs and valid ranges. To add a
+// parameter: add the member with its default and one line to the struct's
+// `visit_fields` (name, member, doc, range; bool fields have no range).
+// Loading and overrides reject values outside a field's range, and
+// combinations that contradict each other (see validate_config).
 //
 // Keys are "<section>.<field>", e.g. "odometry.alpha". Table I symbols are
 // named in each comment.
 
 #include <cstdint>
 #include <filesystem>
+#include <initializer_list>
 #include <limits>
 #include <map>
 #include <string>
@@ -24,6 +28,34 @@ using ClassValueMap = std::map<std::string, double>;
 
 /// Value of `map` for a raw class id, falling back to map["default"], then to `fallback`.
 double class_value(const ClassValueMap& map, std::uint16_t raw_id, double fallback);
+
+/// Valid values of a numeric field: lo <= x <= hi. An infinite hi admits
+/// infinity (".inf"), for fields where it means "off" or "never".
+struct Range {
+  double lo;
+  double hi;
+};
+/// Valid values of a numeric field: finite x >= lo.
+struct AtLeast {
+  double lo;
+};
+/// Valid values of a numeric field: finite x > lo (sizes, scales, durations).
+struct Above {
+  double lo;
+};
+/// Valid values of a field: one of those listed (strings or integers).
+template <class T>
+struct OneOf {
+  OneOf(std::initializer_list<T> listed) : values(listed) {}
+  std::vector<T> values;
+};
+/// Every value of the field's type is valid (free text, a seed).
+struct Any {};
+
+/// Infinity, the upper bound of a Range that admits ".inf".
+inline constexpr double kInf = std::numeric_limits<double>::infinity();
+/// Neighbours the registration fits a line or plane to at most (its kMaxNeighbours).
+inline constexpr int kMaxFitNeighbours = 32;
 
 /// LOAM feature extraction (paper Sec. III-B, Eq. 1).
 struct FeatureConfig {
@@ -196,80 +228,82 @@ struct SaloamConfig {
   SlamConfig slam;
 };
 
-/// Calls v(name, member, description) for every scalar field.
+/// Calls v(name, member, description, range) for every field; range is the
+/// set of valid values (Range, AtLeast, Above, OneOf, Any; for a ClassValueMap
+/// the range of each value). bool fields take no range: v(name, member, description).
 template <class Visitor>
 void visit_fields(FeatureConfig& c, Visitor&& v) {
-  v("alpha", c.alpha, "alpha: roughness threshold edge/planar [m^2, unnormalised Eq. 1]");
-  v("num_sectors", c.num_sectors, "N_r: sectors per ring");
-  v("edges_per_sector", c.edges_per_sector, "N_e: edge features per sector");
-  v("planars_per_sector", c.planars_per_sector, "N_p: planar features per sector");
-  v("ground_edge_alpha", c.ground_edge_alpha, "with labels, min roughness of a ground edge (.inf: none)");
-  v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1");
-  v("min_range", c.min_range, "min range [m]");
-  v("max_range", c.max_range, "max range [m]");
-  v("num_beams", c.num_beams, "beams (0 = detect)");
+  v("alpha", c.alpha, "alpha: roughness threshold edge/planar [m^2, unnormalised Eq. 1]", Above{0});
+  v("num_sectors", c.num_sectors, "N_r: sectors per ring", AtLeast{1});
+  v("edges_per_sector", c.edges_per_sector, "N_e: edge features per sector", AtLeast{1});
+  v("planars_per_sector", c.planars_per_sector, "N_p: planar features per sector", AtLeast{1});
+  v("ground_edge_alpha", c.ground_edge_alpha, "with labels, min roughness of a ground edge (.inf: none)", Range{0, kInf});
+  v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1", AtLeast{1});
+  v("min_range", c.min_range, "min range [m]", AtLeast{0});
+  v("max_range", c.max_range, "max range [m]", Above{0});
+  v("num_beams", c.num_beams, "beams (0 = detect)", OneOf{0, 16, 32, 64});
   v("ring_from_point_order", c.ring_from_point_order, "rings from storage order when it is ring by ring");
-  v("pose_time_in_sweep", c.pose_time_in_sweep, "[s] instant of the sweep a pose refers to");
-  v("sweep_duration", c.sweep_duration, "[s] one revolution");
-  v("sweep_start_azimuth_deg", c.sweep_start_azimuth_deg, "[deg] azimuth where a sweep starts");
+  v("pose_time_in_sweep", c.pose_time_in_sweep, "[s] instant of the sweep a pose refers to", AtLeast{0});
+  v("sweep_duration", c.sweep_duration, "[s] one revolution", Above{0});
+  v("sweep_start_azimuth_deg", c.sweep_start_azimuth_deg, "[deg] azimuth where a sweep starts", Range{-360, 360});
   v("sweep_clockwise", c.sweep_clockwise, "sweep turns clockwise seen from above");
 }
 
 template <class Visitor>
 void visit_fields(OdometryConfig& c, Visitor&& v) {
-  v("local_map_frames", c.local_map_frames, "N_m: frames in the local map");
-  v("edge_neighbours", c.edge_neighbours, "N_ne: neighbours per edge feature");
-  v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature");
-  v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . z|");
+  v("local_map_frames", c.local_map_frames, "N_m: frames in the local map", AtLeast{1});
+  v("edge_neighbours", c.edge_neighbours, "N_ne: neighbours per edge feature", Range{2, kMaxFitNeighbours});
+  v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature", Range{3, kMaxFitNeighbours});
+  v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . z|", Range{0, 1});
   v("use_semantics", c.use_semantics, "semantic assistance on/off");
   v("match_class_groups", c.match_class_groups, "match within class groups instead of single classes");
   v("deskew", c.deskew, "constant-velocity de-skewing");
-  v("max_iterations", c.max_iterations, "Gauss-Newton iterations");
-  v("outer_iterations", c.outer_iterations, "re-association rounds (at most)");
-  v("reassociation_min_translation", c.reassociation_min_translation, "[m] smaller pose change ends re-association");
-  v("reassociation_min_rotation_deg", c.reassociation_min_rotation_deg, "[deg] smaller rotation ends re-association");
-  v("robust_kernel_scale", c.robust_kernel_scale, "[m] robust kernel scale");
-  v("max_correspondence_distance", c.max_correspondence_distance, "[m] max neighbour distance");
-  v("voxel_size", c.voxel_size, "[m] voxel size (label-agnostic)");
-  v("class_voxel_size", c.class_voxel_size, "[m] per-class voxel size");
-  v("class_weight", c.class_weight, "w^l: per-class residual weight");
-  v("threads", c.threads, "threads (0 = all cores)");
+  v("max_iterations", c.max_iterations, "Gauss-Newton iterations", AtLeast{1});
+  v("outer_iterations", c.outer_iterations, "re-association rounds (at most)", AtLeast{1});
+  v("reassociation_min_translation", c.reassociation_min_translation, "[m] smaller pose change ends re-association", AtLeast{0});
+  v("reassociation_min_rotation_deg", c.reassociation_min_rotation_deg, "[deg] smaller rotation ends re-association", AtLeast{0});
+  v("robust_kernel_scale", c.robust_kernel_scale, "[m] robust kernel scale", Above{0});
+  v("max_correspondence_distance", c.max_correspondence_distance, "[m] max neighbour distance", Above{0});
+  v("voxel_size", c.voxel_size, "[m] voxel size (label-agnostic)", Above{0});
+  v("class_voxel_size", c.class_voxel_size, "[m] per-class voxel size", Above{0});
+  v("class_weight", c.class_weight, "w^l: per-class residual weight", AtLeast{0});
+  v("threads", c.threads, "threads (0 = all cores)", AtLeast{0});
 }
 
 template <class Visitor>
 void visit_fields(LoopClosureConfig& c, Visitor&& v) {
-  v("detector", c.detector, "place recognition: sgpr, scancontext or hybrid");
-  v("sigma", c.sigma, "sigma: odometry drift rate of Eq. 3 [m per m travelled]");
-  v("delta_min", c.delta_min, "delta_min [m]: min search radius of Eq. 3");
-  v("delta_max", c.delta_max, "delta_max [m]: max search radius of Eq. 3");
-  v("num_candidates", c.num_candidates, "N_candi: candidates per query (random draw beyond)");
-  v("zeta", c.zeta, "zeta: SGPR score threshold");
-  v("scancontext_zeta", c.scancontext_zeta, "Scan Context (and hybrid) score threshold");
-  v("num_loop", c.num_loop, "N_loop: best pairs verified per query");
-  v("proximity_radius", c.proximity_radius, "[m] also verify the nearest candidate within this (0 = off)");
-  v("delta_r", c.delta_r, "delta_r: ICP loss threshold (Eq. 2 sum) [m]");
-  v("acceptance", c.acceptance, "verification test: normalized or loss");
-  v("max_mean_residual", c.max_mean_residual, "[m] normalized test: max mean inlier residual");
-  v("min_inlier_fraction", c.min_inlier_fraction, "normalized test: min inlier fraction");
-  v("inlier_distance", c.inlier_distance, "[m] inlier residual bound");
-  v("min_translation_eigenvalue", c.min_translation_eigenvalue, "degeneracy: min translation eigenvalue of H/N");
-  v("max_runner_up_ratio", c.max_runner_up_ratio, "uniqueness: max inliers of a distinct fit / best");
-  v("exclude_recent_distance", c.exclude_recent_distance, "[m] recent travel excluded from the search");
-  v("submap_half_width", c.submap_half_width, "keyframes each side of a candidate in its submap");
-  v("search_interval_after_loop", c.search_interval_after_loop, "[m] travel before searching again after a loop");
-  v("seed", c.seed, "seed of the N_candi random draw");
-  v("sgpr_model", c.sgpr_model, "SGPR weights (.sgw)");
+  v("detector", c.detector, "place-recognition scorer", OneOf{"sgpr", "scancontext", "hybrid"});
+  v("sigma", c.sigma, "sigma: odometry drift rate of Eq. 3 [m per m travelled]", AtLeast{0});
+  v("delta_min", c.delta_min, "delta_min [m]: min search radius of Eq. 3", AtLeast{0});
+  v("delta_max", c.delta_max, "delta_max [m]: max search radius of Eq. 3", Above{0});
+  v("num_candidates", c.num_candidates, "N_candi: candidates per query (random draw beyond)", AtLeast{1});
+  v("zeta", c.zeta, "zeta: SGPR score threshold", Range{0, 1});
+  v("scancontext_zeta", c.scancontext_zeta, "Scan Context (and hybrid) score threshold", Range{0, 1});
+  v("num_loop", c.num_loop, "N_loop: best pairs verified per query", AtLeast{1});
+  v("proximity_radius", c.proximity_radius, "[m] also verify the nearest candidate within this (0 = off)", AtLeast{0});
+  v("delta_r", c.delta_r, "delta_r: ICP loss threshold (Eq. 2 sum) [m]", Above{0});
+  v("acceptance", c.acceptance, "verification test", OneOf{"normalized", "loss"});
+  v("max_mean_residual", c.max_mean_residual, "[m] normalized test: max mean inlier residual", Above{0});
+  v("min_inlier_fraction", c.min_inlier_fraction, "normalized test: min inlier fraction", Range{0, 1});
+  v("inlier_distance", c.inlier_distance, "[m] inlier residual bound", Above{0});
+  v("min_translation_eigenvalue", c.min_translation_eigenvalue, "degeneracy: min translation eigenvalue of H/N", Range{0, 1});
+  v("max_runner_up_ratio", c.max_runner_up_ratio, "uniqueness: max inliers of a distinct fit / best", Range{0, kInf});
+  v("exclude_recent_distance", c.exclude_recent_distance, "[m] recent travel excluded from the search", AtLeast{0});
+  v("submap_half_width", c.submap_half_width, "keyframes each side of a candidate in its submap", AtLeast{0});
+  v("search_interval_after_loop", c.search_interval_after_loop, "[m] travel before searching again after a loop", AtLeast{0});
+  v("seed", c.seed, "seed of the N_candi random draw", Any{});
+  v("sgpr_model", c.sgpr_model, "SGPR weights (.sgw)", Any{});
 }
 
 template <class Visitor>
 void visit_fields(SlamConfig& c, Visitor&& v) {
-  v("keyframe_distance", c.keyframe_distance, "[m] travel between keyframes");
-  v("keyframe_angle_deg", c.keyframe_angle_deg, "[deg] rotation between keyframes");
-  v("information_scale", c.information_scale, "[1/m^2] edge information = scale * H / N");
-  v("loop_robust_scale", c.loop_robust_scale, "Cauchy scale of loop edges");
-  v("max_iterations", c.max_iterations, "pose-graph iterations per optimisation");
-  v("map_voxel_size", c.map_voxel_size, "[m] global map voxel size");
-  v("map_frame_step", c.map_frame_step, "every n-th frame goes into the global map");
+  v("keyframe_distance", c.keyframe_distance, "[m] travel between keyframes", AtLeast{0});
+  v("keyframe_angle_deg", c.keyframe_angle_deg, "[deg] rotation between keyframes", AtLeast{0});
+  v("information_scale", c.information_scale, "[1/m^2] edge information = scale * H / N", Above{0});
+  v("loop_robust_scale", c.loop_robust_scale, "Cauchy scale of loop edges", Above{0});
+  v("max_iterations", c.max_iterations, "pose-graph iterations per optimisation", AtLeast{1});
+  v("map_voxel_size", c.map_voxel_size, "[m] global map voxel size", Above{0});
+  v("map_frame_step", c.map_frame_step, "every n-th frame goes into the global map", AtLeast{1});
 }
 
 /// Calls v(section, struct) for every section; nested sections use dots.
@@ -281,15 +315,24 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
   v("slam", c.slam);
 }
 
-/// Loads a YAML file over the defaults. Unknown keys and wrong types are
-/// errors naming the file and the key.
+/// Throws ConfigError, starting with `origin`, for the first field outside
+/// its declared range (NaN never passes) or the first contradicting pair:
+/// odometry.features.min_range < max_range, loop.delta_min <= delta_max,
+/// odometry.features.pose_time_in_sweep <= sweep_duration.
+void validate_config(const SaloamConfig& config, std::string_view origin = "configuration");
+/// Loads a YAML file over the defaults. Unknown keys, wrong types and
+/// invalid values (validate_config) are errors naming the file and the key.
 SaloamConfig load_config(const std::filesystem::path& path);
-/// Applies YAML text over `config` (used by load_config; `origin` names the source in errors).
+/// Applies YAML text over `config` (used by load_config; `origin` names the
+/// source in errors). The result must pass validate_config; on any error
+/// `config` is left unchanged.
 void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin);
 /// Applies one "key=value" override, e.g. "odometry.alpha=0.2" or
-/// "odometry.class_weight.pole=2". A bare Table I name ("alpha") works when unique.
+/// "odometry.class_weight.pole=2". A bare Table I name ("alpha") works when
+/// unique. The result must pass validate_config (so a pair is changed in the
+/// order that keeps it consistent); on any error `config` is left unchanged.
 void apply_config_override(SaloamConfig& config, std::string_view assignment);
-/// The full configuration as commented YAML (every key, its value and meaning).
+/// The full configuration as commented YAML (every key, its value, meaning and range).
 std::string config_to_yaml(const SaloamConfig& config);
 
 }  // namespace saloam
