@@ -17,7 +17,7 @@ void ConfigOptions::add_to(CLI::App& app) {
 
 SaloamConfig ConfigOptions::resolve() const {
   SaloamConfig config = config_file.empty() ? SaloamConfig{} : load_config(config_file);
-  for (const auto& o : overrides) apply_config_override(config, o);
+  apply_config_overrides(config, overrides);
   return config;
 }
 

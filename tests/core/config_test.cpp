@@ -256,6 +256,19 @@ TEST(ConfigRanges, ContradictingPairsAreRejected) {
   apply_config_override(c, "loop.delta_max=300");
   apply_config_override(c, "loop.delta_min=200");
   EXPECT_DOUBLE_EQ(c.loop.delta_min, 200.0);
+
+  // A command line's overrides count together: their order does not matter.
+  SaloamConfig d;
+  apply_config_overrides(d, {"loop.delta_min=150", "loop.delta_max=300"});
+  EXPECT_DOUBLE_EQ(d.loop.delta_min, 150.0);
+  EXPECT_DOUBLE_EQ(d.loop.delta_max, 300.0);
+  EXPECT_NE(config_error([&] { apply_config_overrides(d, {"loop.delta_min=400", "alpha=0.3"}); })
+                .find("'loop.delta_min' = 400 must not exceed"),
+            std::string::npos);
+  EXPECT_DOUBLE_EQ(d.odometry.features.alpha, 0.1);  // nothing applied
+  EXPECT_NE(config_error([&] { apply_config_overrides(d, {"voxel_size=0", "alpha=0.3"}); })
+                .find("--set voxel_size=0: 'odometry.voxel_size' = 0 is not allowed"),
+            std::string::npos);
 }
 
 TEST(ConfigRanges, YamlFileWithBadValueNamesFileKeyAndRange) {

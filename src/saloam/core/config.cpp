@@ -276,7 +276,11 @@ SaloamConfig load_config(const std::filesystem::path& path) {
   return config;
 }
 
-void apply_config_override(SaloamConfig& config, std::string_view assignment) {
+namespace {
+
+// Sets one key=value in `config`, checking every field's range (the
+// cross-field rules are the caller's, once all values are set).
+void set_override(SaloamConfig& config, std::string_view assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string_view::npos || eq == 0) {
     throw ConfigError(fmt::format("--set '{}': expected key=value", assignment));
@@ -288,10 +292,21 @@ void apply_config_override(SaloamConfig& config, std::string_view assignment) {
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}: cannot parse value: {}", origin, e.what()));
   }
-  SaloamConfig updated = config;  // `config` stays as it was when anything is wrong
-  const auto fields = collect_fields(updated);
+  const auto fields = collect_fields(config);
   set_by_key(fields, resolve_short_key(fields, std::string(assignment.substr(0, eq)), origin), value, origin);
-  validate_config(updated, origin);
+  for (const auto& f : fields) f.check(origin);
+}
+
+}  // namespace
+
+void apply_config_override(SaloamConfig& config, std::string_view assignment) {
+  apply_config_overrides(config, {std::string(assignment)});
+}
+
+void apply_config_overrides(SaloamConfig& config, const std::vector<std::string>& assignments) {
+  SaloamConfig updated = config;  // `config` stays as it was when anything is wrong
+  for (const auto& assignment : assignments) set_override(updated, assignment);
+  if (!assignments.empty()) validate_config(updated, fmt::format("--set {}", fmt::join(assignments, " --set ")));
   config = std::move(updated);
 }
 

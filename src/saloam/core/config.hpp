@@ -332,6 +332,10 @@ void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::st
 /// unique. The result must pass validate_config (so a pair is changed in the
 /// order that keeps it consistent); on any error `config` is left unchanged.
 void apply_config_override(SaloamConfig& config, std::string_view assignment);
+/// Applies several overrides together (a command line's --set options): each
+/// value is range-checked as it is set, the cross-field rules once at the
+/// end, so their order does not matter.
+void apply_config_overrides(SaloamConfig& config, const std::vector<std::string>& assignments);
 /// The full configuration as commented YAML (every key, its value, meaning and range).
 std::string config_to_yaml(const SaloamConfig& config);
 
