@@ -382,4 +382,10 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   return out;
 }
 
+FeatureCloud transformed(const FeatureCloud& cloud, const Pose& T) {
+  FeatureCloud out = cloud;
+  for (auto& p : out.points) p = T * p;
+  return out;
+}
+
 }  // namespace saloam

@@ -118,6 +118,9 @@ ClassIndex class_group(ClassIndex c);
 /// unlabeled points are dropped from the features (after the roughness, which
 /// is pure geometry: removing them first would create false edges).
 /// With `parallel`, rings are processed as TBB tasks (same result).
+/// The cloud with every point mapped by T (classes and sweep times kept).
+FeatureCloud transformed(const FeatureCloud& cloud, const Pose& T);
+
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
                               bool parallel = false);
 

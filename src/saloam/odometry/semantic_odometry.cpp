@@ -19,11 +19,6 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-FeatureCloud transformed(const FeatureCloud& cloud, const Pose& T) {
-  FeatureCloud out = cloud;
-  for (auto& p : out.points) p = T * p;
-  return out;
-}
 }  // namespace
 
 SemanticOdometry::SemanticOdometry(OdometryConfig config)

@@ -35,11 +35,6 @@ FeatureCloud every_nth(const FeatureCloud& cloud, std::size_t n) {
   return out;
 }
 
-FeatureCloud transformed(const FeatureCloud& cloud, const Pose& T) {
-  FeatureCloud out = cloud;
-  for (auto& p : out.points) p = T * p;
-  return out;
-}
 }  // namespace
 
 LoopVerificationSettings LoopVerificationSettings::from_config(const SaloamConfig& config) {
