@@ -115,12 +115,21 @@ void write_scan_bin(const std::filesystem::path& bin_file, const LabelledCloud& 
   write_bytes(bin_file, raw.data(), raw.size() * sizeof(float));
 }
 
-void write_scan_labels(const std::filesystem::path& label_file, const LabelledCloud& cloud) {
-  std::vector<std::uint32_t> raw(cloud.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    raw[i] = static_cast<std::uint32_t>(cloud.label[i]) | (static_cast<std::uint32_t>(cloud.instance[i]) << 16);
+void write_scan_labels(const std::filesystem::path& label_file, const std::vector<std::uint16_t>& labels,
+                       const std::vector<std::uint16_t>& instances) {
+  if (labels.size() != instances.size()) {
+    throw std::invalid_argument(fmt::format("{}: {} labels but {} instance ids", label_file.string(), labels.size(),
+                                            instances.size()));
+  }
+  std::vector<std::uint32_t> raw(labels.size());
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    raw[i] = static_cast<std::uint32_t>(labels[i]) | (static_cast<std::uint32_t>(instances[i]) << 16);
   }
   write_bytes(label_file, raw.data(), raw.size() * sizeof(std::uint32_t));
+}
+
+void write_scan_labels(const std::filesystem::path& label_file, const LabelledCloud& cloud) {
+  write_scan_labels(label_file, cloud.label, cloud.instance);
 }
 
 }  // namespace saloam

@@ -29,6 +29,9 @@ LabelledCloud read_scan(const std::filesystem::path& bin_file,
 void write_scan_bin(const std::filesystem::path& bin_file, const LabelledCloud& cloud);
 /// Writes the labels (class | instance << 16) as a .label file.
 void write_scan_labels(const std::filesystem::path& label_file, const LabelledCloud& cloud);
+/// The same from separate label and instance arrays (equal lengths).
+void write_scan_labels(const std::filesystem::path& label_file, const std::vector<std::uint16_t>& labels,
+                       const std::vector<std::uint16_t>& instances);
 
 /// Reads only a .label file: one uint32 per point.
 std::vector<std::uint32_t> read_label_file(const std::filesystem::path& label_file);

@@ -67,87 +67,109 @@ SweepSpec sweep_for_frame(const std::vector<Pose>& traj, std::size_t i, const Si
   return s;
 }
 
-SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::path& out_dir) {
-  const auto t0 = std::chrono::steady_clock::now();
-  const std::vector<Pose> trajectory = source_lidar_trajectory(options);
-  const std::vector<std::size_t> frames = selected_frames(options, trajectory.size());
+namespace {
+
+LidarModel lidar_for(const SimulationOptions& options) {
   LidarModel lidar = LidarModel::hdl64e(options.beams);
   if (options.azimuth_steps < 16) throw ConfigError("azimuth steps must be at least 16");
   lidar.azimuth_steps = options.azimuth_steps;
   lidar.sweep_period = options.frame_period;
+  return lidar;
+}
 
+World world_for(const std::vector<Pose>& trajectory, const SimulationOptions& options) {
   WorldOptions world_options = options.world;
   world_options.frame_period = options.frame_period;
-  const World world = build_world(trajectory, options.seed, world_options);
+  return build_world(trajectory, options.seed, world_options);
+}
 
-  // Output poses: re-based so that the first written frame is the origin.
-  const Pose tr = output_velo_to_cam(options);
-  const Pose base_inv = trajectory[frames.front()].inverse();
-  std::vector<Pose> lidar_out;
-  std::vector<double> times;
-  for (std::size_t k = 0; k < frames.size(); ++k) {
-    lidar_out.push_back(orthonormalized(base_inv * trajectory[frames[k]]));
-    times.push_back(static_cast<double>(frames[k] - frames.front()) * options.frame_period);
+}  // namespace
+
+SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
+    : options_(options),
+      trajectory_(source_lidar_trajectory(options)),
+      frames_(selected_frames(options, trajectory_.size())),
+      lidar_(lidar_for(options)),
+      world_(world_for(trajectory_, options)),
+      velo_to_cam_(output_velo_to_cam(options)) {
+  // Re-based so that the first selected frame is the origin.
+  const Pose base_inv = trajectory_[frames_.front()].inverse();
+  std::vector<Pose> lidar_out, sensor_out;
+  for (const std::size_t i : frames_) {
+    lidar_out.push_back(orthonormalized(base_inv * trajectory_[i]));
+    // Where the sweep really started: the given pose, raised or lowered onto
+    // the ground where the trajectory's heights do not fit one surface.
+    Pose sensor = trajectory_[i];
+    sensor.translation() = world_.sensor_origin(sensor.translation());
+    sensor_out.push_back(orthonormalized(base_inv * sensor));
+    times_.push_back(static_cast<double>(i - frames_.front()) * options.frame_period);
   }
-  const std::vector<Pose> camera_out = lidar_to_camera_poses(lidar_out, tr);
+  camera_poses_ = lidar_to_camera_poses(lidar_out, velo_to_cam_);
+  sensor_camera_poses_ = lidar_to_camera_poses(sensor_out, velo_to_cam_);
+}
 
+SimulatedFrame SimulatedSequence::render(std::size_t k) const {
+  const SweepSpec sweep = sweep_for_frame(trajectory_, frames_.at(k), options_);
+  SimulatedScan scan = simulate_scan(world_, lidar_, sweep);
+  if (scan.cloud.size() == 0) {
+    const Eigen::Vector3d p = sweep.start.translation();
+    throw std::runtime_error(fmt::format("simulated frame {} (source pose {}, sensor at {:.2f} {:.2f} {:.2f}) has no points",
+                                         k, frames_[k], p.x(), p.y(), p.z()));
+  }
+  SimulatedFrame frame;
+  frame.sensor_offset = scan.sensor_offset;
+  if (options_.labels == LabelMode::kNoisy) {
+    frame.gt_labels = scan.cloud.label;
+    frame.gt_instances = scan.cloud.instance;
+    scan.cloud.label = emulate_segmentation(scan, lidar_.beams(), lidar_.azimuth_steps,
+                                            hash_combine(sweep.seed, 0x9e7ull), options_.label_noise);
+    std::fill(scan.cloud.instance.begin(), scan.cloud.instance.end(), 0);
+  }
+  frame.cloud = std::move(scan.cloud);
+  return frame;
+}
+
+SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::path& out_dir) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SimulatedSequence sequence(options);
   SequenceWriter writer(out_dir);
-  writer.write_calib(tr);
+  writer.write_calib(sequence.velo_to_cam());
   // Written up front so that a crash mid-way still leaves a readable sequence
   // (the reader accepts more poses than scans); trimmed on interruption.
-  writer.write_camera_poses(camera_out);
-  writer.write_times(times);
+  writer.write_camera_poses(sequence.camera_poses());
+  writer.write_times(sequence.times());
   const bool noisy = options.labels == LabelMode::kNoisy;
   if (noisy) fs::create_directories(out_dir / "labels_gt");
 
-  // Where each sweep really started: the given pose, raised or lowered onto
-  // the ground where the trajectory's heights do not fit one surface.
-  std::vector<Pose> sensor_out;
-  sensor_out.reserve(frames.size());
-
   SimulationSummary summary;
-  ProgressBar progress(frames.size(), "simulate", options.show_progress);
-  for (std::size_t k = 0; k < frames.size(); ++k) {
+  ProgressBar progress(sequence.size(), "simulate", options.show_progress);
+  for (std::size_t k = 0; k < sequence.size(); ++k) {
     if (stop_requested()) {
       summary.interrupted = true;
       break;
     }
-    const SweepSpec sweep = sweep_for_frame(trajectory, frames[k], options);
-    SimulatedScan scan = simulate_scan(world, lidar, sweep);
-    if (scan.cloud.size() == 0) {
-      const Eigen::Vector3d p = sweep.start.translation();
-      throw std::runtime_error(fmt::format(
-          "simulated frame {} (source pose {}, sensor at {:.2f} {:.2f} {:.2f}) has no points; not writing an empty scan to {}",
-          k, frames[k], p.x(), p.y(), p.z(), (out_dir / "velodyne" / (frame_name(k) + ".bin")).string()));
-    }
-    Pose sensor = sweep.start;
-    sensor.translation() = world.sensor_origin(sweep.start.translation());
-    sensor_out.push_back(orthonormalized(base_inv * sensor));
-    const double offset = std::abs(static_cast<double>(scan.sensor_offset));
+    SimulatedFrame frame = sequence.render(k);
+    const double offset = std::abs(static_cast<double>(frame.sensor_offset));
     summary.max_sensor_offset = std::max(summary.max_sensor_offset, offset);
     if (offset > 0.0) ++summary.reseated_frames;
     if (noisy) {
-      write_scan_labels(out_dir / "labels_gt" / (frame_name(k) + ".label"), scan.cloud);
-      const std::vector<std::uint16_t> predicted =
-          emulate_segmentation(scan, lidar.beams(), lidar.azimuth_steps, hash_combine(sweep.seed, 0x9e7ull), options.label_noise);
-      summary.score.add(scan.cloud.label, predicted);
-      scan.cloud.label = predicted;
-      std::fill(scan.cloud.instance.begin(), scan.cloud.instance.end(), 0);
+      summary.score.add(frame.gt_labels, frame.cloud.label);
+      write_scan_labels(out_dir / "labels_gt" / (frame_name(k) + ".label"), frame.gt_labels, frame.gt_instances);
     }
-    writer.write_scan(k, scan.cloud);
-    summary.points += scan.cloud.size();
+    writer.write_scan(k, frame.cloud);
+    summary.points += frame.cloud.size();
     ++summary.frames;
     progress.advance();
   }
   progress.finish();
-  if (summary.frames < frames.size()) {
-    writer.write_camera_poses(std::vector<Pose>(camera_out.begin(), camera_out.begin() + static_cast<std::ptrdiff_t>(summary.frames)));
-    writer.write_times(std::vector<double>(times.begin(), times.begin() + static_cast<std::ptrdiff_t>(summary.frames)));
+  const auto first = [&](const auto& all) {
+    return std::vector(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(summary.frames));
+  };
+  if (summary.frames < sequence.size()) {
+    writer.write_camera_poses(first(sequence.camera_poses()));
+    writer.write_times(first(sequence.times()));
   }
-  if (summary.reseated_frames > 0) {
-    sensor_out.resize(summary.frames);
-    write_kitti_poses(out_dir / "poses_sensor.txt", lidar_to_camera_poses(sensor_out, tr));
-  }
+  if (summary.reseated_frames > 0) write_kitti_poses(out_dir / "poses_sensor.txt", first(sequence.sensor_camera_poses()));
   if (noisy && summary.frames > 0) {
     summary.miou = summary.score.miou();
     summary.label_accuracy = summary.score.accuracy();

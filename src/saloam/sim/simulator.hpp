@@ -76,6 +76,50 @@ std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::
 SweepSpec sweep_for_frame(const std::vector<Pose>& lidar_trajectory, std::size_t source_index,
                           const SimulationOptions& options);
 
+/// One simulated frame: the scan (labels as chosen: noisy or ground truth)
+/// and, with noisy labels, the ground-truth labels beside them.
+struct SimulatedFrame {
+  LabelledCloud cloud;
+  /// With noisy labels, the ground truth (class, instance id); empty otherwise.
+  std::vector<std::uint16_t> gt_labels, gt_instances;
+  float sensor_offset = 0;               ///< see SimulatedScan::sensor_offset
+};
+
+/// A simulated sequence held in memory: trajectory, world and sensor are set
+/// up once; frames are rendered on request, in any order, each a pure
+/// function of its index (so a sequence written to disk and one streamed
+/// frame by frame are the same). Poses follow the sequence layout above:
+/// re-based on the first selected frame, camera frame, times from 0.
+class SimulatedSequence {
+ public:
+  /// Throws ConfigError on invalid options (empty selection, bad beam count, ...).
+  explicit SimulatedSequence(const SimulationOptions& options);
+  SimulatedSequence(const SimulatedSequence&) = delete;
+  SimulatedSequence& operator=(const SimulatedSequence&) = delete;
+
+  [[nodiscard]] std::size_t size() const { return frames_.size(); }
+  [[nodiscard]] const SimulationOptions& options() const { return options_; }
+  /// Renders frame k (k < size()). Throws std::runtime_error when the frame
+  /// has no return at all (never an empty scan). Thread-safe.
+  [[nodiscard]] SimulatedFrame render(std::size_t k) const;
+
+  [[nodiscard]] const Pose& velo_to_cam() const { return velo_to_cam_; }
+  [[nodiscard]] const std::vector<Pose>& camera_poses() const { return camera_poses_; }  ///< poses.txt
+  [[nodiscard]] const std::vector<double>& times() const { return times_; }              ///< times.txt [s]
+  /// Where each sweep really started (poses_sensor.txt's content, camera frame).
+  [[nodiscard]] const std::vector<Pose>& sensor_camera_poses() const { return sensor_camera_poses_; }
+
+ private:
+  SimulationOptions options_;
+  std::vector<Pose> trajectory_;  ///< source trajectory, LiDAR frame
+  std::vector<std::size_t> frames_;
+  LidarModel lidar_;
+  World world_;
+  Pose velo_to_cam_ = Pose::Identity();
+  std::vector<Pose> camera_poses_, sensor_camera_poses_;
+  std::vector<double> times_;
+};
+
 /// Simulates and writes the sequence to `out_dir` (created). Stops cleanly on
 /// stop_requested(): the frames written so far form a valid sequence. A frame
 /// without any return is an error (std::runtime_error naming the frame), never
