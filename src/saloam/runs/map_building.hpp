@@ -1,20 +1,43 @@
 #pragma once
-// Builds the global semantic map of a sequence from its scans and a
-// trajectory (odometry or SLAM output, or ground truth).
+// Builds the global semantic map of a run from its scans and a trajectory
+// (odometry or SLAM output, or ground truth): from a source that can read
+// its scans again, or from compact copies kept while a stream went by.
 
 #include <cstddef>
 #include <vector>
 
 #include "saloam/core/types.hpp"
-#include "saloam/io/sequence.hpp"
 #include "saloam/mapping/semantic_map.hpp"
+#include "saloam/runs/frame_source.hpp"
 
 namespace saloam {
 
 /// Inserts scan `first_frame + k` with lidar_poses[k] (every `frame_step`-th
-/// pose) into a SemanticMap and returns its points (world frame).
-LabelledCloud build_semantic_map(const SequenceReader& reader, const std::vector<Pose>& lidar_poses,
-                                 std::size_t first_frame, const SemanticMapOptions& options,
-                                 std::size_t frame_step = 1, bool show_progress = true);
+/// pose) into a SemanticMap and returns its points (world frame). The source
+/// must be rereadable().
+LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& lidar_poses, std::size_t first_frame,
+                                 const SemanticMapOptions& options, std::size_t frame_step = 1,
+                                 bool show_progress = true);
+
+/// The scans of a streamed run that go into its map, kept as it goes by:
+/// every `frame_step`-th scan, voxel-downsampled in its sensor frame at the
+/// map's resolution (what the map keeps of it anyway: one point per voxel,
+/// dynamic classes and far returns left out), so a run keeps a few tens of
+/// kilobytes per scan instead of the scan.
+class MapScanStore {
+ public:
+  MapScanStore(SemanticMapOptions options, std::size_t frame_step);
+  /// Scan k of the run (0 = first processed frame); kept when k is a multiple of the step.
+  void offer(std::size_t k, const LabelledCloud& scan);
+  /// The map with lidar_poses[k] for scan k (poses of the whole run).
+  [[nodiscard]] LabelledCloud build(const std::vector<Pose>& lidar_poses, bool show_progress = true) const;
+  [[nodiscard]] std::size_t bytes() const;
+
+ private:
+  SemanticMapOptions options_;
+  std::size_t frame_step_;
+  std::vector<std::size_t> frames_;
+  std::vector<LabelledCloud> scans_;
+};
 
 }  // namespace saloam

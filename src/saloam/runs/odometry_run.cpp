@@ -79,7 +79,7 @@ OdometryRunResult run_odometry(const SequenceReader& reader, const OdometryConfi
     spdlog::warn("{}: no calib.txt; poses.txt holds LiDAR-frame poses, not the KITTI camera convention",
                  reader.root().string());
   }
-  prepare_output_folder(out_dir, reader);
+  prepare_output_folder(out_dir, reader.root());
   TrajectoryWriter writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);
 
   SemanticOdometry odometry(config);

@@ -6,14 +6,14 @@
 
 namespace saloam {
 
-void prepare_output_folder(const std::filesystem::path& out_dir, const SequenceReader& reader) {
+void prepare_output_folder(const std::filesystem::path& out_dir, const std::optional<std::filesystem::path>& sequence) {
   std::error_code error;
   const auto out = std::filesystem::weakly_canonical(out_dir, error);
-  const auto root = std::filesystem::weakly_canonical(reader.root(), error);
-  if (!error && out == root) {
+  const auto root = sequence ? std::filesystem::weakly_canonical(*sequence, error) : std::filesystem::path();
+  if (sequence && !error && out == root) {
     throw InputError(out_dir, fmt::format("is the sequence folder {}: the run's poses.txt would overwrite its ground "
                                           "truth; choose another output folder",
-                                          reader.root().string()));
+                                          sequence->string()));
   }
   std::filesystem::create_directories(out_dir);
 }

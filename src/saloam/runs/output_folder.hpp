@@ -5,12 +5,13 @@
 
 #include <filesystem>
 
-#include "saloam/io/sequence.hpp"
+#include <optional>
 
 namespace saloam {
 
-/// Creates `out_dir` (and its parents); InputError when it is the sequence
-/// folder of `reader`, naming both and what would be lost.
-void prepare_output_folder(const std::filesystem::path& out_dir, const SequenceReader& reader);
+/// Creates `out_dir` (and its parents); InputError when it is the run's
+/// sequence folder `sequence` (when the frames come from one), naming both
+/// and what would be lost.
+void prepare_output_folder(const std::filesystem::path& out_dir, const std::optional<std::filesystem::path>& sequence);
 
 }  // namespace saloam

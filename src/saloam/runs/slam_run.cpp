@@ -169,37 +169,113 @@ std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config, const s
   return SgprNetwork::load(model);
 }
 
-SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
-                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
-  const std::size_t first = options.first_frame;
-  const std::size_t end = std::min(options.end_frame, reader.size());
-  if (first >= end) throw ConfigError(fmt::format("empty frame range {}:{} ({} frames)", first, end, reader.size()));
-  if (config.odometry.use_semantics && !reader.has_labels()) {
-    spdlog::warn("{}: no labels found; running with every point in one class", reader.root().string());
-  }
-  std::optional<Pose> tr;
-  if (reader.has_calib()) {
-    tr = reader.velo_to_cam();
-  } else {
-    spdlog::warn("{}: no calib.txt; pose files hold LiDAR-frame poses, not the KITTI camera convention",
-                 reader.root().string());
-  }
-  prepare_output_folder(out_dir, reader);
+namespace {
 
-  SlamSystem slam(config, std::move(network));
-  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
-  ProgressBar progress(end - first, "slam", options.show_progress);
-  const auto start = std::chrono::steady_clock::now();
-  for (std::size_t i = first; i < end && !stop_requested(); ++i) {
-    const double t = reader.times().at(i);
-    odometry_writer.write(t, slam.process(reader.load_scan(i), t));
-    progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
-    progress.advance();
+struct RunTruth {
+  std::optional<std::vector<Pose>> camera;        ///< poses.txt of the processed frames (output convention)
+  std::optional<std::vector<Pose>> lidar;         ///< the same in the LiDAR frame
+  std::optional<std::vector<Pose>> sensor_lidar;  ///< where the scans were really taken, when that differs
+  [[nodiscard]] const std::vector<Pose>* loop_reference() const {
+    return sensor_lidar ? &*sensor_lidar : lidar ? &*lidar : nullptr;
   }
-  progress.finish();
+};
 
+// Ground truth of the processed frames, camera frame (trajectories) and
+// LiDAR frame (loops). A simulated sequence whose given heights did not fit
+// its ground has sensor poses (poses_sensor.txt), where the scans were really
+// taken: loops are judged against them (poses.txt is wrong in height there,
+// as KITTI's).
+RunTruth run_truth(const FrameSource& source, const std::optional<Pose>& tr, std::size_t first, std::size_t frames) {
+  RunTruth truth;
+  const auto camera = source.camera_poses();
+  if (!camera || frames == 0) return truth;
+  const auto slice_of = [&](const std::vector<Pose>& all) {
+    std::vector<Pose> slice(all.begin() + static_cast<std::ptrdiff_t>(first),
+                            all.begin() + static_cast<std::ptrdiff_t>(first + frames));
+    const Pose rebase = slice.front().inverse();  // world = first processed frame, as the estimates
+    for (auto& p : slice) p = orthonormalized(rebase * p);
+    return slice;
+  };
+  const auto to_lidar = [&](const std::vector<Pose>& in_camera) {
+    std::vector<Pose> lidar;
+    for (const auto& p : in_camera) lidar.push_back(orthonormalized(tr->inverse() * p * *tr));
+    return lidar;
+  };
+  truth.camera = slice_of(*camera);
+  if (!tr) return truth;
+  truth.lidar = to_lidar(*truth.camera);
+  if (const auto sensor = source.sensor_camera_poses()) truth.sensor_lidar = to_lidar(slice_of(*sensor));
+  return truth;
+}
+
+nlohmann::json loop_summary_json(const LoopSummary& s) {
+  return {{"accepted_true", s.accepted_true},
+          {"accepted_false", s.accepted_false},
+          {"accepted_reverse", s.accepted_reverse},
+          {"rejected_but_correct", s.rejected_true},
+          {"revisit_keyframes", s.revisit_keyframes},
+          {"revisit_stretches", s.revisit_stretches},
+          {"missed_stretches", s.missed_stretches},
+          {"reverse_stretches", s.reverse_stretches},
+          {"missed_reverse_stretches", s.missed_reverse_stretches}};
+}
+
+// Evaluates both trajectories and the loops against the ground truth (when
+// known) and writes eval_{odometry,slam}.{json,png} and summary.json.
+void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunTruth& truth,
+                  const std::vector<Pose>& odometry_out, const std::vector<Pose>& slam_out,
+                  const std::filesystem::path& out_dir, SlamRunResult& result) {
+  nlohmann::json summary{{"frames", result.frames},
+                         {"keyframes", result.keyframes},
+                         {"detector", config.loop.detector},
+                         {"loops_verified", result.loops_verified},
+                         {"loops_accepted", result.loops_accepted},
+                         {"interrupted", result.interrupted}};
+  if (truth.camera && result.frames >= 2) {
+    result.odometry_evaluation = evaluate_trajectories(*truth.camera, odometry_out);
+    result.slam_evaluation = evaluate_trajectories(*truth.camera, slam_out);
+    const EvaluationLabels odometry_labels{"ground truth", "poses_odometry.txt"};
+    const EvaluationLabels slam_labels{"ground truth", "poses.txt"};
+    write_evaluation_json(out_dir / "eval_odometry.json", *result.odometry_evaluation, odometry_labels);
+    write_evaluation_json(out_dir / "eval_slam.json", *result.slam_evaluation, slam_labels);
+    plot_evaluation(out_dir / "eval_odometry.png", *truth.camera, odometry_out, *result.odometry_evaluation,
+                    odometry_labels);
+    plot_evaluation(out_dir / "eval_slam.png", *truth.camera, slam_out, *result.slam_evaluation, slam_labels);
+    summary["odometry"] = evaluation_to_json(*result.odometry_evaluation, odometry_labels, false);
+    summary["slam"] = evaluation_to_json(*result.slam_evaluation, slam_labels, false);
+  }
+  if (const std::vector<Pose>* reference = truth.loop_reference()) {
+    LoopTruthOptions truth_options;
+    truth_options.exclude_recent_distance = config.loop.exclude_recent_distance;
+    result.loop_summary = summarize_loops(slam, *reference, truth_options);
+    result.loop_reference = truth.sensor_lidar ? "poses_sensor.txt" : "poses.txt";
+    if (truth.sensor_lidar) result.loop_summary_poses_txt = summarize_loops(slam, *truth.lidar, truth_options);
+    summary["loops_judged_against"] = result.loop_reference;
+    if (result.loop_summary_poses_txt) {
+      summary["loops_vs_poses_txt"] = {{"accepted_true", result.loop_summary_poses_txt->accepted_true},
+                                       {"accepted_false", result.loop_summary_poses_txt->accepted_false}};
+    }
+    summary["loops"] = loop_summary_json(*result.loop_summary);
+  }
+  std::ofstream out(out_dir / "summary.json");
+  if (!out) throw InputError(out_dir / "summary.json", "cannot write the run summary");
+  out << summary.dump(2) << '\n';
+}
+
+void write_map_outputs(const SlamSystem& slam, const LabelledCloud& map, const std::vector<Pose>& optimized,
+                       const std::filesystem::path& out_dir) {
+  write_ply(out_dir / "map.ply", map);
+  std::vector<WorldSegment> links;
+  for (const auto& loop : slam.loops()) {
+    if (!loop.verification.accepted) continue;
+    links.emplace_back(optimized[loop.match_frame].translation(), optimized[loop.query_frame].translation());
+  }
+  render_top_down(out_dir / "map.png", map, optimized, {}, links);
+}
+
+SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
   SlamRunResult result;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = seconds;
   result.interrupted = stop_requested();
   result.frames = slam.odometry_poses().size();
   result.keyframes = slam.keyframes().size();
@@ -213,109 +289,78 @@ SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config,
   }
   result.median_frame_ms = median_of(totals);
   result.mean_loop_ms = mean_of(loops);
+  return result;
+}
+
+std::optional<Pose> extrinsic_of(const FrameSource& source) {
+  std::optional<Pose> tr = source.velo_to_cam();
+  if (!tr) {
+    spdlog::warn("{}: no calib.txt; pose files hold LiDAR-frame poses, not the KITTI camera convention", source.name());
+  }
+  return tr;
+}
+
+}  // namespace
+
+SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
+  const std::size_t first = options.first_frame;
+  const std::size_t end = std::min(options.end_frame, source.size());
+  if (first >= end) throw ConfigError(fmt::format("empty frame range {}:{} ({} frames)", first, end, source.size()));
+  if (config.odometry.use_semantics && !source.has_labels()) {
+    spdlog::warn("{}: no labels found; running with every point in one class", source.name());
+  }
+  const std::optional<Pose> tr = extrinsic_of(source);
+  prepare_output_folder(out_dir, source.folder());
+
+  // A stream cannot be read again for the map: keep what the map needs as it goes by.
+  SemanticMapOptions map_options;
+  map_options.voxel_size = config.slam.map_voxel_size;
+  const auto map_step = static_cast<std::size_t>(std::max(1, config.slam.map_frame_step));
+  std::optional<MapScanStore> map_scans;
+  if (options.write_map && !source.rereadable()) map_scans.emplace(map_options, map_step);
+
+  SlamSystem slam(config, std::move(network));
+  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  ProgressBar progress(end - first, "slam", options.show_progress);
+  const auto start = std::chrono::steady_clock::now();
+  for (std::size_t i = first; i < end && !stop_requested(); ++i) {
+    const LabelledCloud scan = source.scan(i);
+    const double t = source.times().at(i);
+    odometry_writer.write(t, slam.process(scan, t));
+    if (options.on_scan) options.on_scan(i, scan, t);
+    if (map_scans) map_scans->offer(i - first, scan);
+    progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
+    progress.advance();
+  }
+  progress.finish();
+  SlamRunResult result = summarize_run(slam, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 
   const std::vector<Pose> optimized = slam.optimized_poses();
   write_trajectory(out_dir / "poses.txt", out_dir / "poses_tum.txt", slam.timestamps(), optimized, tr);
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
-
-  // Ground truth of the processed frames, camera frame (trajectories) and
-  // LiDAR frame (loops). A simulated sequence whose given heights did not fit
-  // its ground has poses_sensor.txt, where the scans were really taken: loops
-  // are judged against it (poses.txt is wrong in height there, as KITTI's).
-  std::optional<std::vector<Pose>> gt_lidar, gt_output, gt_scan_lidar;
-  const auto slice_of = [&](const std::vector<Pose>& camera) {
-    std::vector<Pose> slice(camera.begin() + static_cast<std::ptrdiff_t>(first),
-                            camera.begin() + static_cast<std::ptrdiff_t>(first + result.frames));
-    const Pose rebase = slice.front().inverse();  // world = first processed frame, as the estimates
-    for (auto& p : slice) p = orthonormalized(rebase * p);
-    return slice;
-  };
-  const auto to_lidar = [&](const std::vector<Pose>& camera) {
-    std::vector<Pose> lidar;
-    for (const auto& p : camera) lidar.push_back(orthonormalized(tr->inverse() * p * *tr));
-    return lidar;
-  };
-  if (reader.has_poses()) {
-    gt_output = slice_of(reader.camera_poses());
-    if (tr) gt_lidar = to_lidar(*gt_output);
-    const auto sensor_file = reader.root() / "poses_sensor.txt";
-    if (tr && std::filesystem::exists(sensor_file)) {
-      const std::vector<Pose> sensor = read_kitti_poses(sensor_file);
-      if (sensor.size() != reader.size()) {
-        throw InputError(sensor_file, fmt::format("{} poses for {} scans", sensor.size(), reader.size()));
-      }
-      gt_scan_lidar = to_lidar(slice_of(sensor));
-    }
-  }
-  const std::vector<Pose>* loop_reference = gt_scan_lidar ? &*gt_scan_lidar : gt_lidar ? &*gt_lidar : nullptr;
-  write_loops_csv(out_dir / "loops.csv", slam, loop_reference);
+  const RunTruth truth = run_truth(source, tr, first, result.frames);
+  write_loops_csv(out_dir / "loops.csv", slam, truth.loop_reference());
   if (uses_sgpr(parse_place_detector(config.loop.detector))) write_graph_map(out_dir / "graph_map.json", slam);
   const std::vector<Pose> odometry_out = output_poses(slam.odometry_poses(), tr);
   const std::vector<Pose> slam_out = output_poses(optimized, tr);
-  plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, gt_output ? &*gt_output : nullptr,
+  plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, truth.camera ? &*truth.camera : nullptr,
                     slam.accepted_loops());
-
-  nlohmann::json summary{{"frames", result.frames},
-                         {"keyframes", result.keyframes},
-                         {"detector", config.loop.detector},
-                         {"loops_verified", result.loops_verified},
-                         {"loops_accepted", result.loops_accepted},
-                         {"interrupted", result.interrupted}};
-  if (gt_output && result.frames >= 2) {
-    result.odometry_evaluation = evaluate_trajectories(*gt_output, odometry_out);
-    result.slam_evaluation = evaluate_trajectories(*gt_output, slam_out);
-    const EvaluationLabels odometry_labels{"ground truth", "poses_odometry.txt"};
-    const EvaluationLabels slam_labels{"ground truth", "poses.txt"};
-    write_evaluation_json(out_dir / "eval_odometry.json", *result.odometry_evaluation, odometry_labels);
-    write_evaluation_json(out_dir / "eval_slam.json", *result.slam_evaluation, slam_labels);
-    plot_evaluation(out_dir / "eval_odometry.png", *gt_output, odometry_out, *result.odometry_evaluation,
-                    odometry_labels);
-    plot_evaluation(out_dir / "eval_slam.png", *gt_output, slam_out, *result.slam_evaluation, slam_labels);
-    summary["odometry"] = evaluation_to_json(*result.odometry_evaluation, odometry_labels, false);
-    summary["slam"] = evaluation_to_json(*result.slam_evaluation, slam_labels, false);
-  }
-  if (loop_reference) {
-    LoopTruthOptions truth_options;
-    truth_options.exclude_recent_distance = config.loop.exclude_recent_distance;
-    result.loop_summary = summarize_loops(slam, *loop_reference, truth_options);
-    result.loop_reference = gt_scan_lidar ? "poses_sensor.txt" : "poses.txt";
-    if (gt_scan_lidar) result.loop_summary_poses_txt = summarize_loops(slam, *gt_lidar, truth_options);
-    const LoopSummary& s = *result.loop_summary;
-    summary["loops_judged_against"] = result.loop_reference;
-    if (result.loop_summary_poses_txt) {
-      summary["loops_vs_poses_txt"] = {{"accepted_true", result.loop_summary_poses_txt->accepted_true},
-                                       {"accepted_false", result.loop_summary_poses_txt->accepted_false}};
-    }
-    summary["loops"] = {{"accepted_true", s.accepted_true},
-                        {"accepted_false", s.accepted_false},
-                        {"accepted_reverse", s.accepted_reverse},
-                        {"rejected_but_correct", s.rejected_true},
-                        {"revisit_keyframes", s.revisit_keyframes},
-                        {"revisit_stretches", s.revisit_stretches},
-                        {"missed_stretches", s.missed_stretches},
-                        {"reverse_stretches", s.reverse_stretches},
-                        {"missed_reverse_stretches", s.missed_reverse_stretches}};
-  }
-  {
-    std::ofstream out(out_dir / "summary.json");
-    out << summary.dump(2) << '\n';
-  }
+  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result);
 
   if (options.write_map && !result.interrupted) {
-    SemanticMapOptions map_options;
-    map_options.voxel_size = config.slam.map_voxel_size;
-    const LabelledCloud map = build_semantic_map(reader, optimized, first, map_options,
-                                                 static_cast<std::size_t>(std::max(1, config.slam.map_frame_step)),
-                                                 options.show_progress);
-    write_ply(out_dir / "map.ply", map);
-    std::vector<WorldSegment> links;
-    for (const auto& loop : slam.loops()) {
-      if (!loop.verification.accepted) continue;
-      links.emplace_back(optimized[loop.match_frame].translation(), optimized[loop.query_frame].translation());
-    }
-    render_top_down(out_dir / "map.png", map, optimized, {}, links);
+    const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)
+                                        : build_semantic_map(source, optimized, first, map_options, map_step,
+                                                             options.show_progress);
+    write_map_outputs(slam, map, optimized, out_dir);
   }
   return result;
+}
+
+SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
+  SequenceFolderSource source(reader);
+  return run_slam(source, config, std::move(network), out_dir, options);
 }
 
 }  // namespace saloam

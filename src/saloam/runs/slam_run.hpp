@@ -24,6 +24,7 @@
 #include "saloam/core/types.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/sequence.hpp"
+#include "saloam/runs/frame_source.hpp"
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/slam/slam_system.hpp"
 
@@ -33,7 +34,10 @@ struct SlamRunOptions {
   std::size_t first_frame = 0;
   std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the sequence
   bool show_progress = true;
-  bool write_map = true;  ///< map.ply / map.png (re-reads the scans)
+  bool write_map = true;  ///< map.ply / map.png (re-reads the scans, or keeps copies of a stream's)
+  /// Called with every scan after the SLAM has processed it (e.g. to run a
+  /// second odometry on the same stream).
+  std::function<void(std::size_t frame, const LabelledCloud& scan, double time)> on_scan;
 };
 
 struct SlamRunResult {
@@ -56,7 +60,10 @@ struct SlamRunResult {
 /// config's loop.sgpr_model, else `fallback_model`; ConfigError when neither is set.
 std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config, const std::filesystem::path& fallback_model);
 
-/// Runs SlamSystem over frames [first_frame, end_frame) of `reader`, writing into `out_dir` (created).
+/// Runs SlamSystem over frames [first_frame, end_frame) of `source`, writing into `out_dir` (created).
+SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options = {});
+/// The same over a sequence folder.
 SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
                        const std::filesystem::path& out_dir, const SlamRunOptions& options = {});
 
