@@ -1,10 +1,13 @@
 // `saloam demo`: the whole system end to end on data it makes itself.
 // Simulates a labelled sequence (default: the ~1.6 km figure eight, which
 // revisits places in the same and in the opposite direction; HDL-64E,
-// emulated segmentation-network labels), runs the SLAM (semantic odometry
-// with loop closure) and the label-agnostic odometry baseline, evaluates
-// them against the ground truth, and writes the semantic map and pictures.
+// emulated segmentation-network labels) and streams it, scan by scan, into
+// the SLAM (semantic odometry with loop closure) and the label-agnostic
+// odometry baseline: the simulator renders ahead on a worker thread, and the
+// scans reach the disk only with --keep-sequence. Evaluates both against the
+// ground truth and writes the semantic map and pictures.
 
+#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -17,7 +20,9 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/runs/odometry_run.hpp"
+#include "saloam/odometry/semantic_odometry.hpp"
+#include "saloam/runs/frame_source.hpp"
+#include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
 #include "saloam/sim/simulator.hpp"
@@ -32,64 +37,65 @@ struct DemoOptions {
   int beams = 64;
   std::uint64_t seed = 1;
   bool gt_labels = false;
+  bool keep_sequence = false;
   bool reuse = false;
+  bool baseline = true;
   ConfigOptions config;
 };
 
 void heading(const std::string& text) { std::cout << "\n== " << text << " ==\n" << std::flush; }
 
-int run_demo(const DemoOptions& options) {
-  const SaloamConfig config = options.config.resolve();
-  const std::filesystem::path out(options.out);
-  const std::filesystem::path sequence = out / "sequence";
-
-  heading(fmt::format("1/4 simulate: preset '{}', {} beams, {} labels -> {}", options.preset, options.beams,
-                      options.gt_labels ? "ground-truth" : "noisy (emulated network)", sequence.string()));
-  if (options.reuse && std::filesystem::exists(sequence / "poses.txt")) {
-    std::cout << "reusing the existing sequence (--reuse)\n";
-  } else {
-    std::filesystem::remove_all(sequence);
-    SimulationOptions sim_options;
-    sim_options.preset = options.preset;
-    sim_options.beams = options.beams;
-    sim_options.seed = options.seed;
-    sim_options.labels = options.gt_labels ? LabelMode::kGroundTruth : LabelMode::kNoisy;
-    if (!options.frames.empty()) {
-      const auto range = FrameRange::parse(options.frames);
-      sim_options.first_frame = range.first;
-      sim_options.end_frame = range.end;
-    }
-    const auto summary = simulate_sequence(sim_options, sequence);
-    std::cout << fmt::format("{} frames, {:.0f} k points per frame, {:.1f} s", summary.frames,
-                             summary.frames ? summary.points / 1000.0 / summary.frames : 0.0, summary.seconds);
-    if (!std::isnan(summary.miou)) std::cout << fmt::format(", label mIoU {:.1f} %", 100.0 * summary.miou);
-    std::cout << "\n";
-    if (summary.interrupted || stop_requested()) return 130;
+SimulationOptions simulation_options(const DemoOptions& options) {
+  SimulationOptions sim;
+  sim.preset = options.preset;
+  sim.beams = options.beams;
+  sim.seed = options.seed;
+  sim.labels = options.gt_labels ? LabelMode::kGroundTruth : LabelMode::kNoisy;
+  sim.show_progress = false;
+  if (!options.frames.empty()) {
+    const auto range = FrameRange::parse(options.frames);
+    sim.first_frame = range.first;
+    sim.end_frame = range.end;
   }
+  return sim;
+}
 
-  const SequenceReader reader(sequence);
-  const auto gt_camera = reader.camera_poses();
+/// The label-agnostic odometry (--no-semantics) run on the same stream as the
+/// SLAM, scan by scan, for the comparison in the summary.
+OdometryConfig without_semantics(OdometryConfig config) {
+  config.use_semantics = false;
+  return config;
+}
 
-  heading(fmt::format("2/4 SLAM: semantic odometry + loop closure ({}) -> {}", config.loop.detector,
-                      (out / "slam").string()));
-  const SlamRunResult slam = run_slam(reader, config, load_loop_network(config, {}), out / "slam", {});
-  if (slam.interrupted) return 130;
-  std::cout << fmt::format("{} frames, median {:.1f} ms/frame ({:.1f} Hz), loop closure {:.2f} ms/frame amortised\n",
-                           slam.frames, slam.median_frame_ms, 1000.0 / std::max(slam.median_frame_ms, 1e-9),
-                           slam.mean_loop_ms);
+const std::filesystem::path& created(const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  return folder;
+}
 
-  heading(fmt::format("3/4 odometry, label-agnostic baseline (--no-semantics) -> {}", (out / "odometry_baseline").string()));
-  OdometryConfig baseline_config = config.odometry;
-  baseline_config.use_semantics = false;
-  const SequenceReader baseline_reader(sequence, SequenceOptions{std::nullopt, true});
-  const OdometryRunResult baseline = run_odometry(baseline_reader, baseline_config, out / "odometry_baseline", {});
-  if (baseline.interrupted) return 130;
-  const TrajectoryEvaluation baseline_eval = evaluate_trajectories(gt_camera, baseline.output_poses);
-  const EvaluationLabels baseline_labels{"sequence/poses.txt", "odometry_baseline/poses.txt"};
-  write_evaluation_json(out / "eval_baseline.json", baseline_eval, baseline_labels);
-  plot_evaluation(out / "eval_baseline.png", gt_camera, baseline.output_poses, baseline_eval, baseline_labels);
+class BaselineOdometry {
+ public:
+  BaselineOdometry(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> tr)
+      : odometry_(without_semantics(config)),
+        writer_(created(out_dir) / "poses.txt", out_dir / "poses_tum.txt", tr) {}
+  void process(const LabelledCloud& scan, double t) { output_.push_back(writer_.write(t, odometry_.register_frame(scan, t))); }
+  [[nodiscard]] const std::vector<Pose>& output_poses() const { return output_; }
 
-  heading("4/4 summary");
+ private:
+  SemanticOdometry odometry_;
+  TrajectoryWriter writer_;
+  std::vector<Pose> output_;
+};
+
+std::uintmax_t disk_usage(const std::filesystem::path& folder) {
+  std::uintmax_t bytes = 0;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder, error)) {
+    if (entry.is_regular_file(error)) bytes += entry.file_size(error);
+  }
+  return bytes;
+}
+
+void print_summary(const SlamRunResult& slam, const std::optional<TrajectoryEvaluation>& baseline) {
   std::cout << "| trajectory | KITTI t_err [%] | KITTI r_err [deg/100 m] | ATE RMSE [m] | RPE [m/frame] |\n"
                "|---|---|---|---|---|\n";
   auto row = [](const std::string& name, const TrajectoryEvaluation& e) {
@@ -97,7 +103,7 @@ int run_demo(const DemoOptions& options) {
                              format_metric(e.kitti.r_err_deg_per_100m, 3), format_metric(e.ate.aligned.rmse, 3),
                              format_metric(e.rpe.trans_rmse_m, 4));
   };
-  row("odometry, label-agnostic baseline", baseline_eval);
+  if (baseline) row("odometry, label-agnostic baseline", *baseline);
   if (slam.odometry_evaluation) row("odometry, semantic (SA-LOAM)", *slam.odometry_evaluation);
   if (slam.slam_evaluation) row("SLAM: semantic odometry + loop closure", *slam.slam_evaluation);
   if (slam.loop_summary) {
@@ -108,14 +114,71 @@ int run_demo(const DemoOptions& options) {
                              l.revisit_stretches - l.missed_stretches, l.revisit_stretches,
                              l.reverse_stretches - l.missed_reverse_stretches, l.reverse_stretches);
   }
-  const std::size_t shown = reader.size() / 2;
-  render_range_image(reader.load_scan(shown), out / fmt::format("range_{:06d}.png", shown));
-  std::cout << fmt::format("\nmap: {}, {} (loop edges in orange)\n", (out / "slam/map.ply").string(),
+}
+
+int run_demo(const DemoOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SaloamConfig config = options.config.resolve();
+  const std::filesystem::path out(options.out);
+  const std::filesystem::path sequence_dir = out / "sequence";
+  const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
+
+  heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.preset, options.beams,
+                      options.gt_labels ? "ground-truth" : "noisy (emulated network)",
+                      from_disk ? " (reusing " + sequence_dir.string() + ")" : ""));
+  std::optional<SimulatedSequence> simulated;
+  std::optional<SimulatedSource> stream;
+  std::optional<SequenceReader> reader;
+  std::optional<SequenceFolderSource> folder;
+  FrameSource* source = nullptr;
+  if (from_disk) {
+    reader.emplace(sequence_dir);
+    source = &folder.emplace(*reader);
+  } else {
+    std::filesystem::remove_all(sequence_dir);
+    simulated.emplace(simulation_options(options));
+    // The simulator renders ahead on another thread while the SLAM runs; the
+    // scans are written to disk only with --keep-sequence.
+    const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
+    source = &stream.emplace(*simulated, 16, keep);
+  }
+  std::cout << fmt::format("{} frames; the simulator renders them {}\n", source->size(),
+                           from_disk ? "from disk" : options.keep_sequence ? "ahead and writes them to " + sequence_dir.string()
+                                                                             : "ahead, in memory");
+
+  std::optional<BaselineOdometry> baseline;
+  if (options.baseline) baseline.emplace(config.odometry, out / "odometry_baseline", source->velo_to_cam());
+  const std::size_t shown = source->size() / 2;
+  SlamRunOptions run_options;
+  run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
+    if (baseline) baseline->process(scan, t);
+    if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
+  };
+  const SlamRunResult slam = run_slam(*source, config, load_loop_network(config, {}), out / "slam", run_options);
+  if (slam.interrupted) return 130;
+  stream.reset();  // stops the simulator's thread; finishes the kept sequence folder
+
+  std::optional<TrajectoryEvaluation> baseline_eval;
+  if (baseline && source->camera_poses()) {
+    const auto gt = *source->camera_poses();
+    baseline_eval = evaluate_trajectories(gt, baseline->output_poses());
+    const EvaluationLabels labels{"ground truth", "odometry_baseline/poses.txt"};
+    write_evaluation_json(out / "eval_baseline.json", *baseline_eval, labels);
+    plot_evaluation(out / "eval_baseline.png", gt, baseline->output_poses(), *baseline_eval, labels);
+  }
+
+  heading("2/2 summary");
+  print_summary(slam, baseline_eval);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::cout << fmt::format("\n{} frames in {:.0f} s; SLAM median {:.1f} Hz, loop closure {:.2f} ms/frame amortised; "
+                           "{:.0f} MB written to {}\n",
+                           slam.frames, seconds, 1000.0 / std::max(slam.median_frame_ms, 1e-9), slam.mean_loop_ms,
+                           static_cast<double>(disk_usage(out)) / 1e6, out.string());
+  std::cout << fmt::format("map: {}, {} (loop edges in orange)\n", (out / "slam/map.ply").string(),
                            (out / "slam/map.png").string());
-  std::cout << fmt::format("plots: {}, {}, {}\n", (out / "slam/trajectories.png").string(),
-                           (out / "slam/eval_slam.png").string(), (out / "eval_baseline.png").string());
-  std::cout << "trajectories: " << (out / "slam/poses.txt").string()
-            << " (KITTI camera frame; compare with " << (sequence / "poses.txt").string() << ")\n";
+  std::cout << fmt::format("plots: {}, {}\n", (out / "slam/trajectories.png").string(),
+                           (out / "slam/eval_slam.png").string());
+  std::cout << "trajectories: " << (out / "slam/poses.txt").string() << " (KITTI camera frame)\n";
   return 0;
 }
 
@@ -129,7 +192,10 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--beams", options->beams, "LiDAR beams: 64, 32 or 16")->check(CLI::IsMember({64, 32, 16}));
       app.add_option("--seed", options->seed, "Simulation seed");
       app.add_flag("--gt-labels", options->gt_labels, "Use ground-truth labels instead of emulated network output");
-      app.add_flag("--reuse", options->reuse, "Reuse an existing simulated sequence in the output folder");
+      app.add_flag("--keep-sequence", options->keep_sequence,
+                   "Also write the simulated sequence to OUT/sequence (about 2.4 MB per 64-beam scan)");
+      app.add_flag("--reuse", options->reuse, "Read OUT/sequence (kept by an earlier --keep-sequence) instead of simulating");
+      app.add_flag("!--no-baseline", options->baseline, "Skip the label-agnostic odometry baseline");
       options->config.add_to(app);
       return [options] { return run_demo(*options); };
     }}};

@@ -1,7 +1,10 @@
 // End-to-end: `saloam demo` on a few frames of the built-in route, the main
 // job of the README's first set-up command.
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -17,13 +20,18 @@ using testing::quoted;
 using testing::run_command;
 using testing::TempDir;
 
+std::string read_text(const fs::path& file) {
+  std::ifstream in(file);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 TEST(DemoCli, ShortRunWritesEveryOutputAndAReadableTable) {
   TempDir dir;
   const fs::path out = dir / "demo";
   std::string output;
   ASSERT_EQ(run_command(quoted(cli_path()) + " demo --out " + quoted(out) + " --frames 0:8 --beams 16", &output), 0)
       << output;
-  for (const char* file : {"sequence/velodyne/000007.bin", "sequence/labels_gt/000007.label", "slam/poses.txt",
+  for (const char* file : {"slam/poses.txt",
                            "slam/poses_odometry.txt", "slam/loops.csv", "slam/eval_slam.json", "slam/eval_odometry.png",
                            "slam/trajectories.png", "slam/map.ply", "slam/map.png", "odometry_baseline/poses.txt",
                            "eval_baseline.png"}) {
@@ -36,6 +44,27 @@ TEST(DemoCli, ShortRunWritesEveryOutputAndAReadableTable) {
   // errors are undefined and shown as such, never as "nan".
   EXPECT_NE(output.find("| n/a | n/a |"), std::string::npos) << output;
   EXPECT_EQ(output.find("nan"), std::string::npos) << output;
+  // The scans went from the simulator straight into the SLAM: none on disk.
+  EXPECT_FALSE(fs::exists(out / "sequence")) << output;
+}
+
+TEST(DemoCli, KeepsTheSequenceWhenAskedAndReusesIt) {
+  TempDir dir;
+  const fs::path out = dir / "demo";
+  const std::string demo = quoted(cli_path()) + " demo --out " + quoted(out) + " --frames 0:6 --beams 16 --no-baseline";
+  std::string output;
+  ASSERT_EQ(run_command(demo + " --keep-sequence", &output), 0) << output;
+  for (const char* file : {"sequence/velodyne/000005.bin", "sequence/labels/000005.label",
+                           "sequence/labels_gt/000005.label", "sequence/poses.txt", "sequence/calib.txt"}) {
+    EXPECT_TRUE(fs::exists(out / file)) << file;
+  }
+  EXPECT_FALSE(fs::exists(out / "odometry_baseline")) << output;
+  const auto lines = [](const std::string& text) { return std::count(text.begin(), text.end(), '\n'); };
+  EXPECT_EQ(lines(read_text(out / "slam/poses.txt")), 6);
+
+  ASSERT_EQ(run_command(demo + " --reuse", &output), 0) << output;
+  EXPECT_NE(output.find("reusing"), std::string::npos) << output;
+  EXPECT_EQ(lines(read_text(out / "slam/poses.txt")), 6);
 }
 
 }  // namespace
