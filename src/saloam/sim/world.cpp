@@ -280,59 +280,91 @@ Eigen::Vector3d World::sensor_origin(const Eigen::Vector3d& pose_origin) const {
   return {pose_origin.x(), pose_origin.y(), z};
 }
 
-double World::ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const {
-  // March along the ray with steps that grow with range and shrink near the
-  // ground, then refine the crossing by regula falsi (the ground has curbs:
-  // no closed form, but it is nearly planar, so few refinements are needed).
-  auto above = [&](double t) {
-    const Eigen::Vector3d p = o + t * d;
-    return p.z() - ground_from(sample(p.x(), p.y())).height;
-  };
-  double t_prev = 0.0, f_prev = above(0.0);
-  if (f_prev <= 0) return 0.0;
-  double t = 1.0;
-  while (t_prev < max_t) {
-    t = std::min(t, max_t);
-    const double f = above(t);
-    if (f <= 0) {
-      // Illinois variant of regula falsi on [t_prev (above), t (below)].
-      double lo = t_prev, hi = t, f_lo = f_prev, f_hi = f;
-      int side = 0;
-      for (int i = 0; i < 20 && hi - lo > 0.003; ++i) {
-        const double m = std::clamp(lo + (hi - lo) * f_lo / (f_lo - f_hi), lo + 1e-4, hi - 1e-4);
-        const double fm = above(m);
-        if (fm > 0) {
-          lo = m;
-          f_lo = fm;
-          if (side == -1) f_hi *= 0.5;
-          side = -1;
-        } else {
-          hi = m;
-          f_hi = fm;
-          if (side == 1) f_lo *= 0.5;
-          side = 1;
-        }
-      }
-      return hi;
-    }
-    // Rays going up and well above the ground never come back.
-    if (d.z() > 0.0 && f > 2.5) return kInf;
-    t_prev = t;
-    f_prev = f;
-    double step = std::max(0.2, 0.04 * t);
-    if (d.z() < -1e-3) step = std::max(step, 0.8 * f / -d.z());
-    t += std::min(step, std::max(0.5, 0.35 * t));
+// The first ground crossing of a ray, found by marching along it with steps
+// that grow with range and shrink near the ground, then refining the crossing
+// by regula falsi (the ground has curbs: no closed form, but it is nearly
+// planar, so few refinements are needed). Lazy: beyond(x) marches only until
+// it knows whether the crossing lies beyond x, so a ray that meets an object
+// first never marches the ground behind it. The steps and the crossing are
+// those of marching the whole way, whatever was asked on the way.
+class World::GroundMarch {
+ public:
+  GroundMarch(const World& world, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t)
+      : world_(world), o_(o), d_(d), max_t_(max_t), f_prev_(above(0.0)) {
+    if (f_prev_ <= 0) finish(0.0);
   }
-  return kInf;
-}
 
-// ---------------------------------------------------------------- ray casting
+  /// True when the crossing lies beyond range x (or there is none).
+  bool beyond(double x) {
+    while (!done_ && t_prev_ < x) advance();
+    return done_ ? crossing_ > x : true;  // not done: no crossing up to t_prev_ >= x
+  }
+  /// The crossing's range (infinity when none within max_t), marching to the end.
+  double crossing() {
+    while (!done_) advance();
+    return crossing_;
+  }
+
+ private:
+  double above(double t) const {
+    const Eigen::Vector3d p = o_ + t * d_;
+    return p.z() - world_.ground_from(world_.sample(p.x(), p.y())).height;
+  }
+  void finish(double crossing) {
+    done_ = true;
+    crossing_ = crossing;
+  }
+  void advance() {
+    if (t_prev_ >= max_t_) return finish(kInf);
+    t_ = std::min(t_, max_t_);
+    const double f = above(t_);
+    if (f <= 0) return finish(refine(f));
+    // Rays going up and well above the ground never come back.
+    if (d_.z() > 0.0 && f > 2.5) return finish(kInf);
+    t_prev_ = t_;
+    f_prev_ = f;
+    double step = std::max(0.2, 0.04 * t_);
+    if (d_.z() < -1e-3) step = std::max(step, 0.8 * f / -d_.z());
+    t_ += std::min(step, std::max(0.5, 0.35 * t_));
+  }
+  // Illinois variant of regula falsi on [t_prev (above), t (below)].
+  double refine(double f_below) const {
+    double lo = t_prev_, hi = t_, f_lo = f_prev_, f_hi = f_below;
+    int side = 0;
+    for (int i = 0; i < 20 && hi - lo > 0.003; ++i) {
+      const double m = std::clamp(lo + (hi - lo) * f_lo / (f_lo - f_hi), lo + 1e-4, hi - 1e-4);
+      const double fm = above(m);
+      if (fm > 0) {
+        lo = m;
+        f_lo = fm;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      } else {
+        hi = m;
+        f_hi = fm;
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      }
+    }
+    return hi;
+  }
+
+  const World& world_;
+  const Eigen::Vector3d o_, d_;
+  const double max_t_;
+  double t_prev_ = 0.0, f_prev_, t_ = 1.0;
+  bool done_ = false;
+  double crossing_ = kInf;
+};
 
 RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_range, double t,
                        std::span<const Primitive> dynamic, Rng& rng) const {
   RayHit best;
-  const double t_ground = ground_intersection(o, d, max_range);
-  double best_t = std::min(t_ground, max_range + 1e-9);
+  // The nearest surface so far is the ground or the nearest object; the
+  // ground is marched only as far as the comparisons below need.
+  GroundMarch ground(*this, o, d, max_range);
+  double object_t = max_range + 1e-9;  // nearest object (or glass) so far, capped at the range
+  const auto nearer = [&](double x) { return x < object_t && ground.beyond(x); };
   const Primitive* best_p = nullptr;
   Interval best_iv;
   bool blocked = false;  // a glass pane ate the return
@@ -340,16 +372,16 @@ RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doubl
   auto consider = [&](const Primitive& p) {
     if (!p.present(t)) return;
     Interval iv;
-    if (!intersect(p, o, d, iv) || iv.t0 >= best_t) return;
+    if (!intersect(p, o, d, iv) || !nearer(iv.t0)) return;
     const double r = surface_range(p, iv, o, d, rng);
     if (r == -kInf) {  // window glass: nothing behind it comes back either
-      best_t = iv.t0;
+      object_t = iv.t0;
       best_p = nullptr;
       blocked = true;
       return;
     }
-    if (r < best_t) {
-      best_t = r;
+    if (nearer(r)) {
+      object_t = r;
       best_p = &p;
       best_iv = iv;
       blocked = false;
@@ -370,7 +402,7 @@ RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doubl
   std::array<std::uint32_t, 48> tested{};
   std::size_t n_tested = 0;
   double t_cell_start = 0.0;
-  while (t_cell_start < best_t) {
+  while (nearer(t_cell_start)) {
     if (ix < 0 || iy < 0 || ix >= gx_ || iy >= gy_) break;
     const std::size_t c = static_cast<std::size_t>(iy) * static_cast<std::size_t>(gx_) + static_cast<std::size_t>(ix);
     for (std::uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
@@ -383,7 +415,7 @@ RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doubl
       consider(primitives_[id]);
     }
     const double t_exit = std::min(t_max_x, t_max_y);
-    if (best_t <= t_exit) break;
+    if (!nearer(t_exit)) break;
     t_cell_start = t_exit;
     if (t_max_x < t_max_y) {
       ix += step_x;
@@ -394,6 +426,9 @@ RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, doubl
     }
   }
 
+  // An object was kept only where the ground crosses beyond it; otherwise the
+  // ground is the nearest surface (or nothing within range).
+  const double best_t = ground.beyond(object_t) ? object_t : ground.crossing();
   if (blocked || best_t > max_range) return best;
   best.hit = true;
   best.range = best_t;

@@ -163,7 +163,8 @@ class World {
   [[nodiscard]] FieldSample sample(double x, double y) const;
   [[nodiscard]] GroundInfo ground_from(const FieldSample& s) const;
   [[nodiscard]] std::size_t cell_index(double x, double y) const;
-  [[nodiscard]] double ground_intersection(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t) const;
+  /// The ray's first ground crossing, marched only as far as a caller needs it.
+  class GroundMarch;
 
   WorldOptions options_;
   std::uint64_t seed_ = 0;
