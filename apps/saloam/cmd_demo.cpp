@@ -118,7 +118,8 @@ void print_summary(const SlamRunResult& slam, const std::optional<TrajectoryEval
 
 int run_demo(const DemoOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
-  const SaloamConfig config = options.config.resolve();
+  SaloamConfig config = options.config.resolve();
+  if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
   const std::filesystem::path out(options.out);
   const std::filesystem::path sequence_dir = out / "sequence";
   const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");

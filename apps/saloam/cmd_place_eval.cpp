@@ -121,11 +121,8 @@ int run_place_eval(const PlaceEvalArgs& args) {
   if (args.save_graphs) std::filesystem::create_directories(out / "graphs");
 
   std::optional<SgprNetwork> network;
-  std::filesystem::path model = args.model.empty() ? std::filesystem::path(config.loop.sgpr_model) : std::filesystem::path(args.model);
-  if (sgpr) {
-    if (model.empty()) model = shared_dir() / "models/sgpr/sgpr_kitti.sgw";
-    network.emplace(SgprNetwork::load(model));
-  }
+  const std::filesystem::path model = sgpr ? sgpr_model_path(args.model, config) : std::filesystem::path();
+  if (sgpr) network.emplace(SgprNetwork::load(model));
   GraphBuilderConfig graph_config;
   graph_config.use_instances = !args.no_instances;
   const PlaceRecognizer recognizer(detector, std::move(network), graph_config);
@@ -244,7 +241,7 @@ const CommandRegistration kRegistration{Command{
           ->check(CLI::IsMember({"sgpr", "scancontext", "hybrid"}))
           ->capture_default_str();
       app.add_option("--model", args->model,
-                     "SGPR weights (.sgw); default: config loop.sgpr_model, else <shared>/models/sgpr/sgpr_kitti.sgw");
+                     "SGPR weights (.sgw); default: config loop.sgpr_model, else the shipped models/sgpr/saloam.sgw");
       app.add_option("--labels", args->labels, "Folder of .label files to use instead of labels/");
       app.add_option("--out", args->out, "Output folder (default ./place_eval_<method>)");
       app.add_option("--positive", args->protocol.positive_distance, "[m] pairs within this distance are matches")

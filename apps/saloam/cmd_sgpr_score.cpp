@@ -19,10 +19,7 @@ struct ScoreArgs {
 
 int run_sgpr_score(const ScoreArgs& args) {
   const SaloamConfig config = args.config.resolve();
-  std::filesystem::path model = args.model;
-  if (model.empty()) model = config.loop.sgpr_model;
-  if (model.empty()) model = shared_dir() / "models/sgpr/sgpr_kitti.sgw";
-  const SgprNetwork network = SgprNetwork::load(model);
+  const SgprNetwork network = SgprNetwork::load(sgpr_model_path(args.model, config));
   const SemanticGraph query = read_graph_json(args.graphs.front());
   const SgprEmbedding query_embedding = network.embed(query);
   for (std::size_t i = 1; i < args.graphs.size(); ++i) {
@@ -41,7 +38,7 @@ const CommandRegistration kRegistration{Command{
       auto args = std::make_shared<ScoreArgs>();
       args->config.add_to(app);
       app.add_option("--model", args->model,
-                     "SGPR weights (.sgw); default: config loop.sgpr_model, else <shared>/models/sgpr/sgpr_kitti.sgw");
+                     "SGPR weights (.sgw); default: config loop.sgpr_model, else the shipped models/sgpr/saloam.sgw");
       app.add_option("graphs", args->graphs, "Graph files (.json): the first is scored against each of the others")
           ->required()
           ->expected(2, -1);

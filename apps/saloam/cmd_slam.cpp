@@ -56,7 +56,9 @@ void print_summary(const SlamRunResult& r) {
 int run_slam_command(const SlamOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (!options.detector.empty()) config.loop.detector = options.detector;
-  if (!options.model.empty()) config.loop.sgpr_model = options.model;
+  if (uses_sgpr(parse_place_detector(config.loop.detector))) {
+    config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
+  }
   SequenceOptions seq_options;
   if (!options.labels.empty()) seq_options.labels_dir = options.labels;
   seq_options.ignore_labels = !config.odometry.use_semantics && !uses_sgpr(parse_place_detector(config.loop.detector));

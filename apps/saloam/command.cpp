@@ -1,6 +1,13 @@
 #include "command.hpp"
 
+#include <algorithm>
 #include <cstdlib>
+#include <optional>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "saloam/core/error.hpp"
 
 namespace saloam::cli {
 
@@ -10,20 +17,71 @@ std::vector<Command>& command_registry() {
 }
 
 void ConfigOptions::add_to(CLI::App& app) {
-  app.add_option("--config", config_file, "YAML configuration file (see config/saloam.yaml)")->check(CLI::ExistingFile);
+  app.add_option("--config", config_file,
+                 "YAML configuration file, or the name of a shipped one (real_kitti, saloam: see config/)");
   app.add_option("--set", overrides, "Override a configuration value, e.g. --set odometry.alpha=0.2 (repeatable)")
       ->take_all();
 }
 
 SaloamConfig ConfigOptions::resolve() const {
-  SaloamConfig config = config_file.empty() ? SaloamConfig{} : load_config(config_file);
+  SaloamConfig config = config_file.empty() ? SaloamConfig{} : load_config(config_file_path(config_file));
   apply_config_overrides(config, overrides);
   return config;
 }
 
-std::filesystem::path shared_dir() {
-  if (const char* env = std::getenv("SALOAM_SHARED_DIR")) return env;
-  return SALOAM_DEFAULT_SHARED_DIR;
+namespace {
+
+std::optional<std::filesystem::path> installed_data_dir() {
+  std::error_code error;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (error) return std::nullopt;
+  const auto dir = (exe.parent_path() / SALOAM_INSTALL_DATA_RELATIVE).lexically_normal();
+  if (!std::filesystem::is_directory(dir / "config", error)) return std::nullopt;
+  return dir;
+}
+
+std::vector<std::string> shipped_configs() {
+  std::vector<std::string> names;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(data_dir() / "config", error)) {
+    if (entry.path().extension() == ".yaml") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace
+
+std::filesystem::path data_dir() {
+  if (const char* env = std::getenv("SALOAM_DATA_DIR"); env && *env) return env;
+  if (auto installed = installed_data_dir()) return *installed;
+  return SALOAM_SOURCE_DATA_DIR;
+}
+
+std::filesystem::path config_file_path(const std::string& name) {
+  const std::filesystem::path given(name);
+  std::error_code error;
+  if (std::filesystem::is_directory(given, error)) throw ConfigError(fmt::format("--config {}: is a directory", name));
+  if (std::filesystem::exists(given, error)) return given;
+  if (!given.has_parent_path()) {
+    auto shipped = data_dir() / "config" / given;
+    if (shipped.extension() != ".yaml") shipped += ".yaml";
+    if (std::filesystem::is_regular_file(shipped, error)) return shipped;
+  }
+  throw ConfigError(fmt::format("--config {}: no such file, nor a shipped configuration of that name (in {}: {})", name,
+                                (data_dir() / "config").string(), fmt::join(shipped_configs(), ", ")));
+}
+
+std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config) {
+  if (!given.empty()) return given;
+  if (!config.loop.sgpr_model.empty()) return config.loop.sgpr_model;
+  const auto shipped = data_dir() / "models" / "sgpr" / "saloam.sgw";
+  std::error_code error;
+  if (std::filesystem::is_regular_file(shipped, error)) return shipped;
+  throw ConfigError(fmt::format(
+      "SGPR needs weights: pass --model FILE.sgw or --set loop.sgpr_model=FILE.sgw (no model ships in {} yet; "
+      "e.g. the original KITTI weights converted to .sgw)",
+      shipped.parent_path().string()));
 }
 
 }  // namespace saloam::cli

@@ -31,8 +31,9 @@ struct CommandRegistration {
   explicit CommandRegistration(Command command) { command_registry().push_back(std::move(command)); }
 };
 
-/// --config FILE and --set key=value (repeatable), shared by every command
-/// that runs the pipeline. Call `resolve()` after parsing.
+/// --config FILE|NAME and --set key=value (repeatable), shared by every
+/// command that runs the pipeline. NAME (no folder, e.g. `real_kitti`) is a
+/// configuration shipped in data_dir()/config. Call `resolve()` after parsing.
 struct ConfigOptions {
   std::string config_file;
   std::vector<std::string> overrides;
@@ -40,8 +41,18 @@ struct ConfigOptions {
   [[nodiscard]] SaloamConfig resolve() const;
 };
 
-/// The development data folder (../shared beside the repository), overridable
-/// with the SALOAM_SHARED_DIR environment variable.
-std::filesystem::path shared_dir();
+/// Where saloam's own data lie (config/*.yaml, models/): $SALOAM_DATA_DIR when
+/// set; else <prefix>/share/saloam when the program runs installed as
+/// <prefix>/bin/saloam; else the source tree it was built from.
+std::filesystem::path data_dir();
+
+/// The configuration file meant by `--config name`: the file itself, or for a
+/// bare name data_dir()/config/<name>[.yaml]; ConfigError naming both places otherwise.
+std::filesystem::path config_file_path(const std::string& name);
+
+/// The SGPR weights to load: `given` (--model), else the config's
+/// loop.sgpr_model, else the model shipped in data_dir()/models/sgpr/saloam.sgw;
+/// ConfigError saying how to pass one when there is none.
+std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config);
 
 }  // namespace saloam::cli

@@ -30,13 +30,29 @@ TEST(LoopCli, SgprScoreReproducesTheReferencePair) {
   ASSERT_EQ(rc, 0) << output;
   EXPECT_NE(output.find("graph_3.json score 0.997977"), std::string::npos) << output;
   EXPECT_NE(output.find("graph_250.json score 0.000001"), std::string::npos) << output;
-  // Default model: the shared sgpr_kitti.sgw; order matters (3-0 = 0.98185).
-  ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("sgpr-score {} {}", quoted(dir / "graph_3.json"),
+  // The model through the configuration; order matters (3-0 = 0.98185).
+  ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("sgpr-score --set loop.sgpr_model={} {} {}",
+                                                        (dir / "sgpr_kitti.sgw").string(), quoted(dir / "graph_3.json"),
                                                         quoted(dir / "graph_0.json"))),
                                  &output),
             0)
       << output;
   EXPECT_NE(output.find("score 0.981845"), std::string::npos) << output;
+}
+
+TEST(LoopCli, WithoutAModelSaysHowToPassOne) {
+  // Nothing is read from ../shared at run time: no weights given and none
+  // shipped is an error that names the options.
+  testing::TempDir tmp;
+  std::ofstream(tmp / "graph.json") << "{}";
+  std::string output;
+  EXPECT_NE(testing::run_command("SALOAM_DATA_DIR=" + quoted(tmp.path()) + " " +
+                                     saloam_cmd(fmt::format("sgpr-score {} {}", quoted(tmp / "graph.json"),
+                                                            quoted(tmp / "graph.json"))),
+                                 &output),
+            0);
+  EXPECT_NE(output.find("--model FILE.sgw"), std::string::npos) << output;
+  EXPECT_NE(output.find("loop.sgpr_model"), std::string::npos) << output;
 }
 
 TEST(LoopCli, BadModelFilesGiveClearErrors) {
@@ -124,7 +140,9 @@ TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
 
   for (const std::string method : {"sgpr", "scancontext"}) {
     const auto out = tmp / ("eval_" + method);
-    ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method {} --out {}", quoted(seq), method, quoted(out))),
+    const auto model = testing::shared_dir() / "models/sgpr/sgpr_kitti.sgw";
+    ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method {} --model {} --out {}", quoted(seq),
+                                                          method, quoted(model), quoted(out))),
                                    &output),
               0)
         << output;
