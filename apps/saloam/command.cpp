@@ -1,5 +1,6 @@
 #include "command.hpp"
 
+#include <cmath>
 #include <cstdlib>
 
 namespace saloam::cli {
@@ -19,6 +20,32 @@ SaloamConfig ConfigOptions::resolve() const {
   SaloamConfig config = config_file.empty() ? SaloamConfig{} : load_config(config_file);
   apply_config_overrides(config, overrides);
   return config;
+}
+
+void add_no_calib_flag(CLI::App& app, bool& no_calib) {
+  app.add_flag("--no-calib", no_calib,
+               "Run without calib.txt (ignored if present): poses.txt holds LiDAR-frame poses, not KITTI's camera "
+               "frame");
+}
+
+CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) && value > 0.0) return "";
+        return "must be a positive number, got '" + text + "'";
+      },
+      "POSITIVE");
+}
+
+CLI::Validator non_negative_integer() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && text.size() <= 18) return "";
+        return "must be a whole number (0 or more), got '" + text + "'";
+      },
+      "UINT");
 }
 
 std::filesystem::path shared_dir() {

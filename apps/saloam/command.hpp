@@ -40,6 +40,16 @@ struct ConfigOptions {
   [[nodiscard]] SaloamConfig resolve() const;
 };
 
+/// --no-calib of the runs (odom, slam): without it a missing calib.txt is an
+/// error; with it poses.txt holds LiDAR-frame poses.
+void add_no_calib_flag(CLI::App& app, bool& no_calib);
+
+/// Checks for numeric options whose messages name the value: CLI11's
+/// PositiveNumber prints its range as 300-digit numbers, and an unsigned
+/// option silently wraps -1 to 18446744073709551615.
+CLI::Validator positive_number();
+CLI::Validator non_negative_integer();
+
 /// The development data folder (../shared beside the repository), overridable
 /// with the SALOAM_SHARED_DIR environment variable.
 std::filesystem::path shared_dir();

@@ -1,8 +1,10 @@
 #include "saloam/runs/output_folder.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace saloam {
 
@@ -15,7 +17,20 @@ void prepare_output_folder(const std::filesystem::path& out_dir, const SequenceR
                                           "truth; choose another output folder",
                                           reader.root().string()));
   }
-  std::filesystem::create_directories(out_dir);
+  create_folder(out_dir);
+}
+
+std::optional<Pose> output_velo_to_cam(const SequenceReader& reader, bool lidar_frame) {
+  if (lidar_frame) {
+    spdlog::info("--no-calib: pose files hold LiDAR-frame poses, not the KITTI camera convention");
+    return std::nullopt;
+  }
+  if (!reader.has_calib()) {
+    throw InputError(reader.root() / "calib.txt",
+                     "not found: needed to write poses.txt in KITTI's camera frame, comparable with the ground "
+                     "truth; pass --no-calib to write LiDAR-frame poses instead");
+  }
+  return reader.velo_to_cam();
 }
 
 }  // namespace saloam

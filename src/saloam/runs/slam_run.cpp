@@ -177,17 +177,12 @@ SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config,
   if (config.odometry.use_semantics && !reader.has_labels()) {
     spdlog::warn("{}: no labels found; running with every point in one class", reader.root().string());
   }
-  std::optional<Pose> tr;
-  if (reader.has_calib()) {
-    tr = reader.velo_to_cam();
-  } else {
-    spdlog::warn("{}: no calib.txt; pose files hold LiDAR-frame poses, not the KITTI camera convention",
-                 reader.root().string());
-  }
+  const std::optional<Pose> tr = output_velo_to_cam(reader, options.no_calib);
   prepare_output_folder(out_dir, reader);
 
   SlamSystem slam(config, std::move(network));
   TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
   ProgressBar progress(end - first, "slam", options.show_progress);
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t i = first; i < end && !stop_requested(); ++i) {
@@ -215,7 +210,7 @@ SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config,
   result.mean_loop_ms = mean_of(loops);
 
   const std::vector<Pose> optimized = slam.optimized_poses();
-  write_trajectory(out_dir / "poses.txt", out_dir / "poses_tum.txt", slam.timestamps(), optimized, tr);
+  for (std::size_t i = 0; i < optimized.size(); ++i) slam_writer.write(slam.timestamps().at(i), optimized[i]);
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
 
   // Ground truth of the processed frames, camera frame (trajectories) and

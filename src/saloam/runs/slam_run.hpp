@@ -34,6 +34,7 @@ struct SlamRunOptions {
   std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the sequence
   bool show_progress = true;
   bool write_map = true;  ///< map.ply / map.png (re-reads the scans)
+  bool no_calib = false;  ///< LiDAR-frame pose files, calib.txt not needed (output_velo_to_cam)
 };
 
 struct SlamRunResult {
