@@ -33,7 +33,9 @@ struct EvalOptions {
 void make_frames_consistent(const EvalOptions& options, Trajectory& gt, TrajectoryFormat gt_format, Trajectory& est,
                             TrajectoryFormat est_format) {
   if (gt_format == est_format) {
-    if (!options.calib_file.empty()) spdlog::warn("--calib unused: both files are {}", gt_format == TrajectoryFormat::kTum ? "TUM" : "KITTI");
+    if (!options.calib_file.empty()) {
+      spdlog::warn("--calib unused: both files are {}", gt_format == TrajectoryFormat::kTum ? "TUM" : "KITTI");
+    }
     return;
   }
   const bool est_is_tum = est_format == TrajectoryFormat::kTum;

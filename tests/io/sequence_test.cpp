@@ -132,6 +132,8 @@ TEST(Sequence, EntriesNamedLikeScansMustBeNumberedFiles) {
 
   std::ofstream(dir / "velodyne/notes.txt") << "other files are ignored\n";
   EXPECT_EQ(SequenceReader(dir.path()).size(), 3u);
+  msg = input_error_of([&] { SequenceReader s(dir / "times.txt"); });
+  EXPECT_NE(msg.find("times.txt: is not a folder (expected a sequence folder)"), std::string::npos) << msg;
 }
 
 // Documented: more times/poses lines than scans is a sequence holding only

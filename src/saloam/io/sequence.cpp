@@ -22,8 +22,8 @@ namespace {
 /// stem is not all digits.
 std::optional<std::size_t> scan_number(const fs::path& file) {
   const std::string stem = file.stem().string();
-  if (stem.empty() || stem.size() > 9 || !std::all_of(stem.begin(), stem.end(), [](char c) { return c >= '0' && c <= '9'; }))
-    return std::nullopt;
+  const auto is_digit = [](char c) { return c >= '0' && c <= '9'; };
+  if (stem.empty() || stem.size() > 9 || !std::all_of(stem.begin(), stem.end(), is_digit)) return std::nullopt;
   return static_cast<std::size_t>(std::stoul(stem));
 }
 
@@ -68,7 +68,8 @@ SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
     : root_(std::move(root)), options_(std::move(options)) {
   std::error_code ec;
   if (!fs::is_directory(root_, ec)) {
-    throw InputError(root_, fs::exists(root_, ec) ? "is not a folder (expected a sequence folder)" : "sequence folder not found");
+    throw InputError(root_, fs::exists(root_, ec) ? "is not a folder (expected a sequence folder)"
+                                                  : "sequence folder not found");
   }
   const fs::path velodyne = root_ / "velodyne";
   if (!fs::is_directory(velodyne, ec)) throw InputError(velodyne, "missing velodyne/ folder of .bin scans");
