@@ -5,12 +5,14 @@
 #include <memory>
 #include <stdexcept>
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
+#include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
 
 namespace saloam::cli {
@@ -22,11 +24,38 @@ struct EvalOptions {
   std::string json_file;
   std::string plot_file;
   std::string alignment = "se3";
+  std::string calib_file;
 };
 
+/// TUM files are LiDAR-frame poses (as saloam writes poses_tum.txt), KITTI
+/// files camera-frame poses (poses.txt): comparing one with the other needs
+/// Tr, which converts the TUM side to the camera frame (P = Tr Q Tr^-1).
+void make_frames_consistent(const EvalOptions& options, Trajectory& gt, TrajectoryFormat gt_format, Trajectory& est,
+                            TrajectoryFormat est_format) {
+  if (gt_format == est_format) {
+    if (!options.calib_file.empty()) {
+      spdlog::warn("--calib unused: both files are {}", gt_format == TrajectoryFormat::kTum ? "TUM" : "KITTI");
+    }
+    return;
+  }
+  const bool est_is_tum = est_format == TrajectoryFormat::kTum;
+  const std::string& tum_file = est_is_tum ? options.est_file : options.gt_file;
+  const std::string& kitti_file = est_is_tum ? options.gt_file : options.est_file;
+  if (options.calib_file.empty()) {
+    throw InputError(tum_file, fmt::format("TUM trajectory (LiDAR frame, as poses_tum.txt) compared with the KITTI "
+                                           "trajectory {} (camera frame, as poses.txt): pass --calib SEQ/calib.txt "
+                                           "to convert it to the camera frame, or compare two files of one format",
+                                           kitti_file));
+  }
+  Trajectory& tum = est_is_tum ? est : gt;
+  tum.poses = lidar_to_camera_poses(tum.poses, read_velo_to_cam(options.calib_file));
+}
+
 int run_eval(const EvalOptions& options) {
-  const Trajectory gt = read_trajectory(options.gt_file);
-  const Trajectory est = read_trajectory(options.est_file);
+  TrajectoryFormat gt_format{}, est_format{};
+  Trajectory gt = read_trajectory(options.gt_file, &gt_format);
+  Trajectory est = read_trajectory(options.est_file, &est_format);
+  make_frames_consistent(options, gt, gt_format, est, est_format);
 
   EvaluationOptions eval_options;
   eval_options.alignment = parse_alignment(options.alignment);  // validated by CLI11 already
@@ -66,6 +95,8 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--align", options->alignment, "Alignment of the estimate for ATE: se3, sim3 or none")
           ->check(CLI::IsMember({"se3", "sim3", "none"}, CLI::ignore_case))
           ->capture_default_str();
+      app.add_option("--calib", options->calib_file,
+                     "KITTI calib.txt (Tr) to compare a TUM file (LiDAR frame) with a KITTI file (camera frame)");
       return [options] { return run_eval(*options); };
     }}};
 

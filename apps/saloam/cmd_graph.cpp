@@ -60,7 +60,7 @@ const CommandRegistration kRegistration{Command{
     "graph", "Build the semantic graph (SGPR JSON) of one labelled scan", 40, [](CLI::App& app) {
       auto args = std::make_shared<GraphArgs>();
       app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt)")->required();
-      app.add_option("--frame", args->frame, "Scan index")->required();
+      app.add_option("--frame", args->frame, "Scan index")->required()->check(non_negative_integer());
       app.add_option("--out", args->out, "Output graph file (.json)")->required();
       app.add_option("--labels", args->labels, "Folder of .label files to use instead of labels/");
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids: cluster vehicles geometrically too");

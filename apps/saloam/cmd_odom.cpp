@@ -24,6 +24,7 @@ struct OdomOptions {
   std::string labels;
   std::string frames;
   bool no_semantics = false;
+  bool no_calib = false;
   ConfigOptions config;
 };
 
@@ -35,6 +36,7 @@ int run_odom(const OdomOptions& options) {
   seq_options.ignore_labels = !config.odometry.use_semantics;
   const SequenceReader reader(options.sequence, seq_options);
   OdometryRunOptions run_options;
+  run_options.no_calib = options.no_calib;
   std::tie(run_options.first_frame, run_options.end_frame) = FrameRange::parse(options.frames).clip(reader.size());
 
   const std::filesystem::path out_dir(options.out);
@@ -61,6 +63,7 @@ const CommandRegistration kRegistration{Command{
       app.add_flag("--no-semantics", options->no_semantics,
                    "Label-agnostic run with plain voxel grid (FLOAM-like baseline)");
       app.add_option("--frames", options->frames, "Frame range A:B (B exclusive; A: = to the end)");
+      add_no_calib_flag(app, options->no_calib);
       options->config.add_to(app);
       return [options] { return run_odom(*options); };
     }}};

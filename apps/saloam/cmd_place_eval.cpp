@@ -20,6 +20,7 @@
 #include "command.hpp"
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/place/graph_json.hpp"
@@ -44,6 +45,7 @@ struct PlaceEvalArgs {
   bool no_instances = false;
   bool save_graphs = false;
   bool save_scores = false;
+  bool no_calib = false;
 };
 
 /// Runs `work(i)` for every frame in parallel with a progress bar; stops early on Ctrl-C.
@@ -111,14 +113,19 @@ int run_place_eval(const PlaceEvalArgs& args) {
   if (!reader.has_poses()) throw InputError(args.sequence, "no poses.txt: place-eval needs ground-truth poses");
   if (sgpr && !reader.has_labels())
     throw InputError(args.sequence, "no labels/ folder (give --labels DIR): SGPR needs semantic labels");
-  const std::vector<Pose> poses = reader.has_calib() ? reader.lidar_poses() : reader.camera_poses();
+  // Distances between LiDAR positions; with --no-calib those of poses.txt as given.
+  if (!args.no_calib && !reader.has_calib()) {
+    throw InputError(reader.root() / "calib.txt", "not found: needed for the LiDAR positions of poses.txt; pass "
+                                                  "--no-calib to use the poses as given (LiDAR frame)");
+  }
+  const std::vector<Pose> poses = args.no_calib ? reader.camera_poses() : reader.lidar_poses();
   std::vector<Eigen::Vector3d> positions;
   for (const auto& p : poses) positions.push_back(p.translation());
   const std::size_t n = reader.size();
 
   const std::filesystem::path out = args.out.empty() ? std::filesystem::path("place_eval_" + args.method) : std::filesystem::path(args.out);
-  std::filesystem::create_directories(out);
-  if (args.save_graphs) std::filesystem::create_directories(out / "graphs");
+  create_folder(out);
+  if (args.save_graphs) create_folder(out / "graphs");
 
   std::optional<SgprNetwork> network;
   const std::filesystem::path model = sgpr ? sgpr_model_path(args.model, config) : std::filesystem::path();
@@ -245,18 +252,20 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--labels", args->labels, "Folder of .label files to use instead of labels/");
       app.add_option("--out", args->out, "Output folder (default ./place_eval_<method>)");
       app.add_option("--positive", args->protocol.positive_distance, "[m] pairs within this distance are matches")
-          ->check(CLI::PositiveNumber)
+          ->check(positive_number())
           ->capture_default_str();
       app.add_option("--negative", args->protocol.negative_distance,
                      "[m] pairs beyond this distance are non-matches (more than --positive)")
-          ->check(CLI::PositiveNumber)
+          ->check(positive_number())
           ->capture_default_str();
       app.add_option("--exclude", args->protocol.exclude_recent, "most recent frames not compared with a query")
-          ->check(CLI::NonNegativeNumber)
+          ->check(non_negative_integer())
           ->capture_default_str();
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
       app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");
       app.add_flag("--save-scores", args->save_scores, "Also write every pair's score to OUT/pair_scores.csv");
+      app.add_flag("--no-calib", args->no_calib,
+                   "No calib.txt needed: match distances from poses.txt as given (LiDAR-frame poses)");
       return [args] { return run_place_eval(*args); };
     }}};
 

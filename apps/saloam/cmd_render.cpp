@@ -8,6 +8,7 @@
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/sim/render.hpp"
 
@@ -25,7 +26,7 @@ struct RenderArgs {
 
 int run_render(const RenderArgs& args) {
   const std::filesystem::path out(args.out);
-  std::filesystem::create_directories(out);
+  create_folder(out);
   SequenceOptions seq_options;
   if (!args.labels_dir.empty()) seq_options.labels_dir = args.labels_dir;
   const SequenceReader reader(args.sequence, seq_options);
@@ -53,9 +54,10 @@ const CommandRegistration kRegistration{Command{
       auto args = std::make_shared<RenderArgs>();
       app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt, calib.txt)")->required();
       app.add_option("--out", args->out, "Output folder for map.png and range_NNNNNN.png")->required();
-      app.add_option("--frame", args->frame, "Scan shown as a range image (default 0)");
-      app.add_option("--resolution", args->resolution, "Map metres per pixel (default 0.25)")->check(CLI::PositiveNumber);
-      app.add_option("--frame-step", args->frame_step, "Accumulate every n-th scan (default: about 300 scans)");
+      app.add_option("--frame", args->frame, "Scan shown as a range image (default 0)")->check(non_negative_integer());
+      app.add_option("--resolution", args->resolution, "Map metres per pixel (default 0.25)")->check(positive_number());
+      app.add_option("--frame-step", args->frame_step, "Accumulate every n-th scan (default: about 300 scans)")
+          ->check(non_negative_integer());
       app.add_option("--labels-dir", args->labels_dir, "Labels folder instead of labels/ (e.g. labels_gt or predictions)");
       return [args] { return run_render(*args); };
     }}};

@@ -25,6 +25,7 @@ struct SlamOptions {
   std::string detector;
   std::string model;
   bool no_map = false;
+  bool no_calib = false;
   ConfigOptions config;
 };
 
@@ -66,6 +67,7 @@ int run_slam_command(const SlamOptions& options) {
   SlamRunOptions run_options;
   std::tie(run_options.first_frame, run_options.end_frame) = FrameRange::parse(options.frames).clip(reader.size());
   run_options.write_map = !options.no_map;
+  run_options.no_calib = options.no_calib;
 
   const std::filesystem::path out_dir(options.out);
   const SlamRunResult result = run_slam(reader, config, load_loop_network(config, {}), out_dir, run_options);
@@ -94,6 +96,7 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--model", options->model, "SGPR weights (.sgw) for the sgpr and hybrid detectors (loop.sgpr_model)")
           ->check(CLI::ExistingFile);
       app.add_flag("--no-map", options->no_map, "Skip the global map (map.ply, map.png)");
+      add_no_calib_flag(app, options->no_calib);
       options->config.add_to(app);
       return [options] { return run_slam_command(*options); };
     }}};

@@ -1,6 +1,7 @@
 #include "command.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <optional>
 
@@ -82,6 +83,32 @@ std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConf
       "SGPR needs weights: pass --model FILE.sgw or --set loop.sgpr_model=FILE.sgw (no model ships in {} yet; "
       "e.g. the original KITTI weights converted to .sgw)",
       shipped.parent_path().string()));
+}
+
+void add_no_calib_flag(CLI::App& app, bool& no_calib) {
+  app.add_flag("--no-calib", no_calib,
+               "Run without calib.txt (ignored if present): poses.txt holds LiDAR-frame poses, not KITTI's camera "
+               "frame");
+}
+
+CLI::Validator positive_number() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) && value > 0.0) return "";
+        return "must be a positive number, got '" + text + "'";
+      },
+      "POSITIVE");
+}
+
+CLI::Validator non_negative_integer() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        const bool digits = !text.empty() && text.find_first_not_of("0123456789") == std::string::npos;
+        if (digits && text.size() <= 18) return "";
+        return "must be a whole number (0 or more), got '" + text + "'";
+      },
+      "UINT");
 }
 
 }  // namespace saloam::cli

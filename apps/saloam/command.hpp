@@ -54,5 +54,14 @@ std::filesystem::path config_file_path(const std::string& name);
 /// loop.sgpr_model, else the model shipped in data_dir()/models/sgpr/saloam.sgw;
 /// ConfigError saying how to pass one when there is none.
 std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config);
+/// --no-calib of the runs (odom, slam): without it a missing calib.txt is an
+/// error; with it poses.txt holds LiDAR-frame poses.
+void add_no_calib_flag(CLI::App& app, bool& no_calib);
+
+/// Checks for numeric options whose messages name the value: CLI11's
+/// PositiveNumber prints its range as 300-digit numbers, and an unsigned
+/// option silently wraps -1 to 18446744073709551615.
+CLI::Validator positive_number();
+CLI::Validator non_negative_integer();
 
 }  // namespace saloam::cli

@@ -12,6 +12,7 @@
 #include "command.hpp"
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace {
 
@@ -64,6 +65,8 @@ int main(int argc, char** argv) {
     spdlog::error("{}", e.what());
   } catch (const saloam::ConfigError& e) {
     spdlog::error("configuration: {}", e.what());
+  } catch (const std::filesystem::filesystem_error& e) {
+    spdlog::error("{}", saloam::describe(e));  // "PATH: reason", not the library's raw text
   } catch (const std::exception& e) {
     spdlog::error("{}", e.what());
   }

@@ -94,6 +94,66 @@ TEST(Sequence, MissingPiecesGiveClearErrors) {
   EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("poses.txt: line 2"), std::string::npos);
 }
 
+// Scan i is velodyne/i.bin: a gap must not shift the later scans onto the
+// poses and timestamps of their predecessors.
+TEST(Sequence, MissingScanNumberIsAnErrorNamingIt) {
+  testing::TempDir dir;
+  write_sequence(dir.path());
+  SequenceWriter(dir.path()).write_scan(3, small_cloud(40));
+  std::ofstream(dir / "times.txt") << "0\n0.1\n0.2\n0.3\n";
+  std::filesystem::remove(dir / "velodyne/000001.bin");
+  const auto msg = input_error_of([&] { SequenceReader s(dir.path()); });
+  EXPECT_NE(msg.find("velodyne/000001.bin: missing scan"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("found 000002.bin next"), std::string::npos) << msg;
+
+  std::filesystem::rename(dir / "velodyne/000002.bin", dir / "velodyne/000001.bin");
+  std::filesystem::rename(dir / "velodyne/000003.bin", dir / "velodyne/000002.bin");
+  std::filesystem::remove(dir / "velodyne/000000.bin");  // numbering must start at 000000
+  EXPECT_NE(input_error_of([&] { SequenceReader s(dir.path()); }).find("000000.bin: missing scan"), std::string::npos);
+}
+
+TEST(Sequence, EntriesNamedLikeScansMustBeNumberedFiles) {
+  testing::TempDir dir;
+  write_sequence(dir.path());
+  std::filesystem::create_directories(dir / "velodyne/000003.bin");
+  auto msg = input_error_of([&] { SequenceReader s(dir.path()); });
+  EXPECT_NE(msg.find("000003.bin: is a directory, not a scan file"), std::string::npos) << msg;
+  std::filesystem::remove(dir / "velodyne/000003.bin");
+
+  write_scan_bin(dir / "velodyne/scan.bin", small_cloud(40));
+  msg = input_error_of([&] { SequenceReader s(dir.path()); });
+  EXPECT_NE(msg.find("scan.bin: scan names must be frame numbers"), std::string::npos) << msg;
+  std::filesystem::remove(dir / "velodyne/scan.bin");
+
+  write_scan_bin(dir / "velodyne/2.bin", small_cloud(40));
+  msg = input_error_of([&] { SequenceReader s(dir.path()); });
+  EXPECT_NE(msg.find("same frame number as"), std::string::npos) << msg;
+  std::filesystem::remove(dir / "velodyne/2.bin");
+
+  std::ofstream(dir / "velodyne/notes.txt") << "other files are ignored\n";
+  EXPECT_EQ(SequenceReader(dir.path()).size(), 3u);
+  msg = input_error_of([&] { SequenceReader s(dir / "times.txt"); });
+  EXPECT_NE(msg.find("times.txt: is not a folder (expected a sequence folder)"), std::string::npos) << msg;
+}
+
+// Documented: more times/poses lines than scans is a sequence holding only
+// its first scans (the first lines are used); fewer is an error.
+TEST(Sequence, ExtraTimesAndPosesLinesBelongToScansNotPresent) {
+  testing::TempDir dir;
+  write_sequence(dir.path());
+  std::filesystem::remove(dir / "velodyne/000002.bin");
+  std::filesystem::remove(dir / "labels/000002.label");
+  const SequenceReader seq(dir.path());
+  ASSERT_EQ(seq.size(), 2u);
+  EXPECT_EQ(seq.times().size(), 2u);
+  ASSERT_EQ(seq.camera_poses().size(), 2u);
+  EXPECT_NEAR(seq.camera_poses()[1].translation().z(), 1.0, 1e-9);
+
+  std::ofstream(dir / "times.txt") << "0\n0.2\n0.1\n";
+  const auto msg = input_error_of([&] { SequenceReader s(dir.path()); });
+  EXPECT_NE(msg.find("times.txt: line 3: timestamp 0.1 is not after 0.2"), std::string::npos) << msg;
+}
+
 TEST(Ply, BinaryRoundTripWithColoursAndTransform) {
   testing::TempDir dir;
   auto cloud = small_cloud(50, 100);

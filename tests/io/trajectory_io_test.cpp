@@ -134,3 +134,108 @@ TEST(Calibration, ReadsKittiCalibFileAndReportsMissingTr) {
 
 }  // namespace
 }  // namespace saloam
+
+namespace saloam {
+namespace {
+
+using testing::input_error_of;
+
+/// A KITTI line of `pose` with its rotation replaced by `rotation`.
+std::string kitti_line(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& t = Eigen::Vector3d(1, 2, 3)) {
+  Pose pose = Pose::Identity();
+  pose.linear() = rotation;
+  pose.translation() = t;
+  return kitti_pose_line(pose) + "\n";
+}
+
+/// A rotation off SO(3) by about `amount` in ||R^T R - I||, like KITTI's
+/// printed calib Tr (about 1e-4).
+Eigen::Matrix3d nearly_orthonormal(double amount) {
+  Eigen::Matrix3d r = so3_exp(Eigen::Vector3d(0.1, -0.2, 0.3));
+  r(0, 1) += amount;
+  return r;
+}
+
+TEST(TrajectoryIo, RotationsMustBeRigidNotOnlyHaveDeterminantOne) {
+  testing::TempDir dir;
+  const std::string good = kitti_line(Eigen::Matrix3d::Identity());
+  // det = 1 but a scale and a squeeze: not a rotation.
+  write_text(dir / "squeezed.txt", good + kitti_line(Eigen::Vector3d(2.0, 0.5, 1.0).asDiagonal()));
+  auto msg = input_error_of([&] { read_kitti_poses(dir / "squeezed.txt"); });
+  EXPECT_NE(msg.find("squeezed.txt: line 2: rotation is not orthonormal"), std::string::npos) << msg;
+  msg = input_error_of([&] { read_trajectory(dir / "squeezed.txt"); });
+  EXPECT_NE(msg.find("line 2: rotation is not orthonormal"), std::string::npos) << msg;
+
+  write_text(dir / "mirror.txt", kitti_line(Eigen::Vector3d(1.0, 1.0, -1.0).asDiagonal()));
+  msg = input_error_of([&] { read_kitti_poses(dir / "mirror.txt"); });
+  EXPECT_NE(msg.find("line 1: rotation is a reflection"), std::string::npos) << msg;
+
+  // Rounding like KITTI's (1e-4) is accepted and projected back onto SO(3).
+  write_text(dir / "rounded.txt", good + kitti_line(nearly_orthonormal(1e-4)));
+  const auto poses = read_kitti_poses(dir / "rounded.txt");
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_LT(orthonormality_error(poses[1].linear()), 1e-12);
+  EXPECT_NEAR(poses[1].linear().determinant(), 1.0, 1e-12);
+  write_text(dir / "sheared.txt", kitti_line(nearly_orthonormal(1e-2)));
+  EXPECT_NE(input_error_of([&] { read_kitti_poses(dir / "sheared.txt"); }).find("not orthonormal"), std::string::npos);
+}
+
+TEST(TrajectoryIo, TimestampsMustIncrease) {
+  testing::TempDir dir;
+  write_text(dir / "times.txt", "0.0\n0.1\n# comment\n0.05\n");
+  auto msg = input_error_of([&] { read_times(dir / "times.txt"); });
+  EXPECT_NE(msg.find("times.txt: line 4: timestamp 0.05 is not after 0.1 on line 2"), std::string::npos) << msg;
+  write_text(dir / "repeated.txt", "0.0\n0.1\n0.1\n");
+  msg = input_error_of([&] { read_times(dir / "repeated.txt"); });
+  EXPECT_NE(msg.find("line 3"), std::string::npos) << msg;
+  write_text(dir / "inf.txt", "0.0\ninf\n");
+  msg = input_error_of([&] { read_times(dir / "inf.txt"); });
+  EXPECT_NE(msg.find("inf.txt: line 2: non-finite value"), std::string::npos) << msg;
+
+  // TUM trajectories: the same rule, through both readers.
+  write_text(dir / "reversed_tum.txt", "0.2 0 0 0 0 0 0 1\n0.1 1 0 0 0 0 0 1\n");
+  msg = input_error_of([&] { read_tum_trajectory(dir / "reversed_tum.txt"); });
+  EXPECT_NE(msg.find("reversed_tum.txt: line 2: timestamp 0.1 is not after 0.2"), std::string::npos) << msg;
+  msg = input_error_of([&] { read_trajectory(dir / "reversed_tum.txt"); });
+  EXPECT_NE(msg.find("line 2: timestamp"), std::string::npos) << msg;
+}
+
+TEST(TrajectoryIo, ByteOrderMarkIsSkippedAndDirectoriesNamed) {
+  testing::TempDir dir;
+  write_text(dir / "bom.txt", "\xEF\xBB\xBF" + kitti_line(Eigen::Matrix3d::Identity()));
+  ASSERT_EQ(read_kitti_poses(dir / "bom.txt").size(), 1u);
+  write_text(dir / "bom_times.txt", "\xEF\xBB\xBF" "0.0\r\n0.1\r\n");
+  EXPECT_EQ(read_times(dir / "bom_times.txt").size(), 2u);
+  std::filesystem::create_directories(dir / "poses.txt");
+  const auto msg = input_error_of([&] { read_kitti_poses(dir / "poses.txt"); });
+  EXPECT_NE(msg.find("poses.txt: is a directory, not a file"), std::string::npos) << msg;
+}
+
+TEST(TrajectoryIo, FormatIsReported) {
+  testing::TempDir dir;
+  write_text(dir / "k.txt", kitti_line(Eigen::Matrix3d::Identity()));
+  write_text(dir / "t.txt", "0 1 2 3 0 0 0 1\n");
+  TrajectoryFormat format{};
+  read_trajectory(dir / "k.txt", &format);
+  EXPECT_EQ(format, TrajectoryFormat::kKitti);
+  read_trajectory(dir / "t.txt", &format);
+  EXPECT_EQ(format, TrajectoryFormat::kTum);
+}
+
+TEST(Calibration, TrMustBeRigidAndMayBeIndented) {
+  testing::TempDir dir;
+  const auto tr_line = [](const Eigen::Matrix3d& r) { return "Tr: " + kitti_line(r); };
+  write_text(dir / "indented.txt", "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n  Tr: " + kitti_line(nearly_orthonormal(1e-4)));
+  const Pose tr = read_velo_to_cam(dir / "indented.txt");
+  EXPECT_LT(orthonormality_error(tr.linear()), 1e-12);  // re-orthonormalised
+  EXPECT_TRUE(tr.translation().isApprox(Eigen::Vector3d(1, 2, 3)));
+
+  write_text(dir / "squeezed.txt", "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n" + tr_line(Eigen::Vector3d(2.0, 0.5, 1.0).asDiagonal()));
+  const auto msg = input_error_of([&] { read_velo_to_cam(dir / "squeezed.txt"); });
+  EXPECT_NE(msg.find("squeezed.txt: line 2: rotation of 'Tr' is not orthonormal"), std::string::npos) << msg;
+  write_text(dir / "bom.txt", "\xEF\xBB\xBF" + tr_line(Eigen::Matrix3d::Identity()));
+  EXPECT_TRUE(read_velo_to_cam(dir / "bom.txt").isApprox(Pose(Eigen::Translation3d(1, 2, 3))));
+}
+
+}  // namespace
+}  // namespace saloam

@@ -78,6 +78,10 @@ Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& R) {
   return U * V.transpose();
 }
 
+double orthonormality_error(const Eigen::Matrix3d& R) {
+  return (R.transpose() * R - Eigen::Matrix3d::Identity()).norm();
+}
+
 Pose orthonormalized(const Pose& T) {
   Pose out = T;
   out.linear() = orthonormalize(T.linear());

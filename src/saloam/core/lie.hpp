@@ -27,6 +27,13 @@ Vector6d se3_log(const Pose& T);
 
 /// Nearest rotation matrix (SVD projection, det = +1).
 Eigen::Matrix3d orthonormalize(const Eigen::Matrix3d& R);
+/// ||R^T R - I|| (Frobenius norm): 0 for a rotation matrix. KITTI's calib
+/// `Tr` deviates by about 1e-4 (printed digits), a scaled or sheared matrix by
+/// far more.
+double orthonormality_error(const Eigen::Matrix3d& R);
+/// The largest orthonormality_error() accepted for a rotation read from a file.
+inline constexpr double kRotationTolerance = 1e-3;
+
 /// Returns T with its rotation re-orthonormalized. Apply after every
 /// composition chain: accumulated float error otherwise drifts off SO(3).
 Pose orthonormalized(const Pose& T);

@@ -9,7 +9,9 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/io/text_input.hpp"
 
 namespace saloam {
 namespace {
@@ -30,41 +32,42 @@ std::optional<std::vector<double>> parse_values(const std::string& text) {
   return v;
 }
 
+std::string trimmed(const std::string& text) {
+  const auto first = text.find_first_not_of(" \t");
+  if (first == std::string::npos) return "";
+  return text.substr(first, text.find_last_not_of(" \t") - first + 1);
+}
+
 }  // namespace
 
 Pose read_velo_to_cam(const std::filesystem::path& file, int sequence) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "calibration file not found");
-  std::ifstream in(file);
-  std::string line;
-  std::size_t line_no = 0;
-  std::optional<Pose> bare;  // a line with 12 numbers and no key
+  std::optional<Pose> keyed;  // the wanted "KEY:" line
+  std::optional<Pose> bare;   // the first line with 12 numbers and no key
   const std::string wanted = sequence >= 0 ? fmt::format("{:02d}", sequence) : std::string("Tr");
-  while (std::getline(in, line)) {
-    ++line_no;
+  require_file(file, "calibration file");
+  for_each_text_line(file, [&](const std::string& line, std::size_t line_no) {
+    if (keyed) return;
     const auto colon = line.find(':');
-    const std::string key = colon == std::string::npos ? "" : line.substr(0, colon);
+    const std::string key = colon == std::string::npos ? "" : trimmed(line.substr(0, colon));
     const auto values = parse_values(colon == std::string::npos ? line : line.substr(colon + 1));
     const bool relevant = key == wanted || (key.empty() && values && values->size() == 12);
-    if (!relevant) continue;
+    if (!relevant || (key.empty() && bare)) return;
     if (!values || values->size() != 12) {
       throw InputError(file, fmt::format("line {}: '{}' needs 12 numbers (3x4 row-major)", line_no,
                                          key.empty() ? "Tr" : key));
     }
-    const Pose T = pose_from_3x4(values->data());
-    if (std::abs(T.linear().determinant() - 1.0) > 1e-2) {
-      throw InputError(file, fmt::format("line {}: rotation of '{}' is not orthonormal", line_no, key));
-    }
-    if (!key.empty()) return orthonormalized(T);
-    if (!bare) bare = orthonormalized(T);
-  }
+    const Pose T = checked_rigid_pose(pose_from_3x4(values->data()), file, line_no,
+                                      fmt::format("rotation of '{}'", key.empty() ? "Tr" : key));
+    (key.empty() ? bare : keyed) = T;
+  });
+  if (keyed) return *keyed;
   if (bare) return *bare;
   throw InputError(file, sequence >= 0 ? fmt::format("no line for sequence {}", wanted)
                                        : std::string("no 'Tr:' line (velodyne to camera 0 transform)"));
 }
 
 void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam) {
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  create_parent_folder(file);
   std::ofstream out(file, std::ios::trunc);
   if (!out) throw InputError(file, "cannot open for writing");
   // KITTI odometry's rectified camera projections (sequences 00-02), so that

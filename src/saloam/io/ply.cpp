@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -26,7 +27,7 @@ void put(char*& dst, T value) {
 }  // namespace
 
 void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, const Pose& transform) {
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  create_parent_folder(file);
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(file, "cannot open for writing");
   out << "ply\nformat binary_little_endian 1.0\ncomment saloam labelled point cloud (SemanticKITTI classes)\n"

@@ -8,17 +8,19 @@
 #include <spdlog/spdlog.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
 namespace {
 
 std::vector<char> read_bytes(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "file not found");
+  require_file(file);
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file, "cannot open for reading");
-  const auto size = std::filesystem::file_size(file);
+  std::error_code ec;
+  const auto size = std::filesystem::file_size(file, ec);
+  if (ec) throw InputError(file, fmt::format("cannot read size: {}", ec.message()));
   std::vector<char> bytes(size);
   if (size > 0 && !in.read(bytes.data(), static_cast<std::streamsize>(size))) {
     throw InputError(file, "read failed");
@@ -27,7 +29,7 @@ std::vector<char> read_bytes(const std::filesystem::path& file) {
 }
 
 void write_bytes(const std::filesystem::path& file, const void* data, std::size_t size) {
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  create_parent_folder(file);
   std::ofstream out(file, std::ios::binary | std::ios::trunc);
   if (!out) throw InputError(file, "cannot open for writing");
   out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));

@@ -1,10 +1,12 @@
 #include "saloam/io/sequence.hpp"
 
 #include <algorithm>
+#include <map>
 
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
 
@@ -14,17 +16,64 @@ namespace saloam {
 
 std::string frame_name(std::size_t index) { return fmt::format("{:06d}", index); }
 
+namespace {
+
+/// The number of a scan file name ("000042.bin" -> 42), or nullopt when the
+/// stem is not all digits.
+std::optional<std::size_t> scan_number(const fs::path& file) {
+  const std::string stem = file.stem().string();
+  const auto is_digit = [](char c) { return c >= '0' && c <= '9'; };
+  if (stem.empty() || stem.size() > 9 || !std::all_of(stem.begin(), stem.end(), is_digit)) return std::nullopt;
+  return static_cast<std::size_t>(std::stoul(stem));
+}
+
+/// The .bin scans of `velodyne`, indexed by their number: entry i is scan i.
+/// Throws InputError for an entry named like a scan that is not a file, a
+/// name that is not a number, two files of one number, or a gap (which would
+/// pair every later scan with the wrong pose and timestamp).
+std::vector<fs::path> numbered_scans(const fs::path& velodyne) {
+  std::map<std::size_t, fs::path> by_number;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(velodyne, ec)) {
+    if (entry.path().extension() != ".bin") continue;
+    if (!entry.is_regular_file(ec)) {
+      throw InputError(entry.path(), entry.is_directory(ec) ? "is a directory, not a scan file"
+                                                            : "is not a regular file (expected a scan file)");
+    }
+    const auto number = scan_number(entry.path());
+    if (!number) throw InputError(entry.path(), "scan names must be frame numbers (NNNNNN.bin)");
+    const auto [it, inserted] = by_number.emplace(*number, entry.path());
+    if (!inserted) {
+      throw InputError(entry.path(), fmt::format("same frame number as {}", it->second.filename().string()));
+    }
+  }
+  if (ec) throw InputError(velodyne, fmt::format("cannot list folder: {}", ec.message()));
+  if (by_number.empty()) throw InputError(velodyne, "no .bin scans");
+  std::vector<fs::path> scans;
+  for (const auto& [number, file] : by_number) {
+    if (number != scans.size()) {
+      throw InputError(velodyne / (frame_name(scans.size()) + ".bin"),
+                       fmt::format("missing scan: the scans must be numbered without gaps from {} (found {} next), "
+                                   "or every later scan would get the wrong pose and timestamp",
+                                   frame_name(0) + ".bin", file.filename().string()));
+    }
+    scans.push_back(file);
+  }
+  return scans;
+}
+
+}  // namespace
+
 SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
     : root_(std::move(root)), options_(std::move(options)) {
   std::error_code ec;
-  if (!fs::is_directory(root_, ec)) throw InputError(root_, "sequence folder not found");
+  if (!fs::is_directory(root_, ec)) {
+    throw InputError(root_, fs::exists(root_, ec) ? "is not a folder (expected a sequence folder)"
+                                                  : "sequence folder not found");
+  }
   const fs::path velodyne = root_ / "velodyne";
   if (!fs::is_directory(velodyne, ec)) throw InputError(velodyne, "missing velodyne/ folder of .bin scans");
-  for (const auto& entry : fs::directory_iterator(velodyne)) {
-    if (entry.is_regular_file() && entry.path().extension() == ".bin") scan_files_.push_back(entry.path());
-  }
-  std::sort(scan_files_.begin(), scan_files_.end());
-  if (scan_files_.empty()) throw InputError(velodyne, "no .bin scans");
+  scan_files_ = numbered_scans(velodyne);
 
   // Labels: a predictions folder if given, else labels/ when it exists.
   fs::path labels_dir = root_ / "labels";
@@ -61,7 +110,7 @@ SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
     if (times_.size() < scan_files_.size()) {
       throw InputError(times_file, fmt::format("{} timestamps for {} scans", times_.size(), scan_files_.size()));
     }
-    times_.resize(scan_files_.size());
+    times_.resize(scan_files_.size());  // a sequence may hold only its first scans
     has_times_file_ = true;
   } else {
     times_.resize(scan_files_.size());
@@ -74,7 +123,7 @@ SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
     if (camera_poses_.size() < scan_files_.size()) {
       throw InputError(poses_file, fmt::format("{} poses for {} scans", camera_poses_.size(), scan_files_.size()));
     }
-    camera_poses_.resize(scan_files_.size());
+    camera_poses_.resize(scan_files_.size());  // as for times.txt
   }
 }
 
@@ -102,7 +151,7 @@ std::vector<Pose> SequenceReader::lidar_poses() const {
 }
 
 SequenceWriter::SequenceWriter(fs::path root) : root_(std::move(root)) {
-  fs::create_directories(root_ / "velodyne");
+  create_folder(root_ / "velodyne");
 }
 
 void SequenceWriter::write_scan(std::size_t index, const LabelledCloud& cloud) const {

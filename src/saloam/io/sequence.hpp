@@ -24,16 +24,20 @@ struct SequenceOptions {
 
 class SequenceReader {
  public:
-  /// Indexes the folder. Throws InputError when `velodyne/` is missing or empty,
+  /// Indexes the folder: scan i is velodyne/i.bin (NNNNNN.bin, numbered from
+  /// 000000). Throws InputError when `velodyne/` is missing or empty, when a
+  /// scan number is missing (a gap would pair later scans with the wrong pose
+  /// and time), when an entry named like a scan is not a file or not a number,
   /// when a given labels folder does not exist, or when times.txt / poses.txt
-  /// exist but do not match the scan count.
+  /// hold fewer lines than there are scans. More lines are accepted and the
+  /// first ones used: a sequence folder may hold only the first scans.
   explicit SequenceReader(std::filesystem::path root, SequenceOptions options = {});
 
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
   [[nodiscard]] std::size_t size() const { return scan_files_.size(); }
   [[nodiscard]] bool has_labels() const { return labels_available_; }
 
-  /// Loads scan i (index into the sorted scan list) with its labels when present.
+  /// Loads scan i (velodyne/i.bin) with its labels when present.
   LabelledCloud load_scan(std::size_t index, ScanReadStats* stats = nullptr) const;
   [[nodiscard]] const std::filesystem::path& scan_file(std::size_t index) const { return scan_files_.at(index); }
 

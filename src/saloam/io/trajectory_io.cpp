@@ -8,21 +8,15 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/io/text_input.hpp"
 
 namespace saloam {
 namespace {
 
-std::ifstream open_text(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "file not found");
-  std::ifstream in(file);
-  if (!in) throw InputError(file, "cannot open for reading");
-  return in;
-}
-
 std::ofstream create_text(const std::filesystem::path& file) {
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  create_parent_folder(file);
   std::ofstream out(file, std::ios::trunc);
   if (!out) throw InputError(file, "cannot open for writing");
   return out;
@@ -55,23 +49,17 @@ std::vector<double> parse_numbers(const std::string& line, const std::filesystem
 
 template <class OnLine>
 void for_each_data_line(const std::filesystem::path& file, OnLine&& on_line) {
-  auto in = open_text(file);
-  std::string line;
-  std::size_t line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (is_blank_or_comment(line)) continue;
-    on_line(parse_numbers(line, file, line_no), line_no);
-  }
+  for_each_text_line(file, [&](const std::string& line, std::size_t line_no) {
+    if (!is_blank_or_comment(line)) on_line(parse_numbers(line, file, line_no), line_no);
+  });
 }
 
-Pose checked_pose(const std::vector<double>& v, const std::filesystem::path& file, std::size_t line_no) {
-  const Pose T = pose_from_3x4(v.data());
-  const double det = T.linear().determinant();
-  if (std::abs(det - 1.0) > 1e-2) {
-    throw InputError(file, fmt::format("line {}: rotation is not orthonormal (det = {:.4f})", line_no, det));
-  }
-  return orthonormalized(T);
+/// Appends a TUM line's timestamp, which must be later than the previous one.
+void push_tum_timestamp(Trajectory& traj, double t, std::size_t& previous_line, const std::filesystem::path& file,
+                        std::size_t line_no) {
+  if (!traj.timestamps.empty()) check_time_increases(traj.timestamps.back(), previous_line, t, file, line_no);
+  traj.timestamps.push_back(t);
+  previous_line = line_no;
 }
 
 Pose tum_pose(const std::vector<double>& v, const std::filesystem::path& file, std::size_t line_no) {
@@ -93,7 +81,7 @@ std::vector<Pose> read_kitti_poses(const std::filesystem::path& file) {
     if (v.size() != 12) {
       throw InputError(file, fmt::format("line {}: expected 12 numbers (KITTI 3x4 pose), found {}", line_no, v.size()));
     }
-    poses.push_back(checked_pose(v, file, line_no));
+    poses.push_back(checked_rigid_pose(pose_from_3x4(v.data()), file, line_no));
   });
   if (poses.empty()) throw InputError(file, "no poses in file");
   return poses;
@@ -113,12 +101,13 @@ void write_kitti_poses(const std::filesystem::path& file, const std::vector<Pose
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
   Trajectory traj;
+  std::size_t previous_line = 0;
   for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 8) {
       throw InputError(file, fmt::format("line {}: expected 8 numbers (TUM: t x y z qx qy qz qw), found {}", line_no,
                                          v.size()));
     }
-    traj.timestamps.push_back(v[0]);
+    push_tum_timestamp(traj, v[0], previous_line, file, line_no);
     traj.poses.push_back(tum_pose(v, file, line_no));
   });
   if (traj.empty()) throw InputError(file, "no poses in file");
@@ -142,9 +131,10 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
   if (!out) throw InputError(file, "write failed");
 }
 
-Trajectory read_trajectory(const std::filesystem::path& file) {
+Trajectory read_trajectory(const std::filesystem::path& file, TrajectoryFormat* format) {
   Trajectory traj;
   std::size_t columns = 0;
+  std::size_t previous_line = 0;
   for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (columns == 0) {
       columns = v.size();
@@ -158,21 +148,25 @@ Trajectory read_trajectory(const std::filesystem::path& file) {
     }
     if (columns == 12) {
       traj.timestamps.push_back(0.1 * static_cast<double>(traj.poses.size()));
-      traj.poses.push_back(checked_pose(v, file, line_no));
+      traj.poses.push_back(checked_rigid_pose(pose_from_3x4(v.data()), file, line_no));
     } else {
-      traj.timestamps.push_back(v[0]);
+      push_tum_timestamp(traj, v[0], previous_line, file, line_no);
       traj.poses.push_back(tum_pose(v, file, line_no));
     }
   });
   if (traj.empty()) throw InputError(file, "no poses in file");
+  if (format) *format = columns == 12 ? TrajectoryFormat::kKitti : TrajectoryFormat::kTum;
   return traj;
 }
 
 std::vector<double> read_times(const std::filesystem::path& file) {
   std::vector<double> times;
+  std::size_t previous_line = 0;
   for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 1) throw InputError(file, fmt::format("line {}: expected one timestamp, found {} numbers", line_no, v.size()));
+    if (!times.empty()) check_time_increases(times.back(), previous_line, v[0], file, line_no);
     times.push_back(v[0]);
+    previous_line = line_no;
   });
   return times;
 }

@@ -9,6 +9,10 @@
 
 namespace saloam {
 
+// Every reader skips a UTF-8 byte-order mark at the start of the file. A
+// rotation must be orthonormal within kRotationTolerance (lie.hpp) with
+// det > 0; it is re-orthonormalized on load. TUM timestamps must increase.
+
 /// Reads a KITTI pose file. Rotations are re-orthonormalized on load.
 std::vector<Pose> read_kitti_poses(const std::filesystem::path& file);
 void write_kitti_poses(const std::filesystem::path& file, const std::vector<Pose>& poses);
@@ -21,11 +25,14 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
 /// One TUM line (no newline) for streaming writers.
 std::string tum_pose_line(double timestamp, const Pose& pose);
 
-/// Reads a KITTI or TUM trajectory, deciding by the number of columns
-/// (12 = KITTI, 8 = TUM). KITTI timestamps are the frame indices * 0.1 s.
-Trajectory read_trajectory(const std::filesystem::path& file);
+enum class TrajectoryFormat { kKitti, kTum };
 
-/// Reads a times.txt file (one timestamp in seconds per line).
+/// Reads a KITTI or TUM trajectory, deciding by the number of columns
+/// (12 = KITTI, 8 = TUM; stored in `format` when given). KITTI timestamps are
+/// the frame indices * 0.1 s.
+Trajectory read_trajectory(const std::filesystem::path& file, TrajectoryFormat* format = nullptr);
+
+/// Reads a times.txt file (one timestamp in seconds per line, increasing).
 std::vector<double> read_times(const std::filesystem::path& file);
 void write_times(const std::filesystem::path& file, const std::vector<double>& times);
 

@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace saloam {
 
@@ -80,6 +81,7 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
 }
 
 void write_graph_json(const std::filesystem::path& file, const SemanticGraph& graph) {
+  create_parent_folder(file);
   std::ofstream out(file);
   if (!out) throw InputError(file, "cannot create graph file");
   out << graph_to_json(graph).dump() << '\n';
@@ -87,6 +89,7 @@ void write_graph_json(const std::filesystem::path& file, const SemanticGraph& gr
 }
 
 SemanticGraph read_graph_json(const std::filesystem::path& file) {
+  require_file(file, "graph file");
   std::ifstream in(file);
   if (!in) throw InputError(file, "graph file not found or not readable");
   nlohmann::json json;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace saloam {
 namespace {
@@ -124,8 +125,7 @@ SgprWeights parse_sgpr_weights(std::span<const std::byte> bytes, const std::file
 }
 
 SgprWeights read_sgpr_weights(const std::filesystem::path& file) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(file, "SGPR weights file not found");
+  require_file(file, "SGPR weights file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(file, "cannot open SGPR weights file");
   std::vector<char> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -71,14 +71,8 @@ OdometryRunResult run_odometry(const SequenceReader& reader, const OdometryConfi
   }
 
   OdometryRunResult result;
-  std::optional<Pose> tr;
-  if (reader.has_calib()) {
-    tr = reader.velo_to_cam();
-    result.camera_frame = true;
-  } else {
-    spdlog::warn("{}: no calib.txt; poses.txt holds LiDAR-frame poses, not the KITTI camera convention",
-                 reader.root().string());
-  }
+  const std::optional<Pose> tr = output_velo_to_cam(SequenceFolderSource(reader), options.no_calib);
+  result.camera_frame = tr.has_value();
   prepare_output_folder(out_dir, reader.root());
   TrajectoryWriter writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);
 

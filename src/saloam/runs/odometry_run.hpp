@@ -27,6 +27,7 @@ struct OdometryRunOptions {
   std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the sequence
   bool show_progress = true;
   std::string progress_label = "odom";
+  bool no_calib = false;  ///< LiDAR-frame poses.txt, calib.txt not needed (output_velo_to_cam)
 };
 
 struct OdometryRunResult {

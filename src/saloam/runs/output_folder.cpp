@@ -1,8 +1,10 @@
 #include "saloam/runs/output_folder.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace saloam {
 
@@ -15,7 +17,18 @@ void prepare_output_folder(const std::filesystem::path& out_dir, const std::opti
                                           "truth; choose another output folder",
                                           sequence->string()));
   }
-  std::filesystem::create_directories(out_dir);
+  create_folder(out_dir);
+}
+
+std::optional<Pose> output_velo_to_cam(const FrameSource& source, bool lidar_frame) {
+  if (lidar_frame) {
+    spdlog::info("--no-calib: pose files hold LiDAR-frame poses, not the KITTI camera convention");
+    return std::nullopt;
+  }
+  if (auto tr = source.velo_to_cam()) return tr;
+  throw InputError(source.folder().value_or(std::filesystem::path(source.name())) / "calib.txt",
+                   "not found: needed to write poses.txt in KITTI's camera frame, comparable with the ground "
+                   "truth; pass --no-calib to write LiDAR-frame poses instead");
 }
 
 }  // namespace saloam

@@ -292,14 +292,6 @@ SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
   return result;
 }
 
-std::optional<Pose> extrinsic_of(const FrameSource& source) {
-  std::optional<Pose> tr = source.velo_to_cam();
-  if (!tr) {
-    spdlog::warn("{}: no calib.txt; pose files hold LiDAR-frame poses, not the KITTI camera convention", source.name());
-  }
-  return tr;
-}
-
 }  // namespace
 
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
@@ -310,7 +302,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   if (config.odometry.use_semantics && !source.has_labels()) {
     spdlog::warn("{}: no labels found; running with every point in one class", source.name());
   }
-  const std::optional<Pose> tr = extrinsic_of(source);
+  const std::optional<Pose> tr = output_velo_to_cam(source, options.no_calib);
   prepare_output_folder(out_dir, source.folder());
 
   // A stream cannot be read again for the map: keep what the map needs as it goes by.
@@ -322,6 +314,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
 
   SlamSystem slam(config, std::move(network));
   TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
   ProgressBar progress(end - first, "slam", options.show_progress);
   const auto start = std::chrono::steady_clock::now();
   for (std::size_t i = first; i < end && !stop_requested(); ++i) {
@@ -337,7 +330,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   SlamRunResult result = summarize_run(slam, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
 
   const std::vector<Pose> optimized = slam.optimized_poses();
-  write_trajectory(out_dir / "poses.txt", out_dir / "poses_tum.txt", slam.timestamps(), optimized, tr);
+  for (std::size_t i = 0; i < optimized.size(); ++i) slam_writer.write(slam.timestamps().at(i), optimized[i]);
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
   const RunTruth truth = run_truth(source, tr, first, result.frames);
   write_loops_csv(out_dir / "loops.csv", slam, truth.loop_reference());

@@ -38,6 +38,7 @@ struct SlamRunOptions {
   /// Called with every scan after the SLAM has processed it (e.g. to run a
   /// second odometry on the same stream).
   std::function<void(std::size_t frame, const LabelledCloud& scan, double time)> on_scan;
+  bool no_calib = false;  ///< LiDAR-frame pose files, calib.txt not needed (output_velo_to_cam)
 };
 
 struct SlamRunResult {

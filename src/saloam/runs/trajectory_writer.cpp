@@ -12,15 +12,26 @@ Pose output_pose(const Pose& lidar_pose, const std::optional<Pose>& tr) {
 }
 }  // namespace
 
-TrajectoryWriter::TrajectoryWriter(const std::filesystem::path& kitti_file, const std::filesystem::path& tum_file,
+TrajectoryWriter::TrajectoryWriter(std::filesystem::path kitti_file, std::filesystem::path tum_file,
                                    std::optional<Pose> velo_to_cam)
-    : velo_to_cam_(std::move(velo_to_cam)), kitti_(kitti_file), tum_(tum_file) {
-  if (!kitti_) throw InputError(kitti_file, "cannot write pose file");
-  if (!tum_) throw InputError(tum_file, "cannot write pose file");
+    : kitti_file_(std::move(kitti_file)), tum_file_(std::move(tum_file)), velo_to_cam_(std::move(velo_to_cam)) {
+  for (const auto* file : {&kitti_file_, &tum_file_}) {
+    std::error_code ec;
+    std::filesystem::remove(*file, ec);
+    if (ec) throw InputError(*file, "cannot replace the pose file of an earlier run: " + ec.message());
+  }
+}
+
+void TrajectoryWriter::open() {
+  kitti_.open(kitti_file_);
+  if (!kitti_) throw InputError(kitti_file_, "cannot write pose file");
+  tum_.open(tum_file_);
+  if (!tum_) throw InputError(tum_file_, "cannot write pose file");
   tum_ << "# timestamp x y z qx qy qz qw (LiDAR frame, world = first scan)\n";
 }
 
 Pose TrajectoryWriter::write(double timestamp, const Pose& lidar_pose) {
+  if (!kitti_.is_open()) open();
   const Pose p = output_pose(lidar_pose, velo_to_cam_);
   kitti_ << kitti_pose_line(p) << '\n' << std::flush;
   tum_ << tum_pose_line(timestamp, lidar_pose) << '\n' << std::flush;

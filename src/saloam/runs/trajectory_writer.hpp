@@ -5,7 +5,9 @@
 //     with poses.txt directly; LiDAR-frame poses when no Tr is known
 //   TUM (timestamp x y z qx qy qz qw): LiDAR-frame poses Q_i = T_L0<-Li
 // Each line is flushed as soon as it is written: an interrupted run keeps
-// every frame it finished.
+// every frame it finished. The files are created with the first pose: a run
+// that stops before its first frame (e.g. an unreadable first scan) leaves no
+// pose file that could be taken for a result.
 
 #include <filesystem>
 #include <fstream>
@@ -18,13 +20,17 @@ namespace saloam {
 
 class TrajectoryWriter {
  public:
-  /// Creates (truncates) both files; InputError when they cannot be written.
-  TrajectoryWriter(const std::filesystem::path& kitti_file, const std::filesystem::path& tum_file,
-                   std::optional<Pose> velo_to_cam);
-  /// Appends one pose (LiDAR frame) and returns the pose written to the KITTI file.
+  /// Removes both files if they exist (an earlier run's); InputError when
+  /// that fails. Nothing is created yet.
+  TrajectoryWriter(std::filesystem::path kitti_file, std::filesystem::path tum_file, std::optional<Pose> velo_to_cam);
+  /// Appends one pose (LiDAR frame) and returns the pose written to the KITTI
+  /// file; the first call creates the files (InputError when it cannot).
   Pose write(double timestamp, const Pose& lidar_pose);
 
  private:
+  void open();
+
+  std::filesystem::path kitti_file_, tum_file_;
   std::optional<Pose> velo_to_cam_;
   std::ofstream kitti_, tum_;
 };

@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace saloam {
 namespace {
@@ -278,7 +279,7 @@ void Plot::save_png(const std::filesystem::path& file) {
   cairo_move_to(cr, width_ / 2.0 - ext.width / 2, 26);
   cairo_show_text(cr, title_.c_str());
 
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  create_parent_folder(file);
   cairo_surface_flush(impl_->surface);
   check_status(cairo_surface_write_to_png(impl_->surface, file.c_str()), file);
 }
@@ -335,7 +336,7 @@ void RasterImage::save_png(const std::filesystem::path& file, int scale_x, int s
     }
   }
   cairo_surface_mark_dirty(surface);
-  if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+  create_parent_folder(file);
   const auto status = cairo_surface_write_to_png(surface, file.c_str());
   cairo_surface_destroy(surface);
   check_status(status, file);

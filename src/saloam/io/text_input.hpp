@@ -1,0 +1,33 @@
+#pragma once
+// Shared checks of the text readers (poses, times, calibration): line
+// iteration (a UTF-8 byte-order mark at the start is skipped, '\r' of CRLF
+// files dropped), rigid-rotation and increasing-timestamp checks. Every
+// error names the file and the line.
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+/// Calls on_line(line, line_no) for every line (numbered from 1). InputError
+/// when the file is missing, a directory, or unreadable.
+void for_each_text_line(const std::filesystem::path& file,
+                        const std::function<void(const std::string& line, std::size_t line_no)>& on_line);
+
+/// T with its rotation projected back onto SO(3). InputError (file, line)
+/// when the rotation is not one: ||R^T R - I|| > kRotationTolerance (a scale
+/// or shear, not rounding) or a reflection (det < 0). `what` names the pose
+/// in the message, e.g. "rotation" or "rotation of 'Tr'".
+Pose checked_rigid_pose(const Pose& T, const std::filesystem::path& file, std::size_t line_no,
+                        const std::string& what = "rotation");
+
+/// InputError (file, line) unless `t` is later than `previous` (the
+/// timestamp of `previous_line`).
+void check_time_increases(double previous, std::size_t previous_line, double t, const std::filesystem::path& file,
+                          std::size_t line_no);
+
+}  // namespace saloam

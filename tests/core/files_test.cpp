@@ -1,0 +1,56 @@
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/lie.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::input_error_of;
+
+TEST(Files, RequireFileNamesWhatIsWrong) {
+  testing::TempDir dir;
+  std::ofstream(dir / "a.txt") << "x";
+  EXPECT_NO_THROW(require_file(dir / "a.txt"));
+  EXPECT_EQ(input_error_of([&] { require_file(dir / "none.txt", "pose file"); }),
+            (dir / "none.txt").string() + ": pose file not found");
+  fs::create_directories(dir / "folder.txt");
+  EXPECT_EQ(input_error_of([&] { require_file(dir / "folder.txt"); }),
+            (dir / "folder.txt").string() + ": is a directory, not a file");
+}
+
+TEST(Files, CreateFolderReportsThePathAndReason) {
+  testing::TempDir dir;
+  create_folder(dir / "a/b/c");
+  EXPECT_TRUE(fs::is_directory(dir / "a/b/c"));
+  create_parent_folder(dir / "d/e/file.txt");
+  EXPECT_TRUE(fs::is_directory(dir / "d/e"));
+  std::ofstream(dir / "plain") << "x";
+  const std::string msg = input_error_of([&] { create_folder(dir / "plain/sub"); });
+  EXPECT_EQ(msg.rfind((dir / "plain/sub").string() + ": cannot create folder: ", 0), 0u) << msg;
+  try {
+    fs::create_directories(dir / "plain/sub");
+    FAIL() << "no filesystem_error";
+  } catch (const fs::filesystem_error& e) {
+    const std::string text = describe(e);
+    EXPECT_EQ(text.find("filesystem error"), std::string::npos) << text;
+    EXPECT_NE(text.find((dir / "plain").string()), std::string::npos) << text;
+  }
+}
+
+TEST(Lie, OrthonormalityErrorSeparatesRoundingFromScale) {
+  EXPECT_EQ(orthonormality_error(Eigen::Matrix3d::Identity()), 0.0);
+  EXPECT_LT(orthonormality_error(so3_exp(Eigen::Vector3d(0.3, -1.0, 2.0))), 1e-12);
+  EXPECT_GT(orthonormality_error(Eigen::Vector3d(2.0, 0.5, 1.0).asDiagonal()), 1.0);
+  Eigen::Matrix3d rounded = Eigen::Matrix3d::Identity();
+  rounded(0, 1) = 1e-4;
+  EXPECT_LT(orthonormality_error(rounded), kRotationTolerance);
+}
+
+}  // namespace
+}  // namespace saloam
