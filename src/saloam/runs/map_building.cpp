@@ -1,6 +1,8 @@
 #include "saloam/runs/map_building.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
 
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/progress.hpp"
@@ -22,22 +24,40 @@ LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& l
 }
 
 MapScanStore::MapScanStore(SemanticMapOptions options, std::size_t frame_step)
-    : options_(options), frame_step_(std::max<std::size_t>(frame_step, 1)) {}
+    : options_(options), frame_step_(std::max<std::size_t>(frame_step, 1)) {
+  if (!(options_.max_range <= 300.0)) {
+    throw std::invalid_argument("MapScanStore keeps centimetre coordinates in 16 bits: map range at most 300 m");
+  }
+}
 
 void MapScanStore::offer(std::size_t k, const LabelledCloud& scan) {
   if (k % frame_step_ != 0) return;
   SemanticMap downsampled(options_);
   downsampled.insert(scan, Pose::Identity());
+  const LabelledCloud voxels = downsampled.to_cloud();
+  std::vector<CompactPoint> compact(voxels.size());
+  const auto centimetres = [](float metres) { return static_cast<std::int16_t>(std::lround(metres * 100.0f)); };
+  for (std::size_t i = 0; i < voxels.size(); ++i) {
+    const Eigen::Vector3f& p = voxels.points[i];
+    compact[i] = {centimetres(p.x()), centimetres(p.y()), centimetres(p.z()), voxels.label[i],
+                  static_cast<std::uint8_t>(std::lround(std::clamp(voxels.remission[i], 0.0f, 1.0f) * 255.0f))};
+  }
   frames_.push_back(k);
-  scans_.push_back(downsampled.to_cloud());
+  scans_.push_back(std::move(compact));
 }
 
 LabelledCloud MapScanStore::build(const std::vector<Pose>& lidar_poses, bool show_progress) const {
   SemanticMap map(options_);
   ProgressBar progress(scans_.size(), "map", show_progress);
+  LabelledCloud scan;
+  scan.has_labels = true;
   for (std::size_t s = 0; s < scans_.size() && !stop_requested(); ++s) {
     if (frames_[s] >= lidar_poses.size()) break;
-    map.insert(scans_[s], lidar_poses[frames_[s]]);
+    scan.clear();
+    for (const CompactPoint& c : scans_[s]) {
+      scan.push_back(Eigen::Vector3f(c.x, c.y, c.z) * 0.01f, c.remission / 255.0f, c.label, 0);
+    }
+    map.insert(scan, lidar_poses[frames_[s]]);
     progress.advance();
   }
   progress.finish();
@@ -46,9 +66,7 @@ LabelledCloud MapScanStore::build(const std::vector<Pose>& lidar_poses, bool sho
 
 std::size_t MapScanStore::bytes() const {
   std::size_t total = 0;
-  for (const auto& s : scans_) {
-    total += s.size() * (sizeof(Eigen::Vector3f) + sizeof(float) + 2 * sizeof(std::uint16_t));
-  }
+  for (const auto& s : scans_) total += s.size() * sizeof(CompactPoint);
   return total;
 }
 

@@ -4,6 +4,7 @@
 // its scans again, or from compact copies kept while a stream went by.
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "saloam/core/types.hpp"
@@ -22,10 +23,13 @@ LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& l
 /// The scans of a streamed run that go into its map, kept as it goes by:
 /// every `frame_step`-th scan, voxel-downsampled in its sensor frame at the
 /// map's resolution (what the map keeps of it anyway: one point per voxel,
-/// dynamic classes and far returns left out), so a run keeps a few tens of
-/// kilobytes per scan instead of the scan.
+/// dynamic classes and far returns left out), each point in 10 bytes
+/// (centimetre coordinates, class, remission), so a run keeps a few hundred
+/// kilobytes per scan instead of megabytes.
 class MapScanStore {
  public:
+  /// std::invalid_argument when options.max_range exceeds what centimetre
+  /// coordinates in 16 bits hold (300 m).
   MapScanStore(SemanticMapOptions options, std::size_t frame_step);
   /// Scan k of the run (0 = first processed frame); kept when k is a multiple of the step.
   void offer(std::size_t k, const LabelledCloud& scan);
@@ -34,10 +38,15 @@ class MapScanStore {
   [[nodiscard]] std::size_t bytes() const;
 
  private:
+  struct CompactPoint {
+    std::int16_t x, y, z;  ///< [cm], sensor frame
+    std::uint16_t label;
+    std::uint8_t remission;  ///< 0..255 for 0..1
+  };
   SemanticMapOptions options_;
   std::size_t frame_step_;
   std::vector<std::size_t> frames_;
-  std::vector<LabelledCloud> scans_;
+  std::vector<std::vector<CompactPoint>> scans_;
 };
 
 }  // namespace saloam
