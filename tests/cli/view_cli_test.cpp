@@ -52,6 +52,23 @@ TEST(ViewCli, WritesThePageWithTheBudget) {
   EXPECT_TRUE(fs::exists(tmp / "p.html"));
 }
 
+TEST(ViewCli, SlamWritesThePageBesideItsResults) {
+  TempDir tmp;
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("simulate --out {} --preset straight --frames 0:6 --beams 16",
+                                               quoted(tmp / "seq"))),
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {}", quoted(tmp / "seq"), quoted(tmp / "out"))), &output), 0)
+      << output;
+  EXPECT_NE(output.find("3D view: " + (tmp / "out/view.html").string()), std::string::npos) << output;
+  const auto data = testing::page_data(testing::read_text(tmp / "out/view.html"));
+  EXPECT_EQ(data["frames"], 6U);
+  EXPECT_EQ(data["trajectories"].size(), 3U) << "ground truth found through summary.json";
+  EXPECT_EQ(data["scans"]["frames"].size(), 6U);
+}
+
 TEST(ViewCli, MissingMapIsAClearError) {
   TempDir tmp;
   const auto run = testing::write_fake_run(tmp.path(), 100);
