@@ -38,9 +38,10 @@ int write_page(const ViewOptions& options) {
   const std::filesystem::path page =
       options.page.empty() ? std::filesystem::path(options.run_dir) / "view.html" : std::filesystem::path(options.page);
   const ViewerPageStats s = write_viewer_page(options.run_dir, page, viewer_options(options));
-  std::cout << fmt::format("wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n",
-                           page.string(), static_cast<double>(s.bytes) / 1e6, s.map_points, s.map_points_total, s.frames,
-                           s.ground_truth ? " with ground truth" : "", s.loops, s.scans, s.scan_points);
+  std::cout << fmt::format(
+      "wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n", page.string(),
+      static_cast<double>(s.bytes) / 1e6, s.map_points, s.map_points_total, s.frames,
+      s.ground_truth ? " with ground truth" : "", s.loops, s.scans, s.scan_points);
   std::cout << fmt::format("open file://{}\n", std::filesystem::absolute(page).lexically_normal().string());
   return 0;
 }
@@ -84,7 +85,9 @@ const CommandRegistration kRegistration{Command{
           ->capture_default_str();
       app.add_option("--sequence", options->sequence, "Sequence folder (default: the one recorded in summary.json)");
       app.add_flag("--serve", options->serve, "Serve the page from 127.0.0.1 instead, scans loaded on demand");
-      app.add_option("--port", options->port, "Port for --serve (0: any free one)")->capture_default_str()->check(CLI::Range(0, 65535));
+      app.add_option("--port", options->port, "Port for --serve (0: any free one)")
+          ->capture_default_str()
+          ->check(CLI::Range(0, 65535));
       return [options] { return options->serve ? serve(*options) : write_page(*options); };
     }}};
 

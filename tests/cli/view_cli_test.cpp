@@ -43,11 +43,13 @@ TEST(ViewCli, WritesThePageWithTheBudget) {
   TempDir tmp;
   const auto run = testing::write_fake_run(tmp.path(), 8000);
   std::string output;
-  ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {} --max-points 3000", quoted(run.run_dir))), &output), 0) << output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {} --max-points 3000", quoted(run.run_dir))), &output), 0)
+      << output;
   EXPECT_NE(output.find("3000 of 8000 map points, 40 frames with ground truth"), std::string::npos) << output;
   const auto data = testing::page_data(testing::read_text(run.run_dir / "view.html"));
   EXPECT_EQ(data["map"]["count"], 3000U);
-  ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {} --out {}", quoted(run.run_dir), quoted(tmp / "p.html"))), &output), 0)
+  ASSERT_EQ(
+      run_command(saloam_cmd(fmt::format("view {} --out {}", quoted(run.run_dir), quoted(tmp / "p.html"))), &output), 0)
       << output;
   EXPECT_TRUE(fs::exists(tmp / "p.html"));
 }
@@ -60,7 +62,8 @@ TEST(ViewCli, SlamWritesThePageBesideItsResults) {
                         &output),
             0)
       << output;
-  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {}", quoted(tmp / "seq"), quoted(tmp / "out"))), &output), 0)
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {}", quoted(tmp / "seq"), quoted(tmp / "out"))), &output),
+            0)
       << output;
   EXPECT_NE(output.find("3D view: " + (tmp / "out/view.html").string()), std::string::npos) << output;
   const auto data = testing::page_data(testing::read_text(tmp / "out/view.html"));
@@ -81,13 +84,13 @@ TEST(ViewCli, MissingMapIsAClearError) {
 }
 
 /// Headless Chromium, or a skip (a failure with CI=true) when it is not installed.
-#define SALOAM_REQUIRE_CHROMIUM()                                                                  \
-  do {                                                                                             \
-    if (run_command("command -v chromium") != 0) {                                                 \
-      const char* ci = std::getenv("CI");                                                          \
-      if (ci && std::string(ci) == "true") FAIL() << "chromium is not installed (CI=true)";        \
+#define SALOAM_REQUIRE_CHROMIUM()                                                                     \
+  do {                                                                                                \
+    if (run_command("command -v chromium") != 0) {                                                    \
+      const char* ci = std::getenv("CI");                                                             \
+      if (ci && std::string(ci) == "true") FAIL() << "chromium is not installed (CI=true)";           \
       GTEST_SKIP() << "chromium is not installed (Debian package chromium; scripts/install_deps.sh)"; \
-    }                                                                                              \
+    }                                                                                                 \
   } while (false)
 
 std::string chromium(const TempDir& tmp, const std::string& args, const fs::path& page) {

@@ -75,7 +75,8 @@ inline void write_tum(const std::filesystem::path& file, const std::vector<Pose>
 }
 
 /// loops.csv with the columns the viewer reads (and a quoted field with commas, as `saloam slam` writes).
-inline void write_loops(const std::filesystem::path& file, std::size_t frames, std::size_t& accepted, std::size_t& verified) {
+inline void write_loops(const std::filesystem::path& file, std::size_t frames, std::size_t& accepted,
+                        std::size_t& verified) {
   std::ofstream out(file);
   out << "query_frame,match_frame,score,accepted,reason,relative_pose_3x4\n";
   accepted = verified = 0;

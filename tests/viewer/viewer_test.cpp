@@ -87,7 +87,8 @@ TEST(Viewer, MapAndScansKeepToTheirBudgets) {
   options.points_per_scan = 500;
   options.max_scan_points = 5000;
   ViewerPageStats stats;
-  const std::string html = viewer_page(load_viewer_scene(run.run_dir, options), options, ViewerDataSource::kEmbedded, &stats);
+  const std::string html =
+      viewer_page(load_viewer_scene(run.run_dir, options), options, ViewerDataSource::kEmbedded, &stats);
   const auto data = testing::page_data(html);
   EXPECT_EQ(data["map"]["count"], 3000U);
   EXPECT_EQ(data["map"]["total"], 20'000U);
@@ -140,16 +141,20 @@ TEST(Viewer, BadInputGivesClearErrors) {
 
   const auto run2 = testing::write_fake_run(tmp / "b", 100);
   std::ofstream(run2.run_dir / "loops.csv") << "query_frame,match_frame,accepted\n3,x,1\n";
-  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(run2.run_dir); }).find("loops.csv: line 2: 'x' is not a frame index"),
+  EXPECT_NE(testing::input_error_of([&] {
+              load_viewer_scene(run2.run_dir);
+            }).find("loops.csv: line 2: 'x' is not a frame index"),
             std::string::npos);
   std::ofstream(run2.run_dir / "loops.csv") << "query_frame,match_frame,accepted\n300,1,1\n";
-  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(run2.run_dir); }).find("beyond the 40 poses"), std::string::npos);
+  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(run2.run_dir); }).find("beyond the 40 poses"),
+            std::string::npos);
 
   const auto run3 = testing::write_fake_run(tmp / "c", 100);
   ViewerOptions options;
   options.sequence = tmp / "no_sequence";
-  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(run3.run_dir, options); }).find("sequence folder not found"),
-            std::string::npos);
+  EXPECT_NE(
+      testing::input_error_of([&] { load_viewer_scene(run3.run_dir, options); }).find("sequence folder not found"),
+      std::string::npos);
 }
 
 TEST(Viewer, RunWithoutSequenceHasNoGroundTruthAndNoScans) {

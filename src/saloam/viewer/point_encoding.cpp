@@ -19,7 +19,8 @@ void append_raw(std::string& bytes, const std::vector<T>& values) {
   if (!values.empty()) std::memcpy(bytes.data() + offset, values.data(), values.size() * sizeof(T));
 }
 
-std::string positions_and_classes(const std::vector<std::uint16_t>& xyz_bits, const std::vector<std::uint8_t>& classes) {
+std::string positions_and_classes(const std::vector<std::uint16_t>& xyz_bits,
+                                  const std::vector<std::uint8_t>& classes) {
   std::string bytes;
   bytes.reserve(xyz_bits.size() * 2 + classes.size());
   append_raw(bytes, xyz_bits);

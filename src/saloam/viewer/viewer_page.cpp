@@ -82,7 +82,8 @@ json trajectories_json(const ViewerScene& scene) {
   return list;
 }
 
-json scans_json(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source, ViewerPageStats& stats) {
+json scans_json(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
+                ViewerPageStats& stats) {
   json scans{{"scale", kScanScale}, {"source", "none"}, {"frames", json::array()}, {"data", json::array()}};
   if (!scene.sequence) return scans;
   if (source == ViewerDataSource::kServer) {
@@ -100,7 +101,8 @@ json scans_json(const ViewerScene& scene, const ViewerOptions& options, ViewerDa
   return scans;
 }
 
-json page_data(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source, ViewerPageStats& stats) {
+json page_data(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
+               ViewerPageStats& stats) {
   json loops = json::array();
   for (const auto& [query, match] : scene.loops) loops.push_back({query, match});
   return json{{"title", scene.run_dir.filename().empty() ? scene.run_dir.parent_path().filename().string()
@@ -119,7 +121,8 @@ json page_data(const ViewerScene& scene, const ViewerOptions& options, ViewerDat
 
 /// JSON that is safe inside a <script> element ("</" would end it).
 std::string script_safe(std::string text) {
-  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
+  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3))
+    text.replace(at, 2, "<\\/");
   return text;
 }
 

@@ -22,9 +22,9 @@ struct ViewerPageStats {
   std::size_t map_points = 0;        ///< in the page (after decimation)
   std::size_t map_points_total = 0;  ///< in map.ply
   std::size_t frames = 0;
-  std::size_t loops = 0;             ///< accepted loop edges drawn
-  std::size_t scans = 0;             ///< embedded scans
-  std::size_t scan_points = 0;       ///< in the embedded scans, all together
+  std::size_t loops = 0;        ///< accepted loop edges drawn
+  std::size_t scans = 0;        ///< embedded scans
+  std::size_t scan_points = 0;  ///< in the embedded scans, all together
   bool ground_truth = false;
 };
 

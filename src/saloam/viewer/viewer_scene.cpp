@@ -27,8 +27,8 @@ namespace fs = std::filesystem;
 fs::path required_file(const fs::path& run_dir, const std::string& name, const std::string& what) {
   const fs::path file = run_dir / name;
   if (!fs::is_regular_file(file)) {
-    throw InputError(file, fmt::format("not found: {} (is {} the output folder of `saloam slam`?)", what,
-                                       run_dir.string()));
+    throw InputError(file,
+                     fmt::format("not found: {} (is {} the output folder of `saloam slam`?)", what, run_dir.string()));
   }
   return file;
 }
@@ -105,23 +105,52 @@ std::vector<Pose> ground_truth_lidar(const SequenceReader& reader, std::size_t f
   if (!reader.has_poses() || count == 0) return {};
   const auto& camera = reader.camera_poses();
   if (first + count > camera.size()) {
-    throw InputError(reader.root() / "poses.txt",
-                     fmt::format("{} poses, but the run processed frames {}..{}", camera.size(), first, first + count - 1));
+    throw InputError(reader.root() / "poses.txt", fmt::format("{} poses, but the run processed frames {}..{}",
+                                                              camera.size(), first, first + count - 1));
   }
   const Pose tr = reader.has_calib() ? reader.velo_to_cam() : Pose::Identity();
   const Pose rebase = camera[first].inverse();
   std::vector<Pose> lidar;
   lidar.reserve(count);
-  for (std::size_t i = first; i < first + count; ++i) lidar.push_back(orthonormalized(tr.inverse() * rebase * camera[i] * tr));
+  for (std::size_t i = first; i < first + count; ++i)
+    lidar.push_back(orthonormalized(tr.inverse() * rebase * camera[i] * tr));
   return lidar;
 }
 
-void check_loops(const std::vector<std::pair<std::size_t, std::size_t>>& loops, std::size_t frames, const fs::path& file) {
+void check_loops(const std::vector<std::pair<std::size_t, std::size_t>>& loops, std::size_t frames,
+                 const fs::path& file) {
   for (const auto& [query, match] : loops) {
     if (query >= frames || match >= frames) {
       throw InputError(file, fmt::format("loop {}-{} beyond the {} poses of poses_tum.txt", query, match, frames));
     }
   }
+}
+
+/// The loop-closed and odometry trajectories and the accepted loops of the run.
+void read_trajectories_and_loops(ViewerScene& scene) {
+  const fs::path& dir = scene.run_dir;
+  scene.loop_closed = read_tum_poses(required_file(dir, "poses_tum.txt", "the loop-closed trajectory"));
+  if (scene.loop_closed.empty()) throw InputError(dir / "poses_tum.txt", "no poses");
+  if (fs::is_regular_file(dir / "poses_odometry_tum.txt"))
+    scene.odometry = read_tum_poses(dir / "poses_odometry_tum.txt");
+  if (fs::is_regular_file(dir / "loops.csv")) {
+    scene.loops = read_accepted_loops(dir / "loops.csv", &scene.loops_verified);
+    check_loops(scene.loops, scene.loop_closed.size(), dir / "loops.csv");
+  }
+}
+
+/// The sequence the run processed, when known, with its ground truth.
+void attach_sequence(ViewerScene& scene, const RunSummary& summary, const ViewerOptions& options) {
+  scene.first_frame = summary.first_frame;
+  const auto folder = sequence_folder(summary, options);
+  if (!folder) return;
+  scene.sequence = std::make_shared<const SequenceReader>(*folder);
+  const std::size_t frames = scene.loop_closed.size();
+  if (scene.first_frame + frames > scene.sequence->size()) {
+    throw InputError(*folder, fmt::format("{} scans, but the run has poses of frames {}..{}: another sequence?",
+                                          scene.sequence->size(), scene.first_frame, scene.first_frame + frames - 1));
+  }
+  scene.ground_truth = ground_truth_lidar(*scene.sequence, scene.first_frame, frames);
 }
 
 }  // namespace
@@ -140,9 +169,11 @@ std::vector<std::pair<std::size_t, std::size_t>> read_accepted_loops(const fs::p
   for (std::size_t number = 2; std::getline(in, line); ++number) {
     if (line.empty()) continue;
     const auto fields = csv_fields(line);
-    if (fields.size() < header.size()) throw InputError(file, fmt::format("line {}: {} fields, {} expected", number, fields.size(), header.size()));
+    if (fields.size() < header.size())
+      throw InputError(file, fmt::format("line {}: {} fields, {} expected", number, fields.size(), header.size()));
     ++rows;
-    if (fields[accepted] == "1") loops.emplace_back(parse_index(fields[query], file, number), parse_index(fields[match], file, number));
+    if (fields[accepted] == "1")
+      loops.emplace_back(parse_index(fields[query], file, number), parse_index(fields[match], file, number));
   }
   if (verified) *verified = rows;
   return loops;
@@ -156,7 +187,8 @@ LabelledCloud decimate_cloud(const LabelledCloud& cloud, std::size_t budget) {
     std::shuffle(order.begin(), order.end(), rng);
     order.resize(budget);
   }
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return cloud.label[a] < cloud.label[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return cloud.label[a] < cloud.label[b]; });
   LabelledCloud out;
   out.has_labels = cloud.has_labels;
   out.reserve(order.size());
@@ -169,27 +201,8 @@ ViewerScene load_viewer_scene(const fs::path& run_dir, const ViewerOptions& opti
   ViewerScene scene;
   scene.run_dir = run_dir;
   const fs::path map_file = required_file(run_dir, "map.ply", "the global map (run `saloam slam` without --no-map)");
-  scene.loop_closed = read_tum_poses(required_file(run_dir, "poses_tum.txt", "the loop-closed trajectory"));
-  if (scene.loop_closed.empty()) throw InputError(run_dir / "poses_tum.txt", "no poses");
-  if (fs::is_regular_file(run_dir / "poses_odometry_tum.txt")) scene.odometry = read_tum_poses(run_dir / "poses_odometry_tum.txt");
-  if (fs::is_regular_file(run_dir / "loops.csv")) {
-    scene.loops = read_accepted_loops(run_dir / "loops.csv", &scene.loops_verified);
-    check_loops(scene.loops, scene.loop_closed.size(), run_dir / "loops.csv");
-  }
-
-  const RunSummary summary = read_run_summary(run_dir);
-  scene.first_frame = summary.first_frame;
-  if (const auto folder = sequence_folder(summary, options)) scene.sequence = std::make_shared<const SequenceReader>(*folder);
-  if (scene.sequence) {
-    const SequenceReader& reader = *scene.sequence;
-    if (scene.first_frame + scene.loop_closed.size() > reader.size()) {
-      throw InputError(reader.root(), fmt::format("{} scans, but the run has poses of frames {}..{}: another sequence?",
-                                                    reader.size(), scene.first_frame,
-                                                    scene.first_frame + scene.loop_closed.size() - 1));
-    }
-    scene.ground_truth = ground_truth_lidar(reader, scene.first_frame, scene.loop_closed.size());
-  }
-
+  read_trajectories_and_loops(scene);
+  attach_sequence(scene, read_run_summary(run_dir), options);
   const LabelledCloud map = read_ply(map_file);
   scene.map_points_total = map.size();
   scene.map = decimate_cloud(map, options.max_map_points);

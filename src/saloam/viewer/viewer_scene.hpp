@@ -23,20 +23,20 @@
 namespace saloam {
 
 struct ViewerOptions {
-  std::size_t max_map_points = 1'000'000;   ///< map budget: the map is decimated to at most this many points
-  std::size_t max_scan_points = 400'000;    ///< scans embedded in the page, all together
-  std::size_t points_per_scan = 8'000;      ///< each scan is decimated to at most this many points
+  std::size_t max_map_points = 1'000'000;         ///< map budget: the map is decimated to at most this many points
+  std::size_t max_scan_points = 400'000;          ///< scans embedded in the page, all together
+  std::size_t points_per_scan = 8'000;            ///< each scan is decimated to at most this many points
   std::optional<std::filesystem::path> sequence;  ///< sequence folder; default: the one in summary.json
 };
 
 struct ViewerScene {
   std::filesystem::path run_dir;
-  std::shared_ptr<const SequenceReader> sequence;  ///< for the ground truth and the scans, when found
-  std::size_t first_frame = 0;                    ///< sequence frame of the first processed frame
-  std::vector<Pose> loop_closed, odometry, ground_truth;  ///< LiDAR frame; ground truth may be empty
+  std::shared_ptr<const SequenceReader> sequence;          ///< for the ground truth and the scans, when found
+  std::size_t first_frame = 0;                             ///< sequence frame of the first processed frame
+  std::vector<Pose> loop_closed, odometry, ground_truth;   ///< LiDAR frame; ground truth may be empty
   std::vector<std::pair<std::size_t, std::size_t>> loops;  ///< accepted loops (query, match), processed-frame indices
   std::size_t loops_verified = 0;
-  LabelledCloud map;              ///< decimated to the budget, sorted by class
+  LabelledCloud map;                 ///< decimated to the budget, sorted by class
   std::size_t map_points_total = 0;  ///< before decimation
 };
 

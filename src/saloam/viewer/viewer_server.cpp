@@ -30,15 +30,15 @@ void ViewerServer::Impl::add_routes() {
   server.Get("/map.bin", [this](const httplib::Request&, httplib::Response& response) {
     response.set_content(map_bytes, "application/octet-stream");
   });
-  server.Get(R"(/scan/(\d+))", [this](const httplib::Request& request, httplib::Response& response) {
-    send_scan(request, response);
-  });
+  server.Get(R"(/scan/(\d+))",
+             [this](const httplib::Request& request, httplib::Response& response) { send_scan(request, response); });
 }
 
 void ViewerServer::Impl::send_scan(const httplib::Request& request, httplib::Response& response) const {
   try {
     const std::size_t frame = std::stoul(request.matches[1].str());
-    response.set_content(encode_scan(load_viewer_scan(scene, frame, options.points_per_scan)), "application/octet-stream");
+    response.set_content(encode_scan(load_viewer_scan(scene, frame, options.points_per_scan)),
+                         "application/octet-stream");
   } catch (const std::exception& e) {  // a frame out of range, an unreadable scan
     response.status = 404;
     response.set_content(e.what(), "text/plain");
@@ -56,7 +56,8 @@ ViewerServer::ViewerServer(ViewerScene scene, const ViewerOptions& options) : im
 ViewerServer::~ViewerServer() { stop(); }
 
 int ViewerServer::bind(const std::string& host, int port) {
-  const int bound = port == 0 ? impl_->server.bind_to_any_port(host) : (impl_->server.bind_to_port(host, port) ? port : -1);
+  const int bound =
+      port == 0 ? impl_->server.bind_to_any_port(host) : (impl_->server.bind_to_port(host, port) ? port : -1);
   if (bound <= 0) throw InputError(fmt::format("{}:{}", host, port), "cannot listen there (port in use?)");
   return bound;
 }
