@@ -9,6 +9,7 @@ packages=(
   libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev nlohmann-json3-dev
   libcairo2-dev libgtest-dev libgmock-dev libbenchmark-dev
   robin-map-dev
+  libjs-three libcpp-httplib-dev chromium  # saloam view: three.js, its --serve server, the headless page test
 )
 
 missing=()

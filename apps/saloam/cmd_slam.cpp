@@ -9,10 +9,12 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
+#include "saloam/core/error.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/runs/slam_run.hpp"
+#include "saloam/viewer/viewer_page.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -54,6 +56,17 @@ void print_summary(const SlamRunResult& r) {
   }
 }
 
+/// view.html beside the results (as `saloam view OUT_DIR`); a warning when it cannot be written.
+void write_view_page(const std::filesystem::path& out_dir) {
+  try {
+    const ViewerPageStats s = write_viewer_page(out_dir, out_dir / "view.html");
+    std::cout << fmt::format("3D view: {} ({:.1f} MB, opens in a browser)\n", (out_dir / "view.html").string(),
+                             static_cast<double>(s.bytes) / 1e6);
+  } catch (const InputError& e) {
+    spdlog::warn("no view.html: {}", e.what());
+  }
+}
+
 int run_slam_command(const SlamOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (!options.detector.empty()) config.loop.detector = options.detector;
@@ -75,6 +88,7 @@ int run_slam_command(const SlamOptions& options) {
   std::cout << fmt::format("wrote {} (poses.txt, poses_odometry.txt, loops.csv, map.ply, map.png, trajectories.png, "
                            "timing.json)\n",
                            out_dir.string());
+  if (run_options.write_map && !result.interrupted) write_view_page(out_dir);
   if (result.interrupted) {
     spdlog::warn("interrupted: results of the {} frames processed were written", result.frames);
     return 130;

@@ -220,12 +220,19 @@ nlohmann::json loop_summary_json(const LoopSummary& s) {
           {"missed_reverse_stretches", s.missed_reverse_stretches}};
 }
 
+// Where the frames came from, for `saloam view` (summary.json).
+struct RunOrigin {
+  std::optional<std::filesystem::path> sequence;  ///< the sequence folder; none for a stream
+  std::size_t first_frame = 0;
+};
+
 // Evaluates both trajectories and the loops against the ground truth (when
 // known) and writes eval_{odometry,slam}.{json,png} and summary.json.
 void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunTruth& truth,
                   const std::vector<Pose>& odometry_out, const std::vector<Pose>& slam_out,
-                  const std::filesystem::path& out_dir, SlamRunResult& result) {
-  nlohmann::json summary{{"frames", result.frames},
+                  const std::filesystem::path& out_dir, SlamRunResult& result, const RunOrigin& origin) {
+  nlohmann::json summary{{"first_frame", origin.first_frame},
+                         {"frames", result.frames},
                          {"keyframes", result.keyframes},
                          {"detector", config.loop.detector},
                          {"loops_verified", result.loops_verified},
@@ -257,6 +264,7 @@ void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunT
     }
     summary["loops"] = loop_summary_json(*result.loop_summary);
   }
+  if (origin.sequence) summary["sequence"] = std::filesystem::absolute(*origin.sequence).lexically_normal().string();
   std::ofstream out(out_dir / "summary.json");
   if (!out) throw InputError(out_dir / "summary.json", "cannot write the run summary");
   out << summary.dump(2) << '\n';
@@ -339,7 +347,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   const std::vector<Pose> slam_out = output_poses(optimized, tr);
   plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, truth.camera ? &*truth.camera : nullptr,
                     slam.accepted_loops());
-  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result);
+  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, RunOrigin{source.folder(), first});
 
   if (options.write_map && !result.interrupted) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)

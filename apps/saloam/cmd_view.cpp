@@ -1,0 +1,95 @@
+// `saloam view`: the map, the trajectories and the loops of a `saloam slam`
+// run in the browser. Writes one self-contained page (src/saloam/viewer/), or
+// with --serve serves it from 127.0.0.1 and loads scans on demand.
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "command.hpp"
+#include "saloam/core/cancellation.hpp"
+#include "saloam/viewer/viewer_page.hpp"
+#include "saloam/viewer/viewer_server.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct ViewOptions {
+  std::string run_dir;
+  std::string page;
+  std::string sequence;
+  ViewerOptions viewer;
+  bool serve = false;
+  int port = 8080;
+};
+
+ViewerOptions viewer_options(const ViewOptions& options) {
+  ViewerOptions viewer = options.viewer;
+  if (!options.sequence.empty()) viewer.sequence = options.sequence;
+  return viewer;
+}
+
+int write_page(const ViewOptions& options) {
+  const std::filesystem::path page =
+      options.page.empty() ? std::filesystem::path(options.run_dir) / "view.html" : std::filesystem::path(options.page);
+  const ViewerPageStats s = write_viewer_page(options.run_dir, page, viewer_options(options));
+  std::cout << fmt::format(
+      "wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n", page.string(),
+      static_cast<double>(s.bytes) / 1e6, s.map_points, s.map_points_total, s.frames,
+      s.ground_truth ? " with ground truth" : "", s.loops, s.scans, s.scan_points);
+  std::cout << fmt::format("open file://{}\n", std::filesystem::absolute(page).lexically_normal().string());
+  return 0;
+}
+
+/// Serves until Ctrl-C (the stop flag of main's signal handler).
+int serve(const ViewOptions& options) {
+  const ViewerOptions viewer = viewer_options(options);
+  ViewerServer server(load_viewer_scene(options.run_dir, viewer), viewer);
+  const int port = server.bind("127.0.0.1", options.port);
+  std::cout << fmt::format("serving {} at http://127.0.0.1:{}/ (Ctrl-C stops)\n", options.run_dir, port) << std::flush;
+  std::atomic<bool> done{false};
+  std::thread listener([&server, &done] {
+    server.listen();
+    done = true;
+  });
+  while (!stop_requested() && !done) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  while (!done) {  // stop() does nothing until listen() runs
+    server.stop();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  listener.join();
+  stop_flag().store(false);  // Ctrl-C is how a server ends: not an interruption
+  std::cout << "server stopped\n";
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "view", "3D viewer in the browser: the semantic map, trajectories, loops and scans of a `saloam slam` run", 27,
+    [](CLI::App& app) {
+      auto options = std::make_shared<ViewOptions>();
+      app.add_option("OUT_DIR", options->run_dir, "Output folder of `saloam slam` (map.ply, poses_tum.txt, loops.csv)")
+          ->required();
+      app.add_option("--out", options->page, "Page to write (default OUT_DIR/view.html)");
+      app.add_option("--max-points", options->viewer.max_map_points, "Map point budget: decimated to at most this many")
+          ->capture_default_str()
+          ->check(CLI::PositiveNumber);
+      app.add_option("--scan-points", options->viewer.points_per_scan, "Points per scan shown at the slider")
+          ->capture_default_str();
+      app.add_option("--max-scan-points", options->viewer.max_scan_points,
+                     "Budget of the scans embedded in the page, all together (0: none)")
+          ->capture_default_str();
+      app.add_option("--sequence", options->sequence, "Sequence folder (default: the one recorded in summary.json)");
+      app.add_flag("--serve", options->serve, "Serve the page from 127.0.0.1 instead, scans loaded on demand");
+      app.add_option("--port", options->port, "Port for --serve (0: any free one)")
+          ->capture_default_str()
+          ->check(CLI::Range(0, 65535));
+      return [options] { return options->serve ? serve(*options) : write_page(*options); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli

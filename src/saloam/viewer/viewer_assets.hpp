@@ -1,0 +1,16 @@
+#pragma once
+// Files embedded into the library at build time (viewer_assets.cpp, written
+// by embed_assets.cmake): the page template and Debian's three.js.
+
+#include <string_view>
+
+namespace saloam::viewer_assets {
+
+/// viewer.html: the page, with /*SALOAM_...*/ placeholders for the scripts and the data.
+extern const std::string_view kPageTemplate;
+/// three.min.js and examples/js/controls/OrbitControls.js; empty when
+/// libjs-three was not installed when saloam was configured.
+extern const std::string_view kThreeJs;
+extern const std::string_view kOrbitControlsJs;
+
+}  // namespace saloam::viewer_assets

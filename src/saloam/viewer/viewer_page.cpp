@@ -1,0 +1,176 @@
+#include "saloam/viewer/viewer_page.hpp"
+
+#include <fstream>
+#include <string_view>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/viewer/point_encoding.hpp"
+#include "saloam/viewer/viewer_assets.hpp"
+
+namespace saloam {
+
+namespace {
+
+using nlohmann::json;
+
+json class_table() {
+  json classes = json::array();
+  for (const SemanticClass& c : semantic_kitti_classes()) {
+    classes.push_back({{"id", c.id}, {"name", c.name}, {"color", {c.color.r, c.color.g, c.color.b}}});
+  }
+  classes.push_back({{"id", -1}, {"name", "unknown"}, {"color", {128, 128, 128}}});
+  return classes;
+}
+
+/// [class index, first point, point count] of each class run of the sorted map.
+json class_ranges(const LabelledCloud& map) {
+  json ranges = json::array();
+  for (std::size_t begin = 0; begin < map.size();) {
+    const std::uint8_t index = class_index(map.label[begin]);
+    std::size_t end = begin;
+    while (end < map.size() && class_index(map.label[end]) == index) ++end;
+    ranges.push_back({index, begin, end - begin});
+    begin = end;
+  }
+  return ranges;
+}
+
+json map_json(const ViewerScene& scene, ViewerDataSource source) {
+  const MapQuantization q = map_quantization(scene.map);
+  json map{{"count", scene.map.size()},
+           {"total", scene.map_points_total},
+           {"origin", {q.origin.x(), q.origin.y(), q.origin.z()}},
+           {"scale", q.scale},
+           {"ranges", class_ranges(scene.map)}};
+  if (source == ViewerDataSource::kEmbedded) map["data"] = base64(encode_map(scene.map, q));
+  return map;
+}
+
+std::string positions_base64(const std::vector<Pose>& poses) {
+  std::vector<float> xyz;
+  xyz.reserve(poses.size() * 3);
+  for (const Pose& p : poses) {
+    for (int a = 0; a < 3; ++a) xyz.push_back(static_cast<float>(p.translation()[a]));
+  }
+  return base64(encode_floats(xyz));
+}
+
+/// 3x4 row-major [R|t] per pose.
+std::string poses_base64(const std::vector<Pose>& poses) {
+  std::vector<float> values;
+  values.reserve(poses.size() * 12);
+  for (const Pose& p : poses) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) values.push_back(static_cast<float>(p.matrix()(r, c)));
+    }
+  }
+  return base64(encode_floats(values));
+}
+
+json trajectories_json(const ViewerScene& scene) {
+  json list = json::array();
+  const auto add = [&](const char* name, const char* color, const std::vector<Pose>& poses) {
+    if (!poses.empty()) list.push_back({{"name", name}, {"color", color}, {"positions", positions_base64(poses)}});
+  };
+  add("ground truth", "#9a9a9a", scene.ground_truth);
+  add("odometry", "#e8412f", scene.odometry);
+  add("loop closed", "#3b9cff", scene.loop_closed);
+  return list;
+}
+
+json scans_json(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
+                ViewerPageStats& stats) {
+  json scans{{"scale", kScanScale}, {"source", "none"}, {"frames", json::array()}, {"data", json::array()}};
+  if (!scene.sequence) return scans;
+  if (source == ViewerDataSource::kServer) {
+    scans["source"] = "server";
+    return scans;
+  }
+  scans["source"] = "embedded";
+  for (const std::size_t frame : embedded_scan_frames(scene, options)) {
+    const std::string bytes = encode_scan(load_viewer_scan(scene, frame, options.points_per_scan));
+    scans["frames"].push_back(frame);
+    scans["data"].push_back(base64(bytes));
+    ++stats.scans;
+    stats.scan_points += bytes.size() / 7;
+  }
+  return scans;
+}
+
+json page_data(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
+               ViewerPageStats& stats) {
+  json loops = json::array();
+  for (const auto& [query, match] : scene.loops) loops.push_back({query, match});
+  return json{{"title", scene.run_dir.filename().empty() ? scene.run_dir.parent_path().filename().string()
+                                                         : scene.run_dir.filename().string()},
+              {"source", source == ViewerDataSource::kEmbedded ? "embedded" : "server"},
+              {"classes", class_table()},
+              {"map", map_json(scene, source)},
+              {"trajectories", trajectories_json(scene)},
+              {"frames", scene.loop_closed.size()},
+              {"first_frame", scene.first_frame},
+              {"poses", poses_base64(scene.loop_closed)},
+              {"loops", loops},
+              {"loops_verified", scene.loops_verified},
+              {"scans", scans_json(scene, options, source, stats)}};
+}
+
+/// JSON that is safe inside a <script> element ("</" would end it).
+std::string script_safe(std::string text) {
+  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3))
+    text.replace(at, 2, "<\\/");
+  return text;
+}
+
+void replace_once(std::string& page, std::string_view placeholder, std::string_view text) {
+  const std::size_t at = page.find(placeholder);
+  if (at == std::string::npos) throw std::logic_error(fmt::format("viewer.html has no {}", placeholder));
+  page.replace(at, placeholder.size(), text);
+}
+
+}  // namespace
+
+bool viewer_has_three_js() { return !viewer_assets::kThreeJs.empty() && !viewer_assets::kOrbitControlsJs.empty(); }
+
+std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
+                        ViewerPageStats* stats) {
+  if (!viewer_has_three_js()) {
+    throw InputError("/usr/share/javascript/three/three.min.js",
+                     "three.js was not found when saloam was built: install the Debian package libjs-three "
+                     "(scripts/install_deps.sh), then reconfigure and rebuild saloam");
+  }
+  ViewerPageStats local;
+  ViewerPageStats& s = stats ? *stats : local;
+  s = ViewerPageStats{};
+  const std::string data = script_safe(page_data(scene, options, source, s).dump());
+  std::string page(viewer_assets::kPageTemplate);
+  // Last placeholder first: every search finds its placeholder before any inserted text.
+  replace_once(page, "/*SALOAM_DATA*/", data);
+  replace_once(page, "/*SALOAM_ORBIT_CONTROLS_JS*/", viewer_assets::kOrbitControlsJs);
+  replace_once(page, "/*SALOAM_THREE_JS*/", viewer_assets::kThreeJs);
+  s.bytes = page.size();
+  s.map_points = scene.map.size();
+  s.map_points_total = scene.map_points_total;
+  s.frames = scene.loop_closed.size();
+  s.loops = scene.loops.size();
+  s.ground_truth = !scene.ground_truth.empty();
+  return page;
+}
+
+ViewerPageStats write_viewer_page(const std::filesystem::path& run_dir, const std::filesystem::path& page,
+                                  const ViewerOptions& options) {
+  const ViewerScene scene = load_viewer_scene(run_dir, options);
+  ViewerPageStats stats;
+  const std::string html = viewer_page(scene, options, ViewerDataSource::kEmbedded, &stats);
+  std::ofstream out(page, std::ios::binary);
+  if (!out) throw InputError(page, "cannot write the viewer page");
+  out << html;
+  if (!out.flush()) throw InputError(page, "cannot write the viewer page (disk full?)");
+  return stats;
+}
+
+}  // namespace saloam

@@ -1,0 +1,64 @@
+#pragma once
+// What the viewer shows, read from the output folder of `saloam slam` (and
+// the sequence it ran on, for the ground truth and the scans):
+//   map.ply                      the global semantic map (LiDAR frame, world = first processed frame)
+//   poses_tum.txt                loop-closed trajectory (LiDAR frame)
+//   poses_odometry_tum.txt       odometry trajectory (LiDAR frame)
+//   loops.csv                    verified loop candidates (frames index the processed frames)
+//   summary.json                 the sequence folder and the first processed frame
+//   SEQ/poses.txt + calib.txt    ground truth, when present
+//   SEQ/velodyne, SEQ/labels     the scans for the frame slider
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "saloam/core/types.hpp"
+#include "saloam/io/sequence.hpp"
+
+namespace saloam {
+
+struct ViewerOptions {
+  std::size_t max_map_points = 1'000'000;         ///< map budget: the map is decimated to at most this many points
+  std::size_t max_scan_points = 400'000;          ///< scans embedded in the page, all together
+  std::size_t points_per_scan = 8'000;            ///< each scan is decimated to at most this many points
+  std::optional<std::filesystem::path> sequence;  ///< sequence folder; default: the one in summary.json
+};
+
+struct ViewerScene {
+  std::filesystem::path run_dir;
+  std::shared_ptr<const SequenceReader> sequence;          ///< for the ground truth and the scans, when found
+  std::size_t first_frame = 0;                             ///< sequence frame of the first processed frame
+  std::vector<Pose> loop_closed, odometry, ground_truth;   ///< LiDAR frame; ground truth may be empty
+  std::vector<std::pair<std::size_t, std::size_t>> loops;  ///< accepted loops (query, match), processed-frame indices
+  std::size_t loops_verified = 0;
+  LabelledCloud map;                 ///< decimated to the budget, sorted by class
+  std::size_t map_points_total = 0;  ///< before decimation
+};
+
+/// Reads a run folder. InputError (naming the file) when the folder, map.ply
+/// or poses_tum.txt is missing or unreadable, or when the sequence does not match.
+ViewerScene load_viewer_scene(const std::filesystem::path& run_dir, const ViewerOptions& options = {});
+
+/// At most `budget` points of `cloud`, an evenly spread deterministic random
+/// subset (all of them when it fits), sorted by label.
+LabelledCloud decimate_cloud(const LabelledCloud& cloud, std::size_t budget);
+
+/// Scan `frame` (processed-frame index) of the scene's sequence in its own
+/// LiDAR frame, decimated to `max_points`. InputError without a sequence or
+/// for a frame out of range.
+LabelledCloud load_viewer_scan(const ViewerScene& scene, std::size_t frame, std::size_t max_points);
+
+/// Processed frames whose scans fit `options` (every k-th frame, evenly spread).
+std::vector<std::size_t> embedded_scan_frames(const ViewerScene& scene, const ViewerOptions& options);
+
+/// The accepted loops of a loops.csv written by `saloam slam` (query_frame,
+/// match_frame, accepted columns); `verified` gets the number of rows.
+std::vector<std::pair<std::size_t, std::size_t>> read_accepted_loops(const std::filesystem::path& file,
+                                                                     std::size_t* verified = nullptr);
+
+}  // namespace saloam

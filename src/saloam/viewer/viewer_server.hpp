@@ -1,0 +1,39 @@
+#pragma once
+// `saloam view --serve`: the viewer page from a local HTTP server
+// (cpp-httplib), for maps too large to embed. Routes:
+//   /            the page (ViewerDataSource::kServer)
+//   /map.bin     the decimated map (point_encoding.hpp)
+//   /scan/N      scan N (processed-frame index), loaded from the sequence on demand
+
+#include <memory>
+#include <string>
+
+#include "saloam/viewer/viewer_scene.hpp"
+
+namespace saloam {
+
+class ViewerServer {
+ public:
+  /// Prepares the page and the map; InputError as write_viewer_page.
+  ViewerServer(ViewerScene scene, const ViewerOptions& options);
+  ~ViewerServer();
+  ViewerServer(const ViewerServer&) = delete;
+  ViewerServer& operator=(const ViewerServer&) = delete;
+
+  /// Binds `host`:`port` (port 0: any free port) and returns the port;
+  /// InputError naming the address when it is taken.
+  int bind(const std::string& host, int port);
+  /// Serves until stop() (from another thread); call after bind().
+  void listen();
+  /// Ends listen() from another thread. Before listen() runs (running()
+  /// false) it does nothing: callers repeat it until listen() returns.
+  void stop();
+  [[nodiscard]] bool running() const;
+  [[nodiscard]] std::size_t page_bytes() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace saloam

@@ -1,0 +1,217 @@
+// End-to-end: `saloam view` writes the page, a headless Chromium draws it
+// (no JavaScript error, a map in class colours on the canvas), and --serve
+// serves it until Ctrl-C.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cairo.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <regex>
+#include <string>
+#include <thread>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "testing/test_support.hpp"
+#include "viewer/viewer_fixture.hpp"
+
+// After Eigen: httplib.h includes <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
+
+extern char** environ;
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::cli_path;
+using testing::quoted;
+using testing::run_command;
+using testing::TempDir;
+
+std::string saloam_cmd(const std::string& args) { return quoted(cli_path()) + " " + args; }
+
+TEST(ViewCli, WritesThePageWithTheBudget) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 8000);
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {} --max-points 3000", quoted(run.run_dir))), &output), 0)
+      << output;
+  EXPECT_NE(output.find("3000 of 8000 map points, 40 frames with ground truth"), std::string::npos) << output;
+  const auto data = testing::page_data(testing::read_text(run.run_dir / "view.html"));
+  EXPECT_EQ(data["map"]["count"], 3000U);
+  ASSERT_EQ(
+      run_command(saloam_cmd(fmt::format("view {} --out {}", quoted(run.run_dir), quoted(tmp / "p.html"))), &output), 0)
+      << output;
+  EXPECT_TRUE(fs::exists(tmp / "p.html"));
+}
+
+TEST(ViewCli, SlamWritesThePageBesideItsResults) {
+  TempDir tmp;
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("simulate --out {} --preset straight --frames 0:6 --beams 16",
+                                               quoted(tmp / "seq"))),
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {}", quoted(tmp / "seq"), quoted(tmp / "out"))), &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("3D view: " + (tmp / "out/view.html").string()), std::string::npos) << output;
+  const auto data = testing::page_data(testing::read_text(tmp / "out/view.html"));
+  EXPECT_EQ(data["frames"], 6U);
+  EXPECT_EQ(data["trajectories"].size(), 3U) << "ground truth found through summary.json";
+  EXPECT_EQ(data["scans"]["frames"].size(), 6U);
+}
+
+TEST(ViewCli, MissingMapIsAClearError) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 100);
+  fs::remove(run.run_dir / "map.ply");
+  std::string output;
+  EXPECT_EQ(run_command(saloam_cmd("view " + quoted(run.run_dir)), &output), 2);
+  EXPECT_NE(output.find("map.ply: not found: the global map"), std::string::npos) << output;
+  EXPECT_EQ(run_command(saloam_cmd("view " + quoted(tmp / "nowhere")), &output), 2);
+  EXPECT_NE(output.find("nowhere: run folder not found"), std::string::npos) << output;
+}
+
+/// Headless Chromium, or a skip (a failure with CI=true) when it is not installed.
+#define SALOAM_REQUIRE_CHROMIUM()                                                                     \
+  do {                                                                                                \
+    if (run_command("command -v chromium") != 0) {                                                    \
+      const char* ci = std::getenv("CI");                                                             \
+      if (ci && std::string(ci) == "true") FAIL() << "chromium is not installed (CI=true)";           \
+      GTEST_SKIP() << "chromium is not installed (Debian package chromium; scripts/install_deps.sh)"; \
+    }                                                                                                 \
+  } while (false)
+
+std::string chromium(const TempDir& tmp, const std::string& args, const fs::path& page) {
+  std::string output;
+  const std::string command = fmt::format(
+      "timeout 120 chromium --headless=new --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader "
+      "--disable-dev-shm-usage --user-data-dir={} --enable-logging=stderr --v=0 {} {}",
+      quoted(tmp / "chromium_profile"), args, testing::quoted(fs::path("file://" + fs::absolute(page).string())));
+  run_command(command, &output);
+  return output;
+}
+
+struct PixelCounts {
+  std::size_t drawn = 0;  ///< differs from the background
+  std::size_t road = 0, building = 0, vegetation = 0;
+};
+
+bool near(const unsigned char* bgra, Rgb c) {
+  return std::abs(bgra[2] - c.r) <= 10 && std::abs(bgra[1] - c.g) <= 10 && std::abs(bgra[0] - c.b) <= 10;
+}
+
+/// Pixels of the centre of the screenshot (away from the legend and the slider).
+PixelCounts count_pixels(const fs::path& png) {
+  PixelCounts counts;
+  cairo_surface_t* surface = cairo_image_surface_create_from_png(png.c_str());
+  if (cairo_surface_status(surface) != CAIRO_STATUS_SUCCESS) {
+    cairo_surface_destroy(surface);
+    return counts;
+  }
+  cairo_surface_flush(surface);
+  const int width = cairo_image_surface_get_width(surface), height = cairo_image_surface_get_height(surface);
+  const int stride = cairo_image_surface_get_stride(surface);
+  const unsigned char* data = cairo_image_surface_get_data(surface);
+  for (int y = height / 8; y < height * 7 / 8; ++y) {
+    for (int x = width * 3 / 10; x < width * 9 / 10; ++x) {
+      const unsigned char* p = data + y * stride + 4 * x;
+      counts.drawn += !near(p, Rgb{16, 20, 24});  // the page's background
+      counts.road += near(p, class_color(cls::kRoad));
+      counts.building += near(p, class_color(cls::kBuilding));
+      counts.vegetation += near(p, class_color(cls::kVegetation));
+    }
+  }
+  cairo_surface_destroy(surface);
+  return counts;
+}
+
+TEST(ViewCli, HeadlessChromiumDrawsTheMapWithoutErrors) {
+  SALOAM_REQUIRE_CHROMIUM();
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 60'000);
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd("view " + quoted(run.run_dir)), &output), 0) << output;
+  const fs::path page = run.run_dir / "view.html";
+
+  // The page reports "ready:<map points>" in its title, or "error: ..." for any JavaScript error.
+  const std::string dom = chromium(tmp, "--dump-dom", page);
+  std::smatch title;
+  ASSERT_TRUE(std::regex_search(dom, title, std::regex("<title>([^<]*)</title>"))) << dom.substr(0, 2000);
+  EXPECT_EQ(title[1].str().rfind("ready:60000 ", 0), 0U) << title[1];
+  EXPECT_EQ(dom.find("Uncaught"), std::string::npos) << dom.substr(0, 4000);
+  EXPECT_EQ(dom.find(":CONSOLE"), std::string::npos) << "console output:\n" << dom.substr(0, 4000);
+
+  const fs::path png = tmp / "view.png";
+  const std::string shot = chromium(tmp, fmt::format("--screenshot={} --window-size=1024,768", quoted(png)), page);
+  ASSERT_TRUE(fs::exists(png)) << shot;
+  const PixelCounts counts = count_pixels(png);
+  const std::size_t area = 1024 * 768 * 3 / 4 * 6 / 10;
+  EXPECT_GT(counts.drawn, area / 20) << "the canvas is almost blank";
+  EXPECT_GT(counts.road, 200U);
+  EXPECT_GT(counts.building, 200U);
+  EXPECT_GT(counts.vegetation, 100U);
+}
+
+/// `saloam ARGS...` as a child process, its output into `log`.
+pid_t spawn_saloam(const std::vector<std::string>& args, const fs::path& log) {
+  std::vector<std::string> argv_text{cli_path().string()};
+  argv_text.insert(argv_text.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, 1, 2);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+TEST(ViewCli, ServeAnswersUntilCtrlC) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 2000, 20, 1000);
+  const fs::path log = tmp / "serve.log";
+  const pid_t pid = spawn_saloam({"view", run.run_dir.string(), "--serve", "--port", "0", "--scan-points", "700"}, log);
+  ASSERT_GT(pid, 0);
+  std::smatch url;
+  std::string text;
+  for (int i = 0; i < 300 && !std::regex_search(text, url, std::regex(R"(http://127\.0\.0\.1:(\d+)/)")); ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    text = testing::read_text(log);
+  }
+  ASSERT_FALSE(url.empty()) << text;
+  const int port = std::stoi(url[1].str());
+
+  httplib::Client client("127.0.0.1", port);
+  const auto page = client.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  EXPECT_EQ(testing::page_data(page->body)["source"], "server");
+  const auto scan = client.Get("/scan/3");
+  ASSERT_TRUE(scan);
+  EXPECT_EQ(scan->body.size(), 7U * 700U);
+
+  kill(pid, SIGINT);
+  int status = 0;
+  ASSERT_EQ(waitpid(pid, &status, 0), pid);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << testing::read_text(log);
+  EXPECT_NE(testing::read_text(log).find("server stopped"), std::string::npos) << testing::read_text(log);
+}
+
+}  // namespace
+}  // namespace saloam

@@ -1,0 +1,210 @@
+// The viewer page: its data, the point budgets, the encodings, bad input, and
+// the local server.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <regex>
+#include <thread>
+
+#include "saloam/viewer/point_encoding.hpp"
+#include "saloam/viewer/viewer_page.hpp"
+#include "saloam/viewer/viewer_server.hpp"
+#include "testing/test_support.hpp"
+#include "viewer/viewer_fixture.hpp"
+
+// After Eigen: httplib.h includes <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::TempDir;
+
+std::size_t decoded_size(const std::string& base64_text) {
+  const std::size_t padding = base64_text.ends_with("==") ? 2 : base64_text.ends_with('=') ? 1 : 0;
+  return base64_text.size() / 4 * 3 - padding;
+}
+
+TEST(Viewer, Base64MatchesRfc4648) {
+  EXPECT_EQ(base64(""), "");
+  EXPECT_EQ(base64("f"), "Zg==");
+  EXPECT_EQ(base64("fo"), "Zm8=");
+  EXPECT_EQ(base64("foo"), "Zm9v");
+  EXPECT_EQ(base64("foobar"), "Zm9vYmFy");
+  EXPECT_EQ(base64(std::string("\xff\xfe\x00", 3)), "//4A");
+}
+
+TEST(Viewer, PageIsSelfContainedAndHoldsTheRun) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 5000);
+  const fs::path page = tmp / "view.html";
+  const ViewerPageStats stats = write_viewer_page(run.run_dir, page);
+  const std::string html = testing::read_text(page);
+  EXPECT_EQ(stats.bytes, html.size());
+  EXPECT_GT(html.size(), 800'000U) << "three.js is inlined";
+  EXPECT_NE(html.find("OrbitControls"), std::string::npos);
+  // Nothing is fetched from elsewhere: no script, style or image source, no URL to load.
+  EXPECT_FALSE(std::regex_search(html, std::regex(R"(<(script|link|img)[^>]*(src|href)\s*=)", std::regex::icase)));
+  EXPECT_EQ(html.find("fetch('http"), std::string::npos);
+
+  const auto data = testing::page_data(html);
+  ASSERT_FALSE(data.is_null());
+  EXPECT_EQ(data["source"], "embedded");
+  EXPECT_EQ(data["map"]["count"], 5000U);
+  EXPECT_EQ(data["map"]["total"], 5000U);
+  EXPECT_EQ(decoded_size(data["map"]["data"]), 7U * 5000U);
+  EXPECT_EQ(data["frames"], run.frames);
+  EXPECT_EQ(decoded_size(data["poses"]), 12U * 4U * run.frames);
+  EXPECT_EQ(data["loops"].size(), run.loops_accepted);
+  EXPECT_EQ(data["loops_verified"], run.loops_verified);
+  ASSERT_EQ(data["trajectories"].size(), 3U);
+  EXPECT_EQ(data["trajectories"][0]["name"], "ground truth");
+  EXPECT_EQ(data["trajectories"][1]["name"], "odometry");
+  EXPECT_EQ(data["trajectories"][2]["name"], "loop closed");
+  for (const auto& t : data["trajectories"]) EXPECT_EQ(decoded_size(t["positions"]), 12U * run.frames);
+  EXPECT_EQ(data["scans"]["source"], "embedded");
+  EXPECT_EQ(data["scans"]["frames"].size(), stats.scans);
+  EXPECT_EQ(stats.map_points, 5000U);
+  EXPECT_EQ(stats.loops, run.loops_accepted);
+  EXPECT_TRUE(stats.ground_truth);
+
+  // One class run per class: road, building, vegetation, car.
+  std::size_t ranged = 0;
+  for (const auto& r : data["map"]["ranges"]) ranged += r[2].get<std::size_t>();
+  EXPECT_EQ(ranged, 5000U);
+  EXPECT_EQ(data["map"]["ranges"].size(), 4U);
+}
+
+TEST(Viewer, MapAndScansKeepToTheirBudgets) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 20'000, 40, 3000);
+  ViewerOptions options;
+  options.max_map_points = 3000;
+  options.points_per_scan = 500;
+  options.max_scan_points = 5000;
+  ViewerPageStats stats;
+  const std::string html =
+      viewer_page(load_viewer_scene(run.run_dir, options), options, ViewerDataSource::kEmbedded, &stats);
+  const auto data = testing::page_data(html);
+  EXPECT_EQ(data["map"]["count"], 3000U);
+  EXPECT_EQ(data["map"]["total"], 20'000U);
+  EXPECT_EQ(decoded_size(data["map"]["data"]), 7U * 3000U);
+  EXPECT_EQ(stats.scans, 10U);  // 5000 / 500, spread over the 40 frames: every 4th
+  EXPECT_EQ(data["scans"]["frames"][1], 4U);
+  EXPECT_LE(stats.scan_points, options.max_scan_points);
+  for (const auto& scan : data["scans"]["data"]) EXPECT_EQ(decoded_size(scan), 7U * 500U);
+}
+
+TEST(Viewer, DecimationIsAnEvenSubsetSortedByClass) {
+  const LabelledCloud map = testing::fake_street(10'000);
+  const LabelledCloud small = decimate_cloud(map, 1000);
+  ASSERT_EQ(small.size(), 1000U);
+  EXPECT_TRUE(std::is_sorted(small.label.begin(), small.label.end()));
+  std::map<std::uint16_t, int> per_class;
+  for (const auto label : small.label) ++per_class[label];
+  for (const auto& [label, count] : per_class) EXPECT_NEAR(count, 250, 60) << class_name(label);
+  EXPECT_EQ(decimate_cloud(map, 20'000).size(), map.size());
+}
+
+TEST(Viewer, EncodingsRoundTripWithinTheirStep) {
+  LabelledCloud cloud = testing::fake_scan(100);
+  cloud.push_back(Eigen::Vector3f(500, 0, 0), 0, cls::kPole);  // beyond the scan encoding's range: left out
+  const std::string scan = encode_scan(cloud);
+  ASSERT_EQ(scan.size(), 7U * 100U);
+  std::int16_t x0 = 0;
+  std::memcpy(&x0, scan.data(), 2);
+  EXPECT_NEAR(x0 * kScanScale, cloud.points[0].x(), kScanScale);
+  EXPECT_EQ(static_cast<std::uint8_t>(scan[600]), class_index(cls::kRoad));
+  EXPECT_EQ(class_name(semantic_kitti_classes()[class_index(cls::kBuilding)].id), "building");
+  EXPECT_EQ(class_index(12345), unknown_class_index());
+
+  const MapQuantization q = map_quantization(cloud);
+  const std::string map = encode_map(cloud, q);
+  std::uint16_t last_x = 0;
+  std::memcpy(&last_x, map.data() + 6 * 100, 2);
+  EXPECT_NEAR(q.origin.x() + last_x * q.scale, 500.0, q.scale);
+}
+
+TEST(Viewer, BadInputGivesClearErrors) {
+  TempDir tmp;
+  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(tmp / "nowhere"); }).find("nowhere: run folder not found"),
+            std::string::npos);
+  const auto run = testing::write_fake_run(tmp.path(), 100);
+  fs::remove(run.run_dir / "map.ply");
+  const std::string missing_map = testing::input_error_of([&] { load_viewer_scene(run.run_dir); });
+  EXPECT_NE(missing_map.find("map.ply: not found"), std::string::npos) << missing_map;
+  EXPECT_NE(missing_map.find("--no-map"), std::string::npos) << missing_map;
+
+  const auto run2 = testing::write_fake_run(tmp / "b", 100);
+  std::ofstream(run2.run_dir / "loops.csv") << "query_frame,match_frame,accepted\n3,x,1\n";
+  EXPECT_NE(testing::input_error_of([&] {
+              load_viewer_scene(run2.run_dir);
+            }).find("loops.csv: line 2: 'x' is not a frame index"),
+            std::string::npos);
+  std::ofstream(run2.run_dir / "loops.csv") << "query_frame,match_frame,accepted\n300,1,1\n";
+  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(run2.run_dir); }).find("beyond the 40 poses"),
+            std::string::npos);
+
+  const auto run3 = testing::write_fake_run(tmp / "c", 100);
+  ViewerOptions options;
+  options.sequence = tmp / "no_sequence";
+  EXPECT_NE(
+      testing::input_error_of([&] { load_viewer_scene(run3.run_dir, options); }).find("sequence folder not found"),
+      std::string::npos);
+}
+
+TEST(Viewer, RunWithoutSequenceHasNoGroundTruthAndNoScans) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 100);
+  fs::remove(run.run_dir / "summary.json");
+  ViewerPageStats stats;
+  const ViewerScene scene = load_viewer_scene(run.run_dir);
+  const auto data = testing::page_data(viewer_page(scene, {}, ViewerDataSource::kEmbedded, &stats));
+  EXPECT_FALSE(stats.ground_truth);
+  EXPECT_EQ(stats.scans, 0U);
+  EXPECT_EQ(data["scans"]["source"], "none");
+  EXPECT_EQ(data["trajectories"].size(), 2U);
+}
+
+TEST(Viewer, ServerSendsThePageTheMapAndScansOnDemand) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 2000, 20, 1000);
+  ViewerOptions options;
+  options.points_per_scan = 600;
+  ViewerServer server(load_viewer_scene(run.run_dir, options), options);
+  const int port = server.bind("127.0.0.1", 0);
+  ASSERT_GT(port, 0);
+  std::thread listener([&server] { server.listen(); });
+  while (!server.running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+
+  httplib::Client client("127.0.0.1", port);
+  const auto page = client.Get("/");
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+  const auto data = testing::page_data(page->body);
+  EXPECT_EQ(data["source"], "server");
+  EXPECT_EQ(data["scans"]["source"], "server");
+  EXPECT_FALSE(data["map"].contains("data"));
+  const auto map = client.Get("/map.bin");
+  ASSERT_TRUE(map);
+  EXPECT_EQ(map->body.size(), 7U * 2000U);
+  const auto scan = client.Get("/scan/7");
+  ASSERT_TRUE(scan);
+  EXPECT_EQ(scan->status, 200);
+  EXPECT_EQ(scan->body.size(), 7U * 600U);
+  const auto beyond = client.Get("/scan/20");
+  ASSERT_TRUE(beyond);
+  EXPECT_EQ(beyond->status, 404);
+  EXPECT_NE(beyond->body.find("frame 20 out of range"), std::string::npos) << beyond->body;
+
+  server.stop();
+  listener.join();
+  EXPECT_FALSE(server.running());
+}
+
+}  // namespace
+}  // namespace saloam
