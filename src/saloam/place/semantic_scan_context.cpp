@@ -122,32 +122,55 @@ double coarse_shift(const std::vector<float>& query, const std::vector<float>& c
 
 struct Correspondences {
   Eigen::Matrix2Xd query, candidate;  ///< matched key points (candidate's moved by the current estimate)
+  std::vector<int> pairs;             ///< per query key sector: the matched candidate key sector (-1: none)
   int count = 0;
 };
 
-/// For each query key point, the nearest moved candidate key point among
-/// those whose azimuth (after the move) falls within `window` sectors of the
-/// query point's sector, kept when closer than the gate in x and in y.
-/// `buckets` lists the moved candidate key points by sector (CSR: `start`
-/// has n + 1 offsets into `members`).
-Correspondences find_correspondences(const SemanticScanContext& query, const std::vector<Eigen::Vector2d>& moved,
-                                     const std::vector<int>& start, const std::vector<int>& members,
+/// The candidate's key points moved by the current estimate, filed by their
+/// sector in the query's frame (CSR: `start` has key_sectors + 1 offsets
+/// into `members`; a counting sort, so the order is deterministic).
+struct MovedKeyPoints {
+  std::vector<Eigen::Vector2d> position;
+  std::vector<int> start, members;
+
+  void build(const std::vector<Eigen::Vector2d>& points, int sectors) {
+    position = points;
+    std::vector<int> sector(points.size());
+    start.assign(static_cast<std::size_t>(sectors) + 1, 0);
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      sector[k] = sector_of(points[k].x(), points[k].y(), sectors);
+      ++start[static_cast<std::size_t>(sector[k]) + 1];
+    }
+    for (std::size_t s = 1; s < start.size(); ++s) start[s] += start[s - 1];
+    members.assign(points.size(), 0);
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (std::size_t k = 0; k < points.size(); ++k)
+      members[static_cast<std::size_t>(fill[static_cast<std::size_t>(sector[k])]++)] = static_cast<int>(k);
+  }
+};
+
+/// For each query key point, the nearest moved candidate key point whose
+/// azimuth (after the move) is within icp_window sectors of the query
+/// point's, kept when closer than the gate in x and in y.
+Correspondences find_correspondences(const SemanticScanContext& query, const MovedKeyPoints& moved,
                                      const SscConfig& config) {
   const int n = config.key_sectors;
   const int window = std::min(config.icp_window, (n - 1) / 2);  // no sector visited twice
   Correspondences c;
   c.query.resize(2, n);
   c.candidate.resize(2, n);
+  c.pairs.assign(static_cast<std::size_t>(n), -1);
   for (int j = 0; j < n; ++j) {
     if (query.key_range[static_cast<std::size_t>(j)] <= 0) continue;
     const Eigen::Vector2d q = query.key_points[static_cast<std::size_t>(j)].cast<double>();
     double best = std::numeric_limits<double>::infinity();
     int best_k = -1;
-    for (int s = j - window; s <= j + window; ++s) {
-      const auto bucket = static_cast<std::size_t>(((s % n) + n) % n);
-      for (int m = start[bucket]; m < start[bucket + 1]; ++m) {
-        const int k = members[static_cast<std::size_t>(m)];
-        const double d = (moved[static_cast<std::size_t>(k)] - q).squaredNorm();
+    int sector = (j - window + n) % n;  // then stepped with a wrap, without a division per sector
+    for (int step = 0; step <= 2 * window; ++step, sector = sector + 1 == n ? 0 : sector + 1) {
+      const auto s = static_cast<std::size_t>(sector);
+      for (int m = moved.start[s]; m < moved.start[s + 1]; ++m) {
+        const int k = moved.members[static_cast<std::size_t>(m)];
+        const double d = (moved.position[static_cast<std::size_t>(k)] - q).squaredNorm();
         if (d < best) {
           best = d;
           best_k = k;
@@ -155,33 +178,14 @@ Correspondences find_correspondences(const SemanticScanContext& query, const std
       }
     }
     if (best_k < 0) continue;
-    const Eigen::Vector2d p = moved[static_cast<std::size_t>(best_k)];
+    const Eigen::Vector2d p = moved.position[static_cast<std::size_t>(best_k)];
     if (std::abs(p.x() - q.x()) >= config.icp_gate || std::abs(p.y() - q.y()) >= config.icp_gate) continue;
     c.query.col(c.count) = q;
     c.candidate.col(c.count) = p;
+    c.pairs[static_cast<std::size_t>(j)] = best_k;
     ++c.count;
   }
   return c;
-}
-
-/// Sorts the candidate's key points (present ones, moved) into the query's
-/// key sectors by azimuth (counting sort: deterministic order).
-void bucket_by_sector(const std::vector<Eigen::Vector2d>& moved, const std::vector<char>& present, int sectors,
-                      std::vector<int>& start, std::vector<int>& members) {
-  std::vector<int> sector_of_point(moved.size(), -1);
-  start.assign(static_cast<std::size_t>(sectors) + 1, 0);
-  for (std::size_t k = 0; k < moved.size(); ++k) {
-    if (!present[k]) continue;
-    sector_of_point[k] = sector_of(moved[k].x(), moved[k].y(), sectors);
-    ++start[static_cast<std::size_t>(sector_of_point[k]) + 1];
-  }
-  for (std::size_t s = 0; s < static_cast<std::size_t>(sectors); ++s) start[s + 1] += start[s];
-  members.assign(static_cast<std::size_t>(start.back()), 0);
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (std::size_t k = 0; k < moved.size(); ++k) {
-    if (sector_of_point[k] < 0) continue;
-    members[static_cast<std::size_t>(fill[static_cast<std::size_t>(sector_of_point[k])]++)] = static_cast<int>(k);
-  }
 }
 
 /// The rigid 2D motion (rotation about the origin, then translation) that
@@ -208,25 +212,33 @@ Eigen::Isometry2d fit_rigid_2d(const Correspondences& c) {
 }
 
 /// Step 2: 2D ICP on the key points from the coarse yaw; T_query<-candidate.
+/// Ends after icp_iterations, when no pair is left, when the pairs repeat
+/// those of the previous iteration (the fit is then already their optimum)
+/// or of the one before (nearest neighbours alternating between two sets),
+/// or when a step moves less than 1 mm and 0.001 degrees.
 SscAlignment refine_alignment(const SemanticScanContext& query, const SemanticScanContext& candidate, double coarse_yaw,
                               const SscConfig& config) {
-  const auto n = static_cast<std::size_t>(config.key_sectors);
-  std::vector<char> has_point(n);
-  for (std::size_t k = 0; k < n; ++k) has_point[k] = candidate.key_range[k] > 0;
+  std::vector<Eigen::Vector2d> present;  // the candidate's key points, by sector
+  for (std::size_t k = 0; k < candidate.key_range.size(); ++k)
+    if (candidate.key_range[k] > 0) present.push_back(candidate.key_points[k].cast<double>());
   Eigen::Isometry2d estimate = Eigen::Isometry2d::Identity();
   estimate.linear() = Eigen::Rotation2Dd(coarse_yaw).toRotationMatrix();
-  std::vector<Eigen::Vector2d> moved(n);
-  std::vector<int> start, members;
+  std::vector<Eigen::Vector2d> points(present.size());
+  MovedKeyPoints moved;
+  std::vector<int> previous_pairs, earlier_pairs;
   SscAlignment result;
   for (int iteration = 0; iteration < config.icp_iterations; ++iteration) {
-    for (std::size_t k = 0; k < n; ++k) moved[k] = estimate * candidate.key_points[k].cast<double>();
-    bucket_by_sector(moved, has_point, config.key_sectors, start, members);
-    const Correspondences c = find_correspondences(query, moved, start, members, config);
+    for (std::size_t k = 0; k < present.size(); ++k) points[k] = estimate * present[k];
+    moved.build(points, config.key_sectors);
+    Correspondences c = find_correspondences(query, moved, config);
     result.correspondences = c.count;
-    if (c.count == 0) break;
+    result.iterations = iteration + 1;
+    if (c.count == 0 || c.pairs == previous_pairs || c.pairs == earlier_pairs) break;
     const Eigen::Isometry2d step = fit_rigid_2d(c);
     estimate = step * estimate;
-    if (step.translation().norm() < 1e-4 && std::abs(Eigen::Rotation2Dd(step.linear()).angle()) < 1e-6) break;
+    if (step.translation().norm() < 1e-3 && std::abs(Eigen::Rotation2Dd(step.linear()).angle()) < 2e-5) break;
+    earlier_pairs = std::move(previous_pairs);
+    previous_pairs = std::move(c.pairs);
   }
   result.yaw = wrap_angle(Eigen::Rotation2Dd(estimate.linear()).angle());
   result.translation = estimate.translation();

@@ -76,6 +76,7 @@ struct SscAlignment {
   double yaw = 0;                                       ///< [rad] in (-pi, pi]
   Eigen::Vector2d translation = Eigen::Vector2d::Zero();  ///< [m]
   int correspondences = 0;  ///< key-point pairs of the last ICP iteration
+  int iterations = 0;       ///< ICP iterations run
   bool translation_capped = false;  ///< the ICP's translation exceeded max_translation and was reset to 0
 };
 
