@@ -1,5 +1,6 @@
-// `saloam place-eval`: place-recognition evaluation of SGPR, Scan Context or
-// their hybrid (the loop detectors of `saloam slam`, one PlaceRecognizer) on
+// `saloam place-eval`: place-recognition evaluation of SGPR, Scan Context,
+// their hybrid or Semantic Scan Context (the loop detectors of `saloam slam`,
+// one PlaceRecognizer) on
 // a sequence with ground-truth poses (SGPR's protocol: every frame against
 // the earlier frames except the last 50; match within 3 m, non-match beyond
 // 20 m). Prints max F1, precision at 100 % recall and recall at 100 %
@@ -108,11 +109,12 @@ int run_place_eval(const PlaceEvalArgs& args) {
   const bool sgpr = uses_sgpr(detector);
   SequenceOptions options;
   if (!args.labels.empty()) options.labels_dir = args.labels;
-  options.ignore_labels = !sgpr;
+  options.ignore_labels = !needs_labels(detector);
   const SequenceReader reader(args.sequence, options);
   if (!reader.has_poses()) throw InputError(args.sequence, "no poses.txt: place-eval needs ground-truth poses");
-  if (sgpr && !reader.has_labels())
-    throw InputError(args.sequence, "no labels/ folder (give --labels DIR): SGPR needs semantic labels");
+  if (needs_labels(detector) && !reader.has_labels())
+    throw InputError(args.sequence, fmt::format("no labels/ folder (give --labels DIR): {} needs semantic labels",
+                                                sgpr ? "SGPR" : "SSC"));
   // Distances between LiDAR positions; with --no-calib those of poses.txt as given.
   if (!args.no_calib && !reader.has_calib()) {
     throw InputError(reader.root() / "calib.txt", "not found: needed for the LiDAR positions of poses.txt; pass "
@@ -132,7 +134,7 @@ int run_place_eval(const PlaceEvalArgs& args) {
   if (sgpr) network.emplace(SgprNetwork::load(model));
   GraphBuilderConfig graph_config;
   graph_config.use_instances = !args.no_instances;
-  const PlaceRecognizer recognizer(detector, std::move(network), graph_config);
+  const PlaceRecognizer recognizer(detector, std::move(network), graph_config, ScanContextConfig{}, config.loop.ssc);
 
   // 1. One descriptor per frame (graph + pooled embedding, and/or Scan Context).
   std::vector<PlaceDescriptor> descriptors(n);
@@ -143,7 +145,8 @@ int run_place_eval(const PlaceEvalArgs& args) {
   std::vector<std::uint8_t> readable(n, 1);
   std::mutex skipped_mutex;
   std::vector<std::string> skipped;
-  for_each_frame(n, sgpr ? "graphs + embeddings" : "scan contexts", [&](std::size_t i) {
+  const char* describe_label = sgpr ? "graphs + embeddings" : uses_ssc(detector) ? "semantic scan contexts" : "scan contexts";
+  for_each_frame(n, describe_label, [&](std::size_t i) {
     LabelledCloud cloud;
     try {
       cloud = reader.load_scan(i);
@@ -239,13 +242,14 @@ int run_place_eval(const PlaceEvalArgs& args) {
 }
 
 const CommandRegistration kRegistration{Command{
-    "place-eval", "Place-recognition evaluation (SGPR, Scan Context or hybrid) against ground-truth poses", 42,
+    "place-eval", "Place-recognition evaluation (SGPR, Scan Context, hybrid or SSC) against ground-truth poses", 42,
     [](CLI::App& app) {
       auto args = std::make_shared<PlaceEvalArgs>();
       args->config.add_to(app);
       app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt, calib.txt)")->required();
-      app.add_option("--method", args->method, "sgpr, scancontext or hybrid (mean of both scores)")
-          ->check(CLI::IsMember({"sgpr", "scancontext", "hybrid"}))
+      app.add_option("--method", args->method,
+                     "sgpr, scancontext, hybrid (mean of both scores) or ssc (Semantic Scan Context, loop.ssc.*)")
+          ->check(CLI::IsMember({"sgpr", "scancontext", "hybrid", "ssc"}))
           ->capture_default_str();
       app.add_option("--model", args->model,
                      "SGPR weights (.sgw); default: config loop.sgpr_model, else the shipped models/sgpr/saloam.sgw");

@@ -75,7 +75,7 @@ int run_slam_command(const SlamOptions& options) {
   }
   SequenceOptions seq_options;
   if (!options.labels.empty()) seq_options.labels_dir = options.labels;
-  seq_options.ignore_labels = !config.odometry.use_semantics && !uses_sgpr(parse_place_detector(config.loop.detector));
+  seq_options.ignore_labels = !config.odometry.use_semantics && !needs_labels(parse_place_detector(config.loop.detector));
   const SequenceReader reader(options.sequence, seq_options);
   SlamRunOptions run_options;
   std::tie(run_options.first_frame, run_options.end_frame) = FrameRange::parse(options.frames).clip(reader.size());
@@ -105,8 +105,8 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--out", options->out, "Output folder")->required();
       app.add_option("--labels", options->labels, "Folder of .label files to use instead of SEQ_DIR/labels");
       app.add_option("--frames", options->frames, "Frame range A:B (B exclusive; A: = to the end)");
-      app.add_option("--detector", options->detector, "Loop detector: scancontext, sgpr or hybrid (loop.detector)")
-          ->check(CLI::IsMember({"scancontext", "sgpr", "hybrid"}));
+      app.add_option("--detector", options->detector, "Loop detector: scancontext, sgpr, hybrid or ssc (loop.detector)")
+          ->check(CLI::IsMember({"scancontext", "sgpr", "hybrid", "ssc"}));
       app.add_option("--model", options->model, "SGPR weights (.sgw) for the sgpr and hybrid detectors (loop.sgpr_model)")
           ->check(CLI::ExistingFile);
       app.add_flag("--no-map", options->no_map, "Skip the global map (map.ply, map.png)");

@@ -138,7 +138,7 @@ TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
                                  &output),
             0);
 
-  for (const std::string method : {"sgpr", "scancontext"}) {
+  for (const std::string method : {"sgpr", "scancontext", "ssc"}) {
     const auto out = tmp / ("eval_" + method);
     const auto model = testing::shared_dir() / "models/sgpr/sgpr_kitti.sgw";
     ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method {} --model {} --out {}", quoted(seq),
@@ -166,7 +166,39 @@ TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
   const auto sc = nlohmann::json::parse(std::ifstream(tmp / "eval_scancontext/summary.json"));
   EXPECT_GT(sc["max_f1"].get<double>(), 0.5);
   EXPECT_NE(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method nope", quoted(seq))), &output), 0);
-  EXPECT_NE(output.find("nope not in {sgpr,scancontext,hybrid}"), std::string::npos) << output;
+  EXPECT_NE(output.find("nope not in {sgpr,scancontext,hybrid,ssc}"), std::string::npos) << output;
+}
+
+// SSC on a short simulated street (16 beams, 8 frames 1.4 m apart): pairs
+// within 3 m are matches, beyond 7 m non-matches.
+TEST(LoopCli, PlaceEvalSscOnASimulatedStreet) {
+  testing::TempDir tmp;
+  const auto seq = tmp / "seq";
+  std::string output;
+  ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format(
+                                     "simulate --out {} --beams 16 --azimuth-steps 600 --preset straight --frames 0:16 "
+                                     "--stride 2 --labels noisy",
+                                     quoted(seq))),
+                                 &output),
+            0)
+      << output;
+  const auto out = tmp / "eval";
+  ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method ssc --exclude 0 --positive 3 "
+                                                        "--negative 7 --out {}",
+                                                        quoted(seq), quoted(out))),
+                                 &output),
+            0)
+      << output;
+  EXPECT_NE(output.find("semantic scan contexts"), std::string::npos) << output;
+  const auto summary = nlohmann::json::parse(std::ifstream(out / "summary.json"));
+  EXPECT_EQ(summary["method"].get<std::string>(), "ssc");
+  EXPECT_GE(summary["positive_pairs"].get<int>(), 6);
+  EXPECT_GE(summary["negative_pairs"].get<int>(), 4);
+  EXPECT_GT(summary["max_f1"].get<double>(), 0.5);
+  // Without labels SSC has nothing to describe.
+  std::filesystem::rename(seq / "labels", tmp / "labels_aside");
+  EXPECT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method ssc", quoted(seq))), &output), 2);
+  EXPECT_NE(output.find("SSC needs semantic labels"), std::string::npos) << output;
 }
 
 TEST(LoopCli, PlaceEvalLeavesOutUnreadableFrames) {

@@ -211,7 +211,7 @@ TEST(ConfigRanges, RepresentativeValuesNameKeyValueAndRange) {
   EXPECT_EQ(override_error("loop.zeta=1.5"), "--set loop.zeta=1.5: 'loop.zeta' = 1.5 is not allowed (valid: [0, 1])");
   EXPECT_EQ(override_error("loop.detector=nope"),
             "--set loop.detector=nope: 'loop.detector' = 'nope' is not allowed "
-            "(valid: one of sgpr, scancontext, hybrid)");
+            "(valid: one of sgpr, scancontext, hybrid, ssc)");
   EXPECT_NE(override_error("loop.acceptance=strict").find("(valid: one of normalized, loss)"), std::string::npos);
   EXPECT_EQ(override_error("odometry.class_voxel_size.pole=0"),
             "--set odometry.class_voxel_size.pole=0: 'odometry.class_voxel_size.pole' = 0 is not allowed "
@@ -308,7 +308,7 @@ TEST(ConfigRanges, SavedYamlShowsEachRange) {
   for (const char* line : {"local_map_frames: 20  # N_m: frames in the local map [>= 1]",
                            "zeta: 0.95  # zeta: SGPR score threshold [0, 1]",
                            "detector: scancontext  # place-recognition scorer "
-                           "[one of sgpr, scancontext, hybrid]",
+                           "[one of sgpr, scancontext, hybrid, ssc]",
                            "max_runner_up_ratio: .inf  # uniqueness: max inliers of a distinct fit / best [0, .inf]",
                            "use_semantics: true  # semantic assistance on/off\n",
                            "seed: 42  # seed of the N_candi random draw\n"}) {

@@ -205,6 +205,11 @@ void check_consistency(const SaloamConfig& config, const std::string& origin) {
                                   "[0, 'odometry.features.sweep_duration' = {}]",
                                   origin, number_text(f.pose_time_in_sweep), number_text(f.sweep_duration)));
   }
+  const SscConfig& ssc = config.loop.ssc;
+  if (!(ssc.inner_radius < ssc.outer_radius)) {
+    throw ConfigError(fmt::format("{}: 'loop.ssc.inner_radius' = {} must be less than 'loop.ssc.outer_radius' = {}",
+                                  origin, number_text(ssc.inner_radius), number_text(ssc.outer_radius)));
+  }
 }
 
 // The full key of a bare field name ("alpha") when exactly one section has it; else `key` as given.

@@ -145,11 +145,34 @@ struct OdometryConfig {
   int threads = 1;               ///< worker threads for association (0 = all cores)
 };
 
+/// Semantic Scan Context (Li et al., "SSC: Semantic Scan Context for
+/// Large-Scale Place Recognition", IROS 2021), the "ssc" loop detector. The
+/// defaults are the paper's (its public code's): 24 rings x 360 sectors over
+/// 5..50 m, 360 key-point sectors, 100 ICP iterations, 3 m gate, 5 m cap.
+struct SscConfig {
+  int rings = 24;                ///< rings of the descriptor between inner_radius and outer_radius
+  int sectors = 360;             ///< sectors of the descriptor (1 degree each)
+  double inner_radius = 5.0;     ///< [m] horizontal range where the descriptor starts
+  double outer_radius = 50.0;    ///< [m] horizontal range where the descriptor ends
+  int key_sectors = 360;         ///< sectors of the key-point projection used for the alignment
+  int icp_iterations = 100;      ///< at most this many iterations of the 2D ICP of the alignment
+  int icp_window = 10;           ///< [sectors] correspondences are searched this far either side
+  double icp_gate = 3.0;         ///< [m] a correspondence farther than this in x or y is ignored
+  /// [m] an alignment translating more than this in x or y is not trusted:
+  /// the translation falls back to zero (the yaw stays).
+  double max_translation = 5.0;
+  /// [m] side of the square x-y cells that thin each scan before it is stored
+  /// (one point per cell, of its highest-priority class); the descriptor of the
+  /// aligned candidate is built from these points.
+  double cell_size = 0.5;
+};
+
 /// Loop closure (paper Sec. III-C): candidates (Eq. 3), similarity scoring,
 /// geometric verification by the semantic-assisted ICP.
 struct LoopClosureConfig {
-  /// Place-recognition scorer: "sgpr" (the paper's), "scancontext" or
-  /// "hybrid" (mean of both scores). The default is the one measured best on
+  /// Place-recognition scorer: "sgpr" (the paper's), "scancontext",
+  /// "hybrid" (mean of SGPR and Scan Context scores) or "ssc" (Semantic Scan
+  /// Context; needs labels). The default is the one measured best on
   /// loop closure (docs/loop_closure.md): the pretrained SGPR weights
   /// transfer poorly to simulated scans.
   std::string detector = "scancontext";
@@ -161,6 +184,11 @@ struct LoopClosureConfig {
   /// Scan Context score threshold (score = 1 - column-shift distance);
   /// also used by "hybrid" for the mean of both scores.
   double scancontext_zeta = 0.6;
+  /// Semantic Scan Context score threshold (score = fraction of the occupied
+  /// cells whose classes agree after the alignment). Scores are low on
+  /// noisy labels: place-eval's max-F1 threshold on simulated 05 (every 5th
+  /// frame, 64 beams, noisy labels) is 0.21, at precision 0.985.
+  double ssc_zeta = 0.2;
   int num_loop = 5;           ///< N_loop: best-scoring pairs (score > threshold) that go on to verification
   /// [m] Beyond the paper: the candidate nearest to the query by the current
   /// estimate is verified too when nearer than this, whatever its score
@@ -202,6 +230,7 @@ struct LoopClosureConfig {
   double search_interval_after_loop = 20.0;
   std::uint64_t seed = 42;     ///< random generator of the N_candi draw (deterministic output)
   std::string sgpr_model;      ///< SGPR weights (.sgw); required when the detector uses SGPR
+  SscConfig ssc;               ///< descriptor and alignment of the "ssc" detector
 };
 
 /// The SLAM back end: keyframes, pose graph and global map.
@@ -272,13 +301,14 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
 
 template <class Visitor>
 void visit_fields(LoopClosureConfig& c, Visitor&& v) {
-  v("detector", c.detector, "place-recognition scorer", OneOf{"sgpr", "scancontext", "hybrid"});
+  v("detector", c.detector, "place-recognition scorer", OneOf{"sgpr", "scancontext", "hybrid", "ssc"});
   v("sigma", c.sigma, "sigma: odometry drift rate of Eq. 3 [m per m travelled]", AtLeast{0});
   v("delta_min", c.delta_min, "delta_min [m]: min search radius of Eq. 3", AtLeast{0});
   v("delta_max", c.delta_max, "delta_max [m]: max search radius of Eq. 3", Above{0});
   v("num_candidates", c.num_candidates, "N_candi: candidates per query (random draw beyond)", AtLeast{1});
   v("zeta", c.zeta, "zeta: SGPR score threshold", Range{0, 1});
   v("scancontext_zeta", c.scancontext_zeta, "Scan Context (and hybrid) score threshold", Range{0, 1});
+  v("ssc_zeta", c.ssc_zeta, "Semantic Scan Context score threshold", Range{0, 1});
   v("num_loop", c.num_loop, "N_loop: best pairs verified per query", AtLeast{1});
   v("proximity_radius", c.proximity_radius, "[m] also verify the nearest candidate within this (0 = off)", AtLeast{0});
   v("delta_r", c.delta_r, "delta_r: ICP loss threshold (Eq. 2 sum) [m]", Above{0});
@@ -293,6 +323,20 @@ void visit_fields(LoopClosureConfig& c, Visitor&& v) {
   v("search_interval_after_loop", c.search_interval_after_loop, "[m] travel before searching again after a loop", AtLeast{0});
   v("seed", c.seed, "seed of the N_candi random draw", Any{});
   v("sgpr_model", c.sgpr_model, "SGPR weights (.sgw)", Any{});
+}
+
+template <class Visitor>
+void visit_fields(SscConfig& c, Visitor&& v) {
+  v("rings", c.rings, "rings between inner_radius and outer_radius", Range{1, 1000});
+  v("sectors", c.sectors, "sectors of the descriptor", Range{1, 3600});
+  v("inner_radius", c.inner_radius, "[m] range where the descriptor starts", AtLeast{0});
+  v("outer_radius", c.outer_radius, "[m] range where the descriptor ends", Above{0});
+  v("key_sectors", c.key_sectors, "sectors of the key-point projection (alignment)", Range{4, 3600});
+  v("icp_iterations", c.icp_iterations, "max iterations of the alignment's 2D ICP (0 = yaw only)", Range{0, 1000});
+  v("icp_window", c.icp_window, "[sectors] correspondence search either side", Range{0, 1800});
+  v("icp_gate", c.icp_gate, "[m] max x or y offset of a correspondence", Above{0});
+  v("max_translation", c.max_translation, "[m] larger x or y alignment falls back to 0", AtLeast{0});
+  v("cell_size", c.cell_size, "[m] x-y cell thinning the stored points", Range{0.05, 5});
 }
 
 template <class Visitor>
@@ -312,13 +356,15 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
   v("odometry", c.odometry);
   v("odometry.features", c.odometry.features);
   v("loop", c.loop);
+  v("loop.ssc", c.loop.ssc);
   v("slam", c.slam);
 }
 
 /// Throws ConfigError, starting with `origin`, for the first field outside
 /// its declared range (NaN never passes) or the first contradicting pair:
 /// odometry.features.min_range < max_range, loop.delta_min <= delta_max,
-/// odometry.features.pose_time_in_sweep <= sweep_duration.
+/// odometry.features.pose_time_in_sweep <= sweep_duration,
+/// loop.ssc.inner_radius < outer_radius.
 void validate_config(const SaloamConfig& config, std::string_view origin = "configuration");
 /// Loads a YAML file over the defaults. Unknown keys, wrong types and
 /// invalid values (validate_config) are errors naming the file and the key.

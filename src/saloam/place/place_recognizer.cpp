@@ -3,6 +3,7 @@
 #include <numbers>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
@@ -13,7 +14,8 @@ PlaceDetector parse_place_detector(std::string_view name) {
   if (name == "sgpr") return PlaceDetector::kSgpr;
   if (name == "scancontext") return PlaceDetector::kScanContext;
   if (name == "hybrid") return PlaceDetector::kHybrid;
-  throw ConfigError(fmt::format("unknown place-recognition detector '{}': use sgpr, scancontext or hybrid", name));
+  if (name == "ssc") return PlaceDetector::kSsc;
+  throw ConfigError(fmt::format("unknown place-recognition detector '{}': use sgpr, scancontext, hybrid or ssc", name));
 }
 
 std::string_view place_detector_name(PlaceDetector detector) {
@@ -21,16 +23,19 @@ std::string_view place_detector_name(PlaceDetector detector) {
     case PlaceDetector::kSgpr: return "sgpr";
     case PlaceDetector::kScanContext: return "scancontext";
     case PlaceDetector::kHybrid: return "hybrid";
+    case PlaceDetector::kSsc: return "ssc";
   }
   return "?";
 }
 
 PlaceRecognizer::PlaceRecognizer(PlaceDetector detector, std::optional<SgprNetwork> network,
-                                 GraphBuilderConfig graph_config, ScanContextConfig context_config)
+                                 GraphBuilderConfig graph_config, ScanContextConfig context_config,
+                                 SscConfig ssc_config)
     : detector_(detector),
       network_(std::move(network)),
       graph_config_(graph_config),
-      context_config_(context_config) {
+      context_config_(context_config),
+      ssc_config_(ssc_config) {
   if (uses_sgpr(detector_) && !network_) {
     throw std::invalid_argument("PlaceRecognizer: the SGPR detector needs the network's weights");
   }
@@ -43,6 +48,7 @@ PlaceDescriptor PlaceRecognizer::describe(const LabelledCloud& scan) const {
     d.embedding = network_->embed(d.graph);
   }
   if (uses_scan_context(detector_)) d.context = make_scan_context(scan.points, context_config_);
+  if (uses_ssc(detector_)) d.ssc = make_semantic_scan_context(scan, ssc_config_);
   return d;
 }
 
@@ -69,11 +75,23 @@ std::vector<PlaceMatch> PlaceRecognizer::match(const PlaceDescriptor& query,
       matches[k].yaw = yaw;
     }
   }
+  if (uses_ssc(detector_)) {
+    for (std::size_t k = 0; k < candidates.size(); ++k) {
+      const SscMatch m = match_semantic_scan_contexts(query.ssc, candidates[k]->ssc, ssc_config_);
+      matches[k].ssc_score = m.score;
+      // SSC aligns the candidate onto the query (T_query<-candidate); the
+      // match reports T_candidate<-query.
+      const Eigen::Rotation2Dd inverse_rotation(-m.alignment.yaw);
+      matches[k].yaw = -m.alignment.yaw;
+      matches[k].translation = -(inverse_rotation * m.alignment.translation);
+    }
+  }
   for (auto& m : matches) {
     switch (detector_) {
       case PlaceDetector::kSgpr: m.score = m.sgpr_score; break;
       case PlaceDetector::kScanContext: m.score = m.scancontext_score; break;
       case PlaceDetector::kHybrid: m.score = 0.5 * (m.sgpr_score + m.scancontext_score); break;
+      case PlaceDetector::kSsc: m.score = m.ssc_score; break;
     }
   }
   return matches;

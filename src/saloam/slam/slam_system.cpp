@@ -55,13 +55,18 @@ std::size_t StoredFeatures::bytes() const {
 SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> network)
     : config_(config),
       odometry_(config.odometry),
-      places_(parse_place_detector(config.loop.detector), std::move(network)),
+      places_(parse_place_detector(config.loop.detector), std::move(network), GraphBuilderConfig{}, ScanContextConfig{},
+              config.loop.ssc),
       gate_(CandidateGate::from_config(config.loop)),
       verification_(LoopVerificationSettings::from_config(config)),
       rng_(config.loop.seed) {
   graph_options_.max_iterations = config.slam.max_iterations;
   graph_options_.loop_robust_scale = config.slam.loop_robust_scale;
-  score_threshold_ = places_.detector() == PlaceDetector::kSgpr ? config.loop.zeta : config.loop.scancontext_zeta;
+  switch (places_.detector()) {
+    case PlaceDetector::kSgpr: score_threshold_ = config.loop.zeta; break;
+    case PlaceDetector::kSsc: score_threshold_ = config.loop.ssc_zeta; break;
+    default: score_threshold_ = config.loop.scancontext_zeta; break;
+  }
 }
 
 SlamSystem::~SlamSystem() = default;
@@ -213,11 +218,13 @@ LoopRecord SlamSystem::verify(std::size_t query, const Proposal& proposal) const
     if (keyframes_[query].travelled - keyframes_[k].travelled < 0.5 * gate_.exclude_recent_distance) continue;
     submap.add(keyframes_[k].features.expand(), match_inverse * graph_.pose(k));
   }
-  // Initial guesses: the current estimates, and the descriptor's yaw in place.
+  // Initial guesses: the current estimates, and the descriptor's yaw (with
+  // its x-y offset when it gives one, SSC's) in place.
   std::vector<Pose> guesses{orthonormalized(match_inverse * graph_.pose(query))};
   if (proposal.match.yaw) {
     Pose yaw_guess = Pose::Identity();
     yaw_guess.linear() = Eigen::AngleAxisd(*proposal.match.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    if (proposal.match.translation) yaw_guess.translation().head<2>() = *proposal.match.translation;
     const Pose difference = guesses.front().inverse() * yaw_guess;
     if (difference.translation().norm() > kSameGuessTranslation || rotation_angle(difference) > kSameGuessRotation) {
       guesses.push_back(yaw_guess);
@@ -284,6 +291,7 @@ std::size_t SlamSystem::keyframe_bytes() const {
     bytes += static_cast<std::size_t>(kf.place.context.descriptor.size() + kf.place.context.unit_columns.size() +
                                       kf.place.context.ring_key.size()) *
              sizeof(float);
+    bytes += kf.place.ssc.bytes();
   }
   return bytes;
 }
