@@ -18,6 +18,7 @@
 #include "command.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
@@ -26,6 +27,7 @@
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
 #include "saloam/sim/simulator.hpp"
+#include "saloam/viewer/viewer_page.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -116,6 +118,20 @@ void print_summary(const SlamRunResult& slam, const std::optional<TrajectoryEval
   }
 }
 
+/// The 3D view of the run (as `saloam view OUT/slam`). A streamed sequence
+/// left no scans and no ground truth on disk: the page then shows the map,
+/// the estimated trajectories and the loops.
+void write_view_page(const std::filesystem::path& run_dir, bool streamed) {
+  try {
+    const ViewerPageStats s = write_viewer_page(run_dir, run_dir / "view.html");
+    std::cout << fmt::format("3D view: {} ({:.1f} MB; open it in a browser{})\n", (run_dir / "view.html").string(),
+                             static_cast<double>(s.bytes) / 1e6,
+                             streamed ? "; scans and ground truth in it need --keep-sequence" : "");
+  } catch (const InputError& e) {
+    spdlog::warn("no view.html: {}", e.what());
+  }
+}
+
 int run_demo(const DemoOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   SaloamConfig config = options.config.resolve();
@@ -180,6 +196,7 @@ int run_demo(const DemoOptions& options) {
   std::cout << fmt::format("plots: {}, {}\n", (out / "slam/trajectories.png").string(),
                            (out / "slam/eval_slam.png").string());
   std::cout << "trajectories: " << (out / "slam/poses.txt").string() << " (KITTI camera frame)\n";
+  write_view_page(out / "slam", !from_disk && !options.keep_sequence);
   return 0;
 }
 

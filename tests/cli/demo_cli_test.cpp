@@ -33,7 +33,7 @@ TEST(DemoCli, ShortRunWritesEveryOutputAndAReadableTable) {
       << output;
   for (const char* file : {"slam/poses.txt",
                            "slam/poses_odometry.txt", "slam/loops.csv", "slam/eval_slam.json", "slam/eval_odometry.png",
-                           "slam/trajectories.png", "slam/map.ply", "slam/map.png", "odometry_baseline/poses.txt",
+                           "slam/trajectories.png", "slam/map.ply", "slam/map.png", "slam/view.html", "odometry_baseline/poses.txt",
                            "eval_baseline.png"}) {
     EXPECT_TRUE(fs::exists(out / file)) << file;
   }
