@@ -66,6 +66,7 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       const Pose sensor = column_pose(lidar, sweep, c);
       const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
       const double az = lidar.column_azimuth(c);
+      const double cos_az = std::cos(az), sin_az = std::sin(az);
       // The sensor stays on a car on the ground (World::sensor_origin); the
       // points are in the sensor frame, so a height error of the pose, if
       // any, shows up as it does in real data: between poses and scans.
@@ -73,7 +74,7 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       column_offset[static_cast<std::size_t>(c)] = static_cast<float>(origin.z() - sensor.translation().z());
       // Moving objects at this column's time, kept only near the column's vertical plane.
       world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
-      const Eigen::Vector3d heading = sensor.linear() * Eigen::Vector3d(std::cos(az), std::sin(az), 0.0);
+      const Eigen::Vector3d heading = sensor.linear() * Eigen::Vector3d(cos_az, sin_az, 0.0);
       Eigen::Vector2d h2 = heading.head<2>();
       if (h2.norm() > 1e-9) h2.normalize();
       near.clear();
@@ -84,8 +85,8 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       }
       Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
       for (int b = 0; b < beams; ++b) {
-        const Eigen::Vector3d dir_s(cos_el[static_cast<std::size_t>(b)] * std::cos(az),
-                                    cos_el[static_cast<std::size_t>(b)] * std::sin(az), sin_el[static_cast<std::size_t>(b)]);
+        const Eigen::Vector3d dir_s(cos_el[static_cast<std::size_t>(b)] * cos_az, cos_el[static_cast<std::size_t>(b)] * sin_az,
+                                    sin_el[static_cast<std::size_t>(b)]);
         const Eigen::Vector3d dir = sensor.linear() * dir_s;
         Return& out = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
         out.valid = false;
