@@ -19,6 +19,7 @@
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
@@ -119,14 +120,21 @@ void print_summary(const SlamRunResult& slam, const std::optional<TrajectoryEval
 }
 
 /// The 3D view of the run (as `saloam view OUT/slam`). A streamed sequence
-/// left no scans and no ground truth on disk: the page then shows the map,
-/// the estimated trajectories and the loops.
-void write_view_page(const std::filesystem::path& run_dir, bool streamed) {
+/// is not on disk: its ground truth comes from the simulation, and the scans
+/// the page embeds are rendered again.
+void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequence* streamed) {
+  ViewerOptions options;
+  if (streamed) {
+    const Pose tr = streamed->velo_to_cam();
+    std::vector<Pose> ground_truth;
+    for (const Pose& camera : streamed->camera_poses()) ground_truth.push_back(orthonormalized(tr.inverse() * camera * tr));
+    options.ground_truth = std::move(ground_truth);
+    options.scans = [streamed](std::size_t frame) { return streamed->render(frame).cloud; };
+  }
   try {
-    const ViewerPageStats s = write_viewer_page(run_dir, run_dir / "view.html");
-    std::cout << fmt::format("3D view: {} ({:.1f} MB; open it in a browser{})\n", (run_dir / "view.html").string(),
-                             static_cast<double>(s.bytes) / 1e6,
-                             streamed ? "; scans and ground truth in it need --keep-sequence" : "");
+    const ViewerPageStats s = write_viewer_page(run_dir, run_dir / "view.html", options);
+    std::cout << fmt::format("3D view: {} ({:.1f} MB; open it in a browser)\n", (run_dir / "view.html").string(),
+                             static_cast<double>(s.bytes) / 1e6);
   } catch (const InputError& e) {
     spdlog::warn("no view.html: {}", e.what());
   }
@@ -196,7 +204,7 @@ int run_demo(const DemoOptions& options) {
   std::cout << fmt::format("plots: {}, {}\n", (out / "slam/trajectories.png").string(),
                            (out / "slam/eval_slam.png").string());
   std::cout << "trajectories: " << (out / "slam/poses.txt").string() << " (KITTI camera frame)\n";
-  write_view_page(out / "slam", !from_disk && !options.keep_sequence);
+  write_view_page(out / "slam", simulated && !options.keep_sequence ? &*simulated : nullptr);
   return 0;
 }
 

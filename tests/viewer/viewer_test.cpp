@@ -170,6 +170,30 @@ TEST(Viewer, RunWithoutSequenceHasNoGroundTruthAndNoScans) {
   EXPECT_EQ(data["trajectories"].size(), 2U);
 }
 
+TEST(Viewer, FramesFromMemoryGiveGroundTruthAndScansWithoutASequence) {
+  TempDir tmp;
+  const auto run = testing::write_fake_run(tmp.path(), 100, 40, 500);
+  fs::remove(run.run_dir / "summary.json");
+  ViewerOptions options;
+  options.ground_truth = testing::straight_poses(run.frames, 2.5, 0.0);
+  std::vector<std::size_t> rendered;
+  options.scans = [&](std::size_t frame) {
+    rendered.push_back(frame);
+    return testing::fake_scan(500);
+  };
+  ViewerPageStats stats;
+  const ViewerScene scene = load_viewer_scene(run.run_dir, options);
+  const auto data = testing::page_data(viewer_page(scene, options, ViewerDataSource::kEmbedded, &stats));
+  EXPECT_TRUE(stats.ground_truth);
+  EXPECT_EQ(data["trajectories"].size(), 3U);
+  EXPECT_GT(stats.scans, 0U);
+  EXPECT_EQ(rendered.size(), stats.scans);  // only the embedded frames are asked for
+  // A ground truth of another length is refused.
+  options.ground_truth->pop_back();
+  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(run.run_dir, options); }).find("ground-truth poses"),
+            std::string::npos);
+}
+
 TEST(Viewer, ServerSendsThePageTheMapAndScansOnDemand) {
   TempDir tmp;
   const auto run = testing::write_fake_run(tmp.path(), 2000, 20, 1000);

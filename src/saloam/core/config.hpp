@@ -71,11 +71,8 @@ struct FeatureConfig {
   /// sidewalk, parking, terrain, other-ground) may be an edge feature; alpha
   /// or less: like any class, .inf: never (the ground gives only planars, as
   /// in LeGO-LOAM). Range noise alone lifts flat ground above alpha here and
-  /// there: on simulated 00, 60 % of all edges lay on the ground and only 40 %
-  /// of those fitted a line, taking the sector slots of real edges. Measured
-  /// (simulated KITTI, 1500 frames, noisy labels; t_err % 00 / 05 / 08 / demo
-  /// loop): 0.1: 0.134 / 0.136 / 0.308 / 0.205; 0.5: 0.135 / 0.095 / 0.239 /
-  /// 0.198; 1.0: 0.118 / 0.086 / 0.244 / 0.174; .inf: 0.142 / 0.090 / 0.244 / 0.242.
+  /// there, and such "edges" take the sector slots of real ones; 1.0 is the
+  /// value measured best (docs/odometry.md).
   double ground_edge_alpha = 1.0;
   double min_range = 2.5;       ///< [m] closer returns are ignored (vehicle body)
   double max_range = 120.0;     ///< [m]
@@ -112,21 +109,19 @@ struct OdometryConfig {
   /// instead of strictly within one class. Voxel size, weight and plane
   /// constraint of a group are those of its representative (road, building,
   /// pole, car).
-  /// On by default: with noisy labels strict per-class matching split one
-  /// surface over several submaps (simulated 05, 300 frames: t_err 0.166 %
-  /// strict vs 0.137 % grouped; 00: 0.267 % vs 0.110 % with the voxel sizes above).
+  /// On by default: with noisy labels strict per-class matching splits one
+  /// surface over several submaps (docs/odometry.md).
   bool match_class_groups = true;
   /// Undistort scans with the constant-velocity motion (internally to
-  /// mid-sweep). On by default: it halves the error of the real KITTI scan
-  /// pairs (3-4 cm -> 1-2.5 cm) and of simulated runs.
+  /// mid-sweep). On by default: it halves the error of real KITTI scan pairs
+  /// and of simulated runs (docs/odometry.md).
   bool deskew = true;
   int max_iterations = 10;       ///< Gauss-Newton iterations per outer loop
   int outer_iterations = 3;      ///< re-association rounds (at most)
   /// A round that moved the pose less than this (and after which the scan
   /// did not need de-skewing again) ends the re-association early (0 =
-  /// always all rounds). Measured on simulated KITTI (1500 frames, GT
-  /// labels): 00 bench 11.6 -> 19.0 Hz CPU, t_err 0.133 -> 0.143 % (00),
-  /// 0.273 -> 0.274 % (08). Today 1.8 rounds per frame on average.
+  /// always all rounds): most frames converge in fewer rounds, at nearly the
+  /// same accuracy (docs/odometry.md).
   double reassociation_min_translation = 0.01;  ///< [m]
   double reassociation_min_rotation_deg = 0.1;  ///< [deg]
   double robust_kernel_scale = 0.1;  ///< [m] Huber scale of the residuals
@@ -136,9 +131,8 @@ struct OdometryConfig {
   double voxel_size = 0.4;       ///< [m] voxel size without semantics (and default class size)
   /// Semantic downsampling: per-class voxel size [m]. Small objects (pole,
   /// trunk, traffic-sign) keep their points at 0.1 m; large classes use the
-  /// label-agnostic size. Measured on simulated KITTI 00/05 (300 frames):
-  /// 0.8 m for road/sidewalk/parking/terrain/vegetation and 0.6 m for building
-  /// (coarser than the baseline) lost to --no-semantics (05: 0.166 % vs 0.128 %).
+  /// label-agnostic size: coarser large classes lost to --no-semantics
+  /// (docs/odometry.md).
   ClassValueMap class_voxel_size{{"default", 0.4}, {"pole", 0.1}, {"trunk", 0.1}, {"traffic-sign", 0.1}};
   /// w^l of Eq. 2: per-class residual weights (equal by default).
   ClassValueMap class_weight{{"default", 1.0}};
@@ -185,9 +179,8 @@ struct LoopClosureConfig {
   /// also used by "hybrid" for the mean of both scores.
   double scancontext_zeta = 0.6;
   /// Semantic Scan Context score threshold (score = fraction of the occupied
-  /// cells whose classes agree after the alignment). Scores are low on
-  /// noisy labels: place-eval's max-F1 threshold on simulated 05 (every 5th
-  /// frame, 64 beams, noisy labels) is 0.21, at precision 0.985.
+  /// cells whose classes agree after the alignment). Scores are low on noisy
+  /// labels: 0.2 is near place-eval's max-F1 threshold (docs/loop_closure.md).
   double ssc_zeta = 0.2;
   int num_loop = 5;           ///< N_loop: best-scoring pairs (score > threshold) that go on to verification
   /// [m] Beyond the paper: the candidate nearest to the query by the current

@@ -85,7 +85,7 @@ json trajectories_json(const ViewerScene& scene) {
 json scans_json(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
                 ViewerPageStats& stats) {
   json scans{{"scale", kScanScale}, {"source", "none"}, {"frames", json::array()}, {"data", json::array()}};
-  if (!scene.sequence) return scans;
+  if (!scene.scan_of) return scans;
   if (source == ViewerDataSource::kServer) {
     scans["source"] = "server";
     return scans;

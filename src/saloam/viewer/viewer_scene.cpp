@@ -142,6 +142,15 @@ void read_trajectories_and_loops(ViewerScene& scene) {
 /// The sequence the run processed, when known, with its ground truth.
 void attach_sequence(ViewerScene& scene, const RunSummary& summary, const ViewerOptions& options) {
   scene.first_frame = summary.first_frame;
+  if (options.ground_truth || options.scans) {  // frames from memory
+    if (options.ground_truth && options.ground_truth->size() != scene.loop_closed.size()) {
+      throw InputError(scene.run_dir, fmt::format("{} ground-truth poses given for a run of {} frames",
+                                                  options.ground_truth->size(), scene.loop_closed.size()));
+    }
+    if (options.ground_truth) scene.ground_truth = *options.ground_truth;
+    scene.scan_of = options.scans;
+    return;
+  }
   const auto folder = sequence_folder(summary, options);
   if (!folder) return;
   scene.sequence = std::make_shared<const SequenceReader>(*folder);
@@ -151,6 +160,9 @@ void attach_sequence(ViewerScene& scene, const RunSummary& summary, const Viewer
                                           scene.sequence->size(), scene.first_frame, scene.first_frame + frames - 1));
   }
   scene.ground_truth = ground_truth_lidar(*scene.sequence, scene.first_frame, frames);
+  scene.scan_of = [sequence = scene.sequence, first = scene.first_frame](std::size_t frame) {
+    return sequence->load_scan(first + frame);
+  };
 }
 
 }  // namespace
@@ -210,17 +222,17 @@ ViewerScene load_viewer_scene(const fs::path& run_dir, const ViewerOptions& opti
 }
 
 LabelledCloud load_viewer_scan(const ViewerScene& scene, std::size_t frame, std::size_t max_points) {
-  if (!scene.sequence) throw InputError(scene.run_dir, "no sequence folder known for the scans (give --sequence)");
+  if (!scene.scan_of) throw InputError(scene.run_dir, "no sequence folder known for the scans (give --sequence)");
   if (frame >= scene.loop_closed.size()) {
-    throw InputError(scene.sequence->root(),
+    throw InputError(scene.run_dir,
                      fmt::format("frame {} out of range (the run has {} frames)", frame, scene.loop_closed.size()));
   }
-  return decimate_cloud(scene.sequence->load_scan(scene.first_frame + frame), max_points);
+  return decimate_cloud(scene.scan_of(frame), max_points);
 }
 
 std::vector<std::size_t> embedded_scan_frames(const ViewerScene& scene, const ViewerOptions& options) {
   const std::size_t frames = scene.loop_closed.size();
-  if (!scene.sequence || options.points_per_scan == 0 || frames == 0) return {};
+  if (!scene.scan_of || options.points_per_scan == 0 || frames == 0) return {};
   const std::size_t count = std::min(frames, options.max_scan_points / options.points_per_scan);
   if (count == 0) return {};
   const std::size_t step = (frames + count - 1) / count;

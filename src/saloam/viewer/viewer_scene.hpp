@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -27,11 +28,19 @@ struct ViewerOptions {
   std::size_t max_scan_points = 400'000;          ///< scans embedded in the page, all together
   std::size_t points_per_scan = 8'000;            ///< each scan is decimated to at most this many points
   std::optional<std::filesystem::path> sequence;  ///< sequence folder; default: the one in summary.json
+  /// Instead of a sequence folder, the frames from memory (e.g. a simulator
+  /// that wrote nothing to disk, as the demo's): the ground truth of the
+  /// processed frames (LiDAR frame, world = the first of them) and scan
+  /// `frame` (processed-frame index) in its own LiDAR frame.
+  std::optional<std::vector<Pose>> ground_truth;
+  std::function<LabelledCloud(std::size_t frame)> scans;
 };
 
 struct ViewerScene {
   std::filesystem::path run_dir;
   std::shared_ptr<const SequenceReader> sequence;          ///< for the ground truth and the scans, when found
+  /// Scan of a processed frame (from the sequence or ViewerOptions::scans); empty when none is known.
+  std::function<LabelledCloud(std::size_t frame)> scan_of;
   std::size_t first_frame = 0;                             ///< sequence frame of the first processed frame
   std::vector<Pose> loop_closed, odometry, ground_truth;   ///< LiDAR frame; ground truth may be empty
   std::vector<std::pair<std::size_t, std::size_t>> loops;  ///< accepted loops (query, match), processed-frame indices
