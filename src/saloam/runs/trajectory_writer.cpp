@@ -45,11 +45,4 @@ std::vector<Pose> output_poses(const std::vector<Pose>& lidar_poses, const std::
   return out;
 }
 
-void write_trajectory(const std::filesystem::path& kitti_file, const std::filesystem::path& tum_file,
-                      const std::vector<double>& timestamps, const std::vector<Pose>& lidar_poses,
-                      const std::optional<Pose>& velo_to_cam) {
-  TrajectoryWriter writer(kitti_file, tum_file, velo_to_cam);
-  for (std::size_t i = 0; i < lidar_poses.size(); ++i) writer.write(timestamps.at(i), lidar_poses[i]);
-}
-
 }  // namespace saloam

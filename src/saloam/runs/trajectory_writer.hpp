@@ -38,9 +38,4 @@ class TrajectoryWriter {
 /// The KITTI-file poses of LiDAR-frame poses (camera convention when Tr is given).
 std::vector<Pose> output_poses(const std::vector<Pose>& lidar_poses, const std::optional<Pose>& velo_to_cam);
 
-/// Writes a whole trajectory with a TrajectoryWriter.
-void write_trajectory(const std::filesystem::path& kitti_file, const std::filesystem::path& tum_file,
-                      const std::vector<double>& timestamps, const std::vector<Pose>& lidar_poses,
-                      const std::optional<Pose>& velo_to_cam);
-
 }  // namespace saloam
