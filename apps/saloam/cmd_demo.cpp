@@ -181,11 +181,13 @@ int run_demo(const DemoOptions& options) {
   };
   const SlamRunResult slam = run_slam(*source, config, load_loop_network(config, {}), out / "slam", run_options);
   if (slam.interrupted) return 130;
+  const std::optional<std::vector<Pose>> ground_truth = source->camera_poses();
+  source = nullptr;
   stream.reset();  // stops the simulator's thread; finishes the kept sequence folder
 
   std::optional<TrajectoryEvaluation> baseline_eval;
-  if (baseline && source->camera_poses()) {
-    const auto gt = *source->camera_poses();
+  if (baseline && ground_truth) {
+    const auto& gt = *ground_truth;
     baseline_eval = evaluate_trajectories(gt, baseline->output_poses());
     const EvaluationLabels labels{"ground truth", "odometry_baseline/poses.txt"};
     write_evaluation_json(out / "eval_baseline.json", *baseline_eval, labels);
