@@ -179,7 +179,7 @@ int run_demo(const DemoOptions& options) {
     if (baseline) baseline->process(scan, t);
     if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
   };
-  const SlamRunResult slam = run_slam(*source, config, load_loop_network(config, {}), out / "slam", run_options);
+  const SlamRunResult slam = run_slam(*source, config, load_loop_network(config), out / "slam", run_options);
   if (slam.interrupted) return 130;
   const std::optional<std::vector<Pose>> ground_truth = source->camera_poses();
   source = nullptr;

@@ -83,7 +83,7 @@ int run_slam_command(const SlamOptions& options) {
   run_options.no_calib = options.no_calib;
 
   const std::filesystem::path out_dir(options.out);
-  const SlamRunResult result = run_slam(reader, config, load_loop_network(config, {}), out_dir, run_options);
+  const SlamRunResult result = run_slam(reader, config, load_loop_network(config), out_dir, run_options);
   print_summary(result);
   std::cout << fmt::format("wrote {} (poses.txt, poses_odometry.txt, loops.csv, map.ply, map.png, trajectories.png, "
                            "timing.json)\n",

@@ -158,15 +158,13 @@ void plot_trajectories(const std::filesystem::path& file, const std::vector<Pose
 
 }  // namespace
 
-std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config, const std::filesystem::path& fallback_model) {
+std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config) {
   if (!uses_sgpr(parse_place_detector(config.loop.detector))) return std::nullopt;
-  const std::filesystem::path model =
-      config.loop.sgpr_model.empty() ? fallback_model : std::filesystem::path(config.loop.sgpr_model);
-  if (model.empty()) {
+  if (config.loop.sgpr_model.empty()) {
     throw ConfigError(fmt::format("loop.detector '{}' needs SGPR weights: give --set loop.sgpr_model=FILE.sgw",
                                   config.loop.detector));
   }
-  return SgprNetwork::load(model);
+  return SgprNetwork::load(config.loop.sgpr_model);
 }
 
 namespace {

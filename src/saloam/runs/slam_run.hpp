@@ -57,9 +57,9 @@ struct SlamRunResult {
   std::optional<LoopSummary> loop_summary_poses_txt;  ///< against poses.txt, when poses_sensor.txt was used
 };
 
-/// Loads the SGPR network when the configured detector needs one: the
-/// config's loop.sgpr_model, else `fallback_model`; ConfigError when neither is set.
-std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config, const std::filesystem::path& fallback_model);
+/// Loads the SGPR network when the configured detector needs one, from the
+/// config's loop.sgpr_model; ConfigError when it is not set.
+std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config);
 
 /// Runs SlamSystem over frames [first_frame, end_frame) of `source`, writing into `out_dir` (created).
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
