@@ -24,7 +24,7 @@ TEST(Config, TableOneDefaults) {
   EXPECT_EQ(c.odometry.features.num_sectors, 6);
   EXPECT_EQ(c.odometry.features.edges_per_sector, 20);
   EXPECT_EQ(c.odometry.features.planars_per_sector, 50);
-  EXPECT_EQ(c.odometry.local_map_frames, 20);
+  EXPECT_EQ(c.odometry.local_map_frames, 40);
   EXPECT_EQ(c.odometry.edge_neighbours, 5);
   EXPECT_EQ(c.odometry.planar_neighbours, 5);
   EXPECT_DOUBLE_EQ(c.odometry.plane_normal_tolerance, 0.05);
@@ -71,6 +71,7 @@ TEST(Config, ShippedRealKittiFileSetsMidSweepPoses) {
 TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
   const auto loaded = load_config(testing::source_dir() / "config" / "paper.yaml");
   SaloamConfig expected;
+  expected.odometry.local_map_frames = 20;
   expected.odometry.local_map_point = "newest";
   expected.odometry.match_class_groups = false;
   expected.odometry.features.ground_edge_alpha = 0.1;
@@ -317,7 +318,7 @@ TEST(ConfigRanges, DefaultsAndShippedFilesAreValid) {
 
 TEST(ConfigRanges, SavedYamlShowsEachRange) {
   const std::string yaml = config_to_yaml(SaloamConfig{});
-  for (const char* line : {"local_map_frames: 20  # N_m: frames in the local map [>= 1]",
+  for (const char* line : {"local_map_frames: 40  # N_m: frames in the local map [>= 1]",
                            "zeta: 0.95  # zeta: SGPR score threshold [0, 1]",
                            "detector: scancontext  # place-recognition scorer "
                            "[one of sgpr, scancontext, hybrid, ssc]",

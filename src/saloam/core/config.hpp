@@ -95,7 +95,10 @@ struct FeatureConfig {
 /// Scan-to-local-map registration (paper Sec. III-B, Eq. 2).
 struct OdometryConfig {
   FeatureConfig features;
-  int local_map_frames = 20;     ///< N_m: a map voxel no frame of the last N_m observed leaves the map
+  /// N_m: a map voxel that none of the last N_m frames observed leaves the
+  /// map. Table I has 20 (config/paper.yaml); 40 (about 40 m of road) halves
+  /// the drift again with first points kept (docs/odometry.md).
+  int local_map_frames = 40;
   /// The point a map voxel keeps when observed again: "first" (the map stays
   /// anchored where it was first registered) or "newest" (the map follows the
   /// latest frames; the paper's map of the last N_m frames). See MapVoxelPoint.
