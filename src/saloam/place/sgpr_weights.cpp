@@ -135,15 +135,6 @@ SgprWeights read_sgpr_weights(const std::filesystem::path& file) {
 }
 
 std::vector<std::byte> serialize_sgpr_weights(const SgprWeights& weights) {
-  for (const auto& [name, tensor] : weights.tensors) {
-    std::uint64_t elements = 1;
-    for (const auto d : tensor.dims) elements *= d;
-    if (tensor.dims.empty() || tensor.dims.size() > 4 || elements != tensor.values.size())
-      throw std::invalid_argument("SGPR tensor '" + name + "' of shape " + shape_text(tensor.dims) + " holds " +
-                                  std::to_string(tensor.values.size()) + " values");
-    for (const float v : tensor.values)
-      if (!std::isfinite(v)) throw std::invalid_argument("SGPR tensor '" + name + "' holds a non-finite value");
-  }
   std::vector<std::byte> out;
   for (const char c : kMagic) out.push_back(static_cast<std::byte>(c));
   put_u32(out, static_cast<std::uint32_t>(weights.tensors.size()));
@@ -162,6 +153,15 @@ std::vector<std::byte> serialize_sgpr_weights(const SgprWeights& weights) {
 }
 
 void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& weights) {
+  for (const auto& [name, tensor] : weights.tensors) {
+    std::uint64_t elements = 1;
+    for (const auto d : tensor.dims) elements *= d;
+    if (tensor.dims.empty() || tensor.dims.size() > 4 || elements != tensor.values.size())
+      throw std::invalid_argument("SGPR tensor '" + name + "' of shape " + shape_text(tensor.dims) + " holds " +
+                                  std::to_string(tensor.values.size()) + " values");
+    for (const float v : tensor.values)
+      if (!std::isfinite(v)) throw std::invalid_argument("SGPR tensor '" + name + "' holds a non-finite value");
+  }
   const auto bytes = serialize_sgpr_weights(weights);
   create_parent_folder(file);
   std::filesystem::path partial = file;

@@ -39,14 +39,15 @@ SgprWeights parse_sgpr_weights(std::span<const std::byte> bytes, const std::file
 SgprWeights read_sgpr_weights(const std::filesystem::path& file);
 
 /// Serialises weights in the `.sgw` layout (tensors in name order; readers
-/// look tensors up by name). Throws std::invalid_argument when a tensor's
-/// value count does not match its dims or a value is not finite, so that
-/// nothing unreadable is ever written.
+/// look tensors up by name), as they are (tests use it to make bad files).
 std::vector<std::byte> serialize_sgpr_weights(const SgprWeights& weights);
 
 /// Writes weights as a `.sgw` file: to a temporary file beside `file`, then
 /// renamed over it, so a reader (or an interrupted run) never sees half a
-/// file. InputError naming `file` when it cannot be written.
+/// file. Throws std::invalid_argument (writing nothing) when a tensor's value
+/// count does not match its dims or a value is not finite, so that nothing
+/// the reader would refuse is ever written; InputError naming the file when
+/// it cannot be written.
 void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& weights);
 
 }  // namespace saloam

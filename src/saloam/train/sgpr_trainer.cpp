@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <fstream>
+#include <malloc.h>
 #include <numeric>
 #include <random>
 
@@ -43,12 +44,32 @@ std::vector<const SemanticGraph*> concat(std::span<const SemanticGraph* const> a
 
 void set_training_threads(int threads) { torch::set_num_threads(std::max(1, threads)); }
 
+namespace {
+
+/// A training step allocates and frees tens of tensors of several MB. With
+/// glibc's defaults each is a fresh mmap and its pages fault in anew every
+/// step (measured: about half of a step's time). Keeping freed memory in the
+/// heap for reuse halves the step time; it changes no result.
+void keep_freed_memory_for_reuse() {
+  static const bool once = [] {
+    mallopt(M_MMAP_THRESHOLD, 1 << 30);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+    mallopt(M_TOP_PAD, 256 << 20);
+    return true;
+  }();
+  (void)once;
+}
+
+}  // namespace
+
 SgprTrainer::SgprTrainer(std::uint64_t seed, const SgprOptimizerOptions& options) {
+  keep_freed_memory_for_reuse();
   torch::manual_seed(seed);
   impl_ = std::make_unique<Impl>(options);
 }
 
 SgprTrainer::SgprTrainer(const SgprWeights& weights, const SgprOptimizerOptions& options) {
+  keep_freed_memory_for_reuse();
   impl_ = std::make_unique<Impl>(options);
   load_sgpr_weights(impl_->net, weights);
 }
