@@ -203,9 +203,11 @@ GraphSourceSpec read_source(const YAML::Node& node, const GraphSourceSpec& defau
     return spec;  // a built-in route needs no files
   }
   if (spec.kind == GraphSourceSpec::Kind::kSimulated) {
-    require_file(spec.path, "pose file");
+    if (!fs::is_regular_file(spec.path))
+      throw InputError(spec.path, "pose file not found (" + where + " of " + file.string() + ")");
     if (spec.calib.empty()) throw InputError(file, where + ": a simulated source needs `calib:` (here or in defaults)");
-    require_file(spec.calib, "calibration file");
+    if (!fs::is_regular_file(spec.calib))
+      throw InputError(spec.calib, "calibration file not found (" + where + " of " + file.string() + ")");
   } else if (!fs::is_directory(spec.path)) {
     throw InputError(spec.path, "sequence folder not found (" + where + " of " + file.string() + ")");
   }
