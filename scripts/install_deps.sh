@@ -10,6 +10,7 @@ packages=(
   libcairo2-dev libgtest-dev libgmock-dev libbenchmark-dev
   robin-map-dev
   libjs-three libcpp-httplib-dev chromium  # saloam view: three.js, its --serve server, the headless page test
+  libtorch-dev  # saloam sgpr-train (optional: without it the rest builds and the trainer is left out)
 )
 
 missing=()

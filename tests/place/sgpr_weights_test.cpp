@@ -63,6 +63,28 @@ TEST(SgprWeights, SerializeRoundTripIsBitExact) {
   EXPECT_EQ(bytes.size(), std::filesystem::file_size(path));
 }
 
+TEST(SgprWeights, WrittenFileReadsBackBitExact) {
+  testing::TempDir dir;
+  SgprWeights weights;
+  weights.tensors["a.weight"] = {{2, 3, 1, 1}, {1.5F, -2.0F, 1e-40F, 0.0F, 3.25F, -7.0F}};  // 1e-40: subnormal, kept
+  weights.tensors["b"] = {{1}, {0.125F}};
+  const auto file = dir / "sub" / "model.sgw";
+  write_sgpr_weights(file, weights);
+  EXPECT_FALSE(std::filesystem::exists(dir / "sub" / "model.sgw.partial"));
+  const auto again = read_sgpr_weights(file);
+  ASSERT_EQ(again.tensors.size(), 2U);
+  for (const auto& [name, t] : weights.tensors) {
+    const auto& u = again.tensors.at(name);
+    EXPECT_EQ(u.dims, t.dims) << name;
+    ASSERT_EQ(u.values.size(), t.values.size());
+    EXPECT_EQ(std::memcmp(u.values.data(), t.values.data(), 4 * t.values.size()), 0) << name;
+  }
+  // Nothing unreadable is written: a shape that does not match the values is refused.
+  weights.tensors["b"] = {{2}, {0.125F}};
+  EXPECT_THROW(write_sgpr_weights(dir / "bad.sgw", weights), std::invalid_argument);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.sgw"));
+}
+
 TEST(SgprWeights, MissingFileIsAClearError) {
   try {
     (void)read_sgpr_weights("/nonexistent/model.sgw");

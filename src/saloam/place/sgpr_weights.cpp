@@ -5,6 +5,7 @@
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
@@ -149,6 +150,29 @@ std::vector<std::byte> serialize_sgpr_weights(const SgprWeights& weights) {
     }
   }
   return out;
+}
+
+void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& weights) {
+  for (const auto& [name, tensor] : weights.tensors) {
+    std::uint64_t elements = 1;
+    for (const auto d : tensor.dims) elements *= d;
+    if (tensor.dims.empty() || tensor.dims.size() > 4 || elements != tensor.values.size())
+      throw std::invalid_argument("SGPR tensor '" + name + "' of shape " + shape_text(tensor.dims) + " holds " +
+                                  std::to_string(tensor.values.size()) + " values");
+    for (const float v : tensor.values)
+      if (!std::isfinite(v)) throw std::invalid_argument("SGPR tensor '" + name + "' holds a non-finite value");
+  }
+  const auto bytes = serialize_sgpr_weights(weights);
+  create_parent_folder(file);
+  std::filesystem::path partial = file;
+  partial += ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError(partial, "cannot create SGPR weights file");
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw InputError(partial, "write error");
+  }
+  std::filesystem::rename(partial, file);
 }
 
 }  // namespace saloam

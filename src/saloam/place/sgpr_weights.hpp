@@ -38,7 +38,16 @@ SgprWeights parse_sgpr_weights(std::span<const std::byte> bytes, const std::file
 /// Reads and parses a `.sgw` file; throws InputError when it is missing or malformed.
 SgprWeights read_sgpr_weights(const std::filesystem::path& file);
 
-/// Serialises weights in the `.sgw` layout (for tests and conversions).
+/// Serialises weights in the `.sgw` layout (tensors in name order; readers
+/// look tensors up by name), as they are (tests use it to make bad files).
 std::vector<std::byte> serialize_sgpr_weights(const SgprWeights& weights);
+
+/// Writes weights as a `.sgw` file: to a temporary file beside `file`, then
+/// renamed over it, so a reader (or an interrupted run) never sees half a
+/// file. Throws std::invalid_argument (writing nothing) when a tensor's value
+/// count does not match its dims or a value is not finite, so that nothing
+/// the reader would refuse is ever written; InputError naming the file when
+/// it cannot be written.
+void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& weights);
 
 }  // namespace saloam

@@ -1,0 +1,386 @@
+#include "saloam/train/graph_dataset.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cctype>
+#include <fstream>
+#include <mutex>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <tbb/parallel_for.h>
+#include <yaml-cpp/yaml.h>
+
+#include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/frame_range.hpp"
+#include "saloam/core/progress.hpp"
+#include "saloam/io/calibration.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/io/trajectory_io.hpp"
+#include "saloam/place/graph_json.hpp"
+#include "saloam/sim/simulator.hpp"
+#include "saloam/sim/trajectories.hpp"
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Tr from a calib.txt (`Tr:` line) or, failing that, from a per-sequence
+/// list (`NN: ...`) picked by the pose file's name (00.txt), as `saloam simulate` does.
+Pose velo_to_cam_for(const fs::path& calib, const fs::path& trajectory) {
+  try {
+    return read_velo_to_cam(calib);
+  } catch (const InputError&) {
+    const std::string stem = trajectory.stem().string();
+    const bool numeric =
+        !stem.empty() && std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); });
+    if (!numeric || !fs::is_regular_file(calib)) throw;
+    return read_velo_to_cam(calib, std::stoi(stem));
+  }
+}
+
+std::vector<Eigen::Vector3d> positions_of(const std::vector<Pose>& lidar_poses) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(lidar_poses.size());
+  for (const auto& p : lidar_poses) out.push_back(p.translation());
+  return out;
+}
+
+nlohmann::json graph_config_json(const GraphBuilderConfig& c) {
+  return {{"tolerance", c.tolerance},       {"min_cluster_size", c.min_cluster_size},
+          {"max_cluster_size", c.max_cluster_size}, {"use_instances", c.use_instances},
+          {"min_instance_points", c.min_instance_points}, {"max_nodes", c.max_nodes},
+          {"edge_distance", c.edge_distance}};
+}
+
+/// Builds graph[i] = make(i) for every i in parallel, with a progress bar.
+template <class Make>
+std::vector<SemanticGraph> build_all(std::size_t count, const std::string& label, bool show_progress, Make&& make) {
+  std::vector<SemanticGraph> graphs(count);
+  ProgressBar progress(count, label, show_progress);
+  std::mutex mutex;
+  tbb::parallel_for(std::size_t{0}, count, [&](std::size_t i) {
+    if (stop_requested()) return;
+    graphs[i] = make(i);
+    const std::lock_guard lock(mutex);
+    progress.advance();
+  });
+  progress.finish();
+  return graphs;
+}
+
+GraphSequence simulated_graphs(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config, bool show_progress) {
+  SimulationOptions options;
+  if (!spec.preset.empty()) {
+    options.preset = spec.preset;
+  } else {
+    options.camera_poses = read_kitti_poses(spec.path);
+    if (options.camera_poses.size() < 2) throw InputError(spec.path, "needs at least two poses");
+    if (spec.calib.empty()) throw InputError(spec.path, "a simulated source needs a calib file (calib: FILE)");
+    options.velo_to_cam = velo_to_cam_for(spec.calib, spec.path);
+    options.velo_to_cam_given = true;
+  }
+  const FrameRange range = FrameRange::parse(spec.frames, "frames");
+  options.first_frame = range.first;
+  options.end_frame = range.end;
+  options.stride = spec.frame_step;
+  options.seed = spec.seed;
+  options.labels = spec.noisy_labels ? LabelMode::kNoisy : LabelMode::kGroundTruth;
+  options.show_progress = false;
+  const SimulatedSequence sequence(options);
+  GraphSequence out;
+  out.name = spec.name();
+  // The sensor poses are where the scans were really taken (FORMAT of poses_sensor.txt).
+  out.positions = positions_of(camera_to_lidar_poses(sequence.sensor_camera_poses(), sequence.velo_to_cam()));
+  out.graphs = build_all(sequence.size(), "graphs of " + out.name, show_progress,
+                         [&](std::size_t i) { return build_semantic_graph(sequence.render(i).cloud, graph_config); });
+  return out;
+}
+
+GraphSequence folder_graphs(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config, bool show_progress) {
+  SequenceOptions options;
+  if (!spec.labels.empty()) options.labels_dir = spec.labels;
+  const SequenceReader reader(spec.path, options);
+  if (!reader.has_poses()) throw InputError(spec.path / "poses.txt", "missing: training needs ground-truth poses");
+  if (!reader.has_labels()) throw InputError(spec.path, "no labels (labels/ or the recipe's labels: folder)");
+  if (!reader.has_calib()) throw InputError(spec.path / "calib.txt", "missing: needed for the LiDAR positions");
+  const auto [first, end] = FrameRange::parse(spec.frames, "frames").clip(reader.size(), "frames");
+  std::vector<std::size_t> frames;
+  for (std::size_t i = first; i < end; i += spec.frame_step) frames.push_back(i);
+  const auto all_positions = positions_of(reader.lidar_poses());
+  GraphSequence out;
+  out.name = spec.name();
+  for (const auto i : frames) out.positions.push_back(all_positions.at(i));
+  out.graphs = build_all(frames.size(), "graphs of " + out.name, show_progress,
+                         [&](std::size_t k) { return build_semantic_graph(reader.load_scan(frames[k]), graph_config); });
+  return out;
+}
+
+std::optional<GraphSequence> read_cache(const fs::path& file, const nlohmann::json& key) {
+  if (!fs::is_regular_file(file)) return std::nullopt;
+  std::ifstream in(file);
+  nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.contains("key") || j["key"] != key) return std::nullopt;
+  GraphSequence out;
+  out.name = j.at("name").get<std::string>();
+  for (const auto& g : j.at("graphs")) out.graphs.push_back(graph_from_json(g, file));
+  for (const auto& p : j.at("positions")) out.positions.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+  if (out.graphs.size() != out.positions.size()) return std::nullopt;
+  return out;
+}
+
+void write_cache(const fs::path& file, const nlohmann::json& key, const GraphSequence& sequence) {
+  nlohmann::json j;
+  j["key"] = key;
+  j["name"] = sequence.name;
+  j["graphs"] = nlohmann::json::array();
+  for (const auto& g : sequence.graphs) j["graphs"].push_back(graph_to_json(g));
+  j["positions"] = nlohmann::json::array();
+  for (const auto& p : sequence.positions) j["positions"].push_back({p.x(), p.y(), p.z()});
+  create_parent_folder(file);
+  fs::path partial = file;
+  partial += ".partial";
+  {
+    std::ofstream out(partial);
+    if (!out) throw InputError(partial, "cannot create graph cache");
+    out << j.dump() << '\n';
+  }
+  fs::rename(partial, file);
+}
+
+// ---- recipe ----
+
+fs::path resolve(const fs::path& base, const std::string& text) {
+  const fs::path p(text);
+  return p.is_absolute() ? p : base / p;
+}
+
+GraphSourceSpec read_source(const YAML::Node& node, const GraphSourceSpec& defaults, const fs::path& base,
+                            const fs::path& file, const std::string& where) {
+  if (!node.IsMap()) throw InputError(file, where + ": expected a map with `simulate:` or `folder:`");
+  GraphSourceSpec spec = defaults;
+  try {
+    if (node["simulate"] && node["folder"]) throw InputError(file, where + ": give `simulate:` or `folder:`, not both");
+    if (node["simulate"]) {
+      spec.kind = GraphSourceSpec::Kind::kSimulated;
+      const auto text = node["simulate"].as<std::string>();
+      if (text.rfind("preset:", 0) == 0) {
+        spec.preset = text.substr(7);
+        const auto names = preset_names();
+        if (std::find(names.begin(), names.end(), spec.preset) == names.end())
+          throw InputError(file, where + ": unknown preset '" + spec.preset + "' (" + fmt::format("{}", fmt::join(names, ", ")) + ")");
+      } else {
+        spec.path = resolve(base, text);
+      }
+    } else if (node["folder"]) {
+      spec.kind = GraphSourceSpec::Kind::kFolder;
+      spec.path = resolve(base, node["folder"].as<std::string>());
+    } else {
+      throw InputError(file, where + ": needs `simulate: POSES.txt` or `folder: DIR`");
+    }
+    for (const auto& kv : node) {
+      const auto key = kv.first.as<std::string>();
+      if (key == "simulate" || key == "folder") continue;
+      if (key == "calib") spec.calib = resolve(base, kv.second.as<std::string>());
+      else if (key == "frames") spec.frames = kv.second.as<std::string>();
+      else if (key == "frame_step") spec.frame_step = kv.second.as<std::size_t>();
+      else if (key == "seed") spec.seed = kv.second.as<std::uint64_t>();
+      else if (key == "labels" && spec.kind == GraphSourceSpec::Kind::kSimulated) {
+        const auto v = kv.second.as<std::string>();
+        if (v != "noisy" && v != "gt") throw InputError(file, where + ": labels must be noisy or gt, not '" + v + "'");
+        spec.noisy_labels = v == "noisy";
+      } else if (key == "labels") spec.labels = resolve(base, kv.second.as<std::string>());
+      else throw InputError(file, where + ": unknown key '" + key + "'");
+    }
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, where + ": " + e.what());
+  }
+  if (spec.frame_step == 0) throw InputError(file, where + ": frame_step must be at least 1");
+  if (spec.kind == GraphSourceSpec::Kind::kSimulated && !spec.preset.empty()) {
+    return spec;  // a built-in route needs no files
+  }
+  if (spec.kind == GraphSourceSpec::Kind::kSimulated) {
+    if (!fs::is_regular_file(spec.path))
+      throw InputError(spec.path, "pose file not found (" + where + " of " + file.string() + ")");
+    if (spec.calib.empty()) throw InputError(file, where + ": a simulated source needs `calib:` (here or in defaults)");
+    if (!fs::is_regular_file(spec.calib))
+      throw InputError(spec.calib, "calibration file not found (" + where + " of " + file.string() + ")");
+  } else if (!fs::is_directory(spec.path)) {
+    throw InputError(spec.path, "sequence folder not found (" + where + " of " + file.string() + ")");
+  }
+  return spec;
+}
+
+}  // namespace
+
+std::string GraphSourceSpec::name() const {
+  if (kind == Kind::kSimulated)
+    return fmt::format("sim-{}{}-s{}-k{}-{}", preset.empty() ? path.stem().string() : preset, frames.empty() ? "" : "-f" + frames, seed,
+                       frame_step, noisy_labels ? "noisy" : "gt");
+  std::string n = fmt::format("folder-{}{}-k{}", path.filename().string(), frames.empty() ? "" : "-f" + frames, frame_step);
+  return n;
+}
+
+nlohmann::json GraphSourceSpec::to_json() const {
+  nlohmann::json j;
+  j[kind == Kind::kSimulated ? "simulate" : "folder"] =
+      preset.empty() ? fs::absolute(path).lexically_normal().string() : "preset:" + preset;
+  if (kind == Kind::kSimulated) {
+    if (!calib.empty()) j["calib"] = fs::absolute(calib).lexically_normal().string();
+    j["seed"] = seed;
+    j["labels"] = noisy_labels ? "noisy" : "gt";
+  } else if (!labels.empty()) {
+    j["labels"] = fs::absolute(labels).lexically_normal().string();
+  }
+  j["frames"] = frames;
+  j["frame_step"] = frame_step;
+  return j;
+}
+
+DataRecipe read_data_recipe(const fs::path& file) {
+  require_file(file, "data recipe");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(file.string());
+  } catch (const YAML::Exception& e) {
+    throw InputError(file, std::string("not valid YAML: ") + e.what());
+  }
+  if (!root.IsMap()) throw InputError(file, "expected a map with `train:` and `validation:` lists");
+  const fs::path base = file.parent_path();
+  GraphSourceSpec defaults;
+  if (const auto d = root["defaults"]) {
+    if (!d.IsMap()) throw InputError(file, "defaults: expected a map");
+    try {
+      for (const auto& kv : d) {
+        const auto key = kv.first.as<std::string>();
+        if (key == "calib") defaults.calib = resolve(base, kv.second.as<std::string>());
+        else if (key == "frame_step") defaults.frame_step = kv.second.as<std::size_t>();
+        else if (key == "seed") defaults.seed = kv.second.as<std::uint64_t>();
+        else if (key == "labels") defaults.noisy_labels = kv.second.as<std::string>() != "gt";
+        else throw InputError(file, "defaults: unknown key '" + key + "'");
+      }
+    } catch (const YAML::Exception& e) {
+      throw InputError(file, std::string("defaults: ") + e.what());
+    }
+  }
+  DataRecipe recipe;
+  for (const char* section : {"train", "validation"}) {
+    const auto list = root[section];
+    if (!list || !list.IsSequence() || list.size() == 0)
+      throw InputError(file, std::string("needs a non-empty `") + section + ":` list");
+    auto& out = std::string(section) == "train" ? recipe.train : recipe.validation;
+    for (std::size_t i = 0; i < list.size(); ++i)
+      out.push_back(read_source(list[i], defaults, base, file, fmt::format("{}[{}]", section, i)));
+  }
+  for (const auto& key : root)
+    if (const auto k = key.first.as<std::string>(); k != "train" && k != "validation" && k != "defaults")
+      throw InputError(file, "unknown key '" + k + "'");
+  return recipe;
+}
+
+nlohmann::json recipe_to_json(const DataRecipe& recipe) {
+  nlohmann::json j;
+  j["train"] = nlohmann::json::array();
+  j["validation"] = nlohmann::json::array();
+  for (const auto& s : recipe.train) j["train"].push_back(s.to_json());
+  for (const auto& s : recipe.validation) j["validation"].push_back(s.to_json());
+  return j;
+}
+
+GraphSequence build_graph_sequence(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config,
+                                   const std::optional<fs::path>& cache_dir, bool show_progress) {
+  const nlohmann::json key = {{"source", spec.to_json()}, {"graph", graph_config_json(graph_config)}};
+  const fs::path cache = cache_dir ? *cache_dir / (spec.name() + ".json") : fs::path();
+  if (cache_dir)
+    if (auto cached = read_cache(cache, key)) return std::move(*cached);
+  GraphSequence sequence = spec.kind == GraphSourceSpec::Kind::kSimulated
+                               ? simulated_graphs(spec, graph_config, show_progress)
+                               : folder_graphs(spec, graph_config, show_progress);
+  if (cache_dir && !stop_requested()) write_cache(cache, key, sequence);
+  return sequence;
+}
+
+std::vector<TrainingPair> positive_pairs(std::span<const GraphSequence> sequences, const PairRecipe& recipe) {
+  std::vector<TrainingPair> pairs;
+  const double limit = recipe.positive_distance * recipe.positive_distance;
+  for (std::uint32_t s = 0; s < sequences.size(); ++s) {
+    const auto& p = sequences[s].positions;
+    for (std::uint32_t i = 0; i < p.size(); ++i)
+      for (std::uint32_t j = i + 1; j < p.size(); ++j)
+        if ((p[i] - p[j]).squaredNorm() <= limit) pairs.push_back({s, i, j, true});
+  }
+  return pairs;
+}
+
+std::vector<std::uint32_t> negative_candidates(const GraphSequence& sequence, std::uint32_t anchor,
+                                               const PairRecipe& recipe) {
+  std::vector<std::uint32_t> out;
+  const double limit = recipe.negative_distance * recipe.negative_distance;
+  const auto& p = sequence.positions;
+  for (std::uint32_t j = 0; j < p.size(); ++j)
+    if ((p[j] - p[anchor]).squaredNorm() > limit) out.push_back(j);
+  return out;
+}
+
+SemanticGraph augment_graph(const SemanticGraph& graph, const AugmentOptions& options, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const double yaw = (2.0 * unit(rng) - 1.0) * options.max_rotation;
+  const double scale = options.scale_min + (options.scale_max - options.scale_min) * unit(rng);
+  const Eigen::Vector3d shift((2.0 * unit(rng) - 1.0) * options.shift, (2.0 * unit(rng) - 1.0) * options.shift,
+                              (2.0 * unit(rng) - 1.0) * 0.1 * options.shift);
+  const Eigen::Matrix3d rotation = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  SemanticGraph out;
+  for (std::size_t n = 0; n < graph.size(); ++n) {
+    // Draw every random number for every node, kept or not, so that the
+    // sequence of draws does not depend on the dropout outcome.
+    const bool drop = unit(rng) < options.node_dropout;
+    Eigen::Vector3d jitter;
+    for (int a = 0; a < 3; ++a)
+      jitter[a] = std::clamp(options.jitter_sigma * normal(rng), -options.jitter_clip, options.jitter_clip);
+    if (drop) continue;
+    out.nodes.push_back(graph.nodes[n]);
+    out.centers.push_back(scale * (rotation * graph.centers[n]) + shift + jitter);
+  }
+  if (out.nodes.empty() && !graph.nodes.empty()) {  // never train on an empty graph made by dropout
+    out.nodes.push_back(graph.nodes[0]);
+    out.centers.push_back(scale * (rotation * graph.centers[0]) + shift);
+  }
+  return out;
+}
+
+std::vector<SgprEmbedding> embed_graphs(const SgprNetwork& network, std::span<const SemanticGraph> graphs) {
+  std::vector<SgprEmbedding> out(graphs.size());
+  tbb::parallel_for(std::size_t{0}, graphs.size(), [&](std::size_t i) { out[i] = network.embed(graphs[i]); });
+  return out;
+}
+
+PrSummary validate_sgpr(const SgprNetwork& network, std::span<const GraphSequence> sequences,
+                        const PlaceEvalConfig& protocol) {
+  std::vector<double> scores;
+  std::vector<std::uint8_t> truth;
+  for (const auto& sequence : sequences) {
+    const auto embeddings = embed_graphs(network, sequence.graphs);
+    const auto pairs = place_pairs(sequence.positions, protocol);
+    // Grouped by query (place_pairs orders by query): one batch per query. Logits
+    // rank pairs like the scores and are better resolved near 0 and 1.
+    std::size_t k = 0;
+    while (k < pairs.size()) {
+      const std::uint32_t query = pairs[k].query;
+      std::vector<SgprEmbedding> candidates;
+      const std::size_t begin = k;
+      for (; k < pairs.size() && pairs[k].query == query; ++k) candidates.push_back(embeddings[pairs[k].candidate]);
+      const auto logits = network.logit_batch(embeddings[query], candidates);
+      for (std::size_t m = 0; m < logits.size(); ++m) {
+        scores.push_back(logits[m]);
+        truth.push_back(pairs[begin + m].positive ? 1 : 0);
+      }
+    }
+  }
+  return precision_recall(scores, truth);
+}
+
+}  // namespace saloam
