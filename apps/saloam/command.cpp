@@ -80,8 +80,8 @@ std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConf
   std::error_code error;
   if (std::filesystem::is_regular_file(shipped, error)) return shipped;
   throw ConfigError(fmt::format(
-      "SGPR needs weights: pass --model FILE.sgw or --set loop.sgpr_model=FILE.sgw (no model ships in {} yet; "
-      "e.g. the original KITTI weights converted to .sgw)",
+      "SGPR needs weights: pass --model FILE.sgw or --set loop.sgpr_model=FILE.sgw (the shipped model is missing "
+      "from {}; set SALOAM_DATA_DIR if saloam was moved)",
       shipped.parent_path().string()));
 }
 

@@ -119,8 +119,8 @@ std::filesystem::path write_revisit_sequence(const testing::TempDir& tmp) {
   return root;
 }
 
+// SGPR runs on the shipped model (models/sgpr/saloam.sgw): no --model needed.
 TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
-  SALOAM_REQUIRE_SHARED_DATA();
   testing::TempDir tmp;
   const auto seq = write_revisit_sequence(tmp);
   std::string output;
@@ -140,9 +140,8 @@ TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
 
   for (const std::string method : {"sgpr", "scancontext", "ssc"}) {
     const auto out = tmp / ("eval_" + method);
-    const auto model = testing::shared_dir() / "models/sgpr/sgpr_kitti.sgw";
-    ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method {} --model {} --out {}", quoted(seq),
-                                                          method, quoted(model), quoted(out))),
+    ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method {} --out {}", quoted(seq), method,
+                                                          quoted(out))),
                                    &output),
               0)
         << output;
