@@ -67,6 +67,18 @@ TEST(Config, ShippedRealKittiFileSetsMidSweepPoses) {
   EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));
 }
 
+// config/paper.yaml: Table I's values (the defaults) and the paper's literal choices.
+TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
+  const auto loaded = load_config(testing::source_dir() / "config" / "paper.yaml");
+  SaloamConfig expected;
+  expected.odometry.local_map_point = "newest";
+  expected.odometry.match_class_groups = false;
+  expected.odometry.features.ground_edge_alpha = 0.1;
+  expected.loop.acceptance = "loss";
+  EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));
+  EXPECT_EQ(loaded.odometry.local_map_frames, 20);  // N_m of Table I
+}
+
 TEST(Config, InfinityRoundTrips) {
   SaloamConfig c;
   apply_config_override(c, "odometry.features.ground_edge_alpha=.inf");

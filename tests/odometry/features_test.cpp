@@ -187,6 +187,60 @@ TEST(SemanticClasses, GroupsMergeConfusableClassesWithSharedGeometry) {
   EXPECT_EQ(class_group(0), 0);
 }
 
+// A 16-ring scan stored ring by ring: every ring starts at `seam_deg` and
+// turns in the given sense, with a gap (no returns) in every third ring.
+LabelledCloud ring_by_ring_scan(double seam_deg, bool clockwise) {
+  LabelledCloud cloud;
+  for (int r = 0; r < 16; ++r) {
+    const double el = (15.0 - 2.0 * r) * M_PI / 180.0;
+    for (int a = 0; a < 1800; ++a) {
+      if (r % 3 == 0 && a > 300 && a < 500) continue;
+      const double turned = 2 * M_PI * (a + 0.5) / 1800.0;
+      const double az = seam_deg * M_PI / 180.0 + (clockwise ? -turned : turned);
+      const double range = 12.0 + 3.0 * std::sin(5 * az);
+      const Eigen::Vector3d d(std::cos(el) * std::cos(az), std::cos(el) * std::sin(az), std::sin(el));
+      cloud.push_back((range * d).cast<float>(), 0.5f, static_cast<std::uint16_t>(r));  // label = ring, for the test
+    }
+  }
+  return cloud;
+}
+
+void expect_rings_of(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& rings) {
+  ASSERT_EQ(rings.size(), 16u);
+  for (std::size_t r = 0; r < rings.size(); ++r) {
+    EXPECT_EQ(rings[r].size(), r % 3 == 0 ? 1601u : 1800u) << "ring " << r;
+    for (const auto i : rings[r]) ASSERT_EQ(cloud.label[i], r) << "point " << i;
+  }
+}
+
+TEST(RingsFromStorage, SweepOrderOfTheSimulator) {
+  FeatureConfig config;  // sweep from azimuth 180 deg, clockwise
+  const auto cloud = ring_by_ring_scan(180.0, true);
+  expect_rings_of(cloud, rings_from_point_order(cloud, config, 16));
+}
+
+TEST(RingsFromStorage, KittiOrderCounterClockwiseFromTheFront) {
+  // Real KITTI stores each ring counter-clockwise from azimuth 0, which the
+  // sweep model (clockwise from 180 deg) does not describe.
+  FeatureConfig config;
+  for (const double seam : {0.0, 0.3, -40.0}) {
+    SCOPED_TRACE(seam);
+    const auto cloud = ring_by_ring_scan(seam, false);
+    expect_rings_of(cloud, rings_from_point_order(cloud, config, 16));
+  }
+  const auto clockwise_from_front = ring_by_ring_scan(0.0, true);
+  expect_rings_of(clockwise_from_front, rings_from_point_order(clockwise_from_front, config, 16));
+}
+
+TEST(RingsFromStorage, ShuffledPointsAreNotRings) {
+  FeatureConfig config;
+  auto cloud = ring_by_ring_scan(0.0, false);
+  std::mt19937 rng(7);
+  std::shuffle(cloud.points.begin(), cloud.points.end(), rng);
+  EXPECT_TRUE(rings_from_point_order(cloud, config, 16).empty());
+  EXPECT_TRUE(rings_from_point_order(cloud, config, 0).empty());
+}
+
 // A synthetic 64-beam scan of a box-shaped room with a pole, labelled.
 LabelledCloud room_scan(bool labelled) {
   LabelledCloud cloud;

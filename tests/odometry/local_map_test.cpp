@@ -108,10 +108,10 @@ FeatureCloud cloud_of(std::initializer_list<Eigen::Vector3d> points, ClassIndex 
   return cloud;
 }
 
-TEST(SemanticLocalMap, KeepsTheNewestPointPerVoxelOverTheLastFrames) {
+TEST(SemanticLocalMap, NewestPolicyKeepsTheNewestPointPerVoxelOverTheLastFrames) {
   ClassVoxelSizes sizes{};
   sizes.fill(0.5);
-  SemanticLocalMap map(2, sizes, 1.0);
+  SemanticLocalMap map(2, sizes, 1.0, MapVoxelPoint::kNewest);
   EXPECT_TRUE(map.empty());
   const Eigen::Vector3d first(0.1, 0.1, 0.1), second(0.2, 0.2, 0.2), far(3.1, 0.1, 0.1);
   map.add_frame(cloud_of({first, far}, 0), FeatureCloud{});
@@ -134,6 +134,36 @@ TEST(SemanticLocalMap, KeepsTheNewestPointPerVoxelOverTheLastFrames) {
   map.add_frame(FeatureCloud{}, FeatureCloud{});
   EXPECT_EQ(map.num_edge_points(), 0u);
   EXPECT_EQ(map.num_planar_points(), 0u);
+}
+
+TEST(SemanticLocalMap, FirstPolicyKeepsTheFirstPointWhileTheVoxelIsObserved) {
+  ClassVoxelSizes sizes{};
+  sizes.fill(0.5);
+  SemanticLocalMap map(2, sizes, 1.0, MapVoxelPoint::kFirst);
+  const Eigen::Vector3d first(0.1, 0.1, 0.1), second(0.2, 0.2, 0.2), far(3.1, 0.1, 0.1);
+  map.add_frame(cloud_of({first, far}, 0), FeatureCloud{});
+  Eigen::Vector3d p[2];
+  double d2[2];
+  // The voxel of `first` is observed by every later frame: it keeps `first`
+  // however long the sequence, while `far`, seen once, leaves after N_m = 2.
+  for (int frame = 1; frame < 6; ++frame) {
+    map.add_frame(cloud_of({second}, 0), FeatureCloud{});
+    ASSERT_EQ(map.edges().nearest(second, 0, 2, 1.0, p, d2), 1) << "frame " << frame;
+    EXPECT_EQ(p[0], first);
+    EXPECT_EQ(map.edges().nearest(far, 0, 1, 1.0, p, d2), frame < 2 ? 1 : 0) << "frame " << frame;
+  }
+  EXPECT_EQ(map.num_edge_points(), 1u);
+  map.add_frame(FeatureCloud{}, FeatureCloud{});
+  EXPECT_EQ(map.num_edge_points(), 1u);  // observed by the previous frame: still in the window
+  map.add_frame(FeatureCloud{}, FeatureCloud{});
+  EXPECT_EQ(map.num_edge_points(), 0u);
+}
+
+TEST(SemanticLocalMap, PolicyFromTheConfig) {
+  OdometryConfig config;
+  EXPECT_EQ(map_voxel_point(config), MapVoxelPoint::kFirst);
+  config.local_map_point = "newest";
+  EXPECT_EQ(map_voxel_point(config), MapVoxelPoint::kNewest);
 }
 
 TEST(SemanticLocalMap, ClassesNeverShareAVoxel) {

@@ -3,13 +3,16 @@
 // (the official GT is a constant-velocity fill for these frames).
 
 #include <cmath>
+#include <algorithm>
 #include <cstdio>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "saloam/core/lie.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/odometry/features.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
 #include "testing/test_support.hpp"
 
@@ -42,6 +45,29 @@ struct Error {
 Error relative_error(const Pose& estimate, const Pose& reference) {
   const Pose d = reference.inverse() * estimate;
   return {d.translation().norm(), rotation_angle(d) * 180.0 / M_PI};
+}
+
+// KITTI stores a scan ring by ring, each counter-clockwise from about
+// azimuth 0, top ring first: 64 runs whose elevations fall monotonically.
+TEST(RealKittiScans, StorageOrderGivesSixtyFourRings) {
+  SALOAM_REQUIRE_SHARED_DATA();
+  for (const auto& scan : load_scans()) {
+    const auto rings = rings_from_point_order(scan, FeatureConfig{}, 64);
+    ASSERT_EQ(rings.size(), 64u);
+    double previous_elevation = 90.0;
+    for (const auto& ring : rings) {
+      ASSERT_GT(ring.size(), 500u);
+      std::vector<double> elevation;
+      for (const auto i : ring) {
+        const auto& p = scan.points[i];
+        elevation.push_back(std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / M_PI);
+      }
+      std::nth_element(elevation.begin(), elevation.begin() + elevation.size() / 2, elevation.end());
+      const double median = elevation[elevation.size() / 2];
+      EXPECT_LT(median, previous_elevation + 0.6);  // the HDL-64E's lasers are not in exact order
+      previous_elevation = median;
+    }
+  }
 }
 
 TEST(RealKittiScans, EachConsecutivePairMatchesIcpReference) {

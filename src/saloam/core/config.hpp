@@ -95,7 +95,11 @@ struct FeatureConfig {
 /// Scan-to-local-map registration (paper Sec. III-B, Eq. 2).
 struct OdometryConfig {
   FeatureConfig features;
-  int local_map_frames = 20;     ///< N_m: frames kept in the local map
+  int local_map_frames = 20;     ///< N_m: a map voxel no frame of the last N_m observed leaves the map
+  /// The point a map voxel keeps when observed again: "first" (the map stays
+  /// anchored where it was first registered) or "newest" (the map follows the
+  /// latest frames; the paper's map of the last N_m frames). See MapVoxelPoint.
+  std::string local_map_point = "first";
   int edge_neighbours = 5;       ///< N_ne: map points fitted to a line per edge feature
   int planar_neighbours = 5;     ///< N_np: map points fitted to a plane per planar feature
   /// Tolerance of the semantic plane constraint (not a Table I parameter;
@@ -274,6 +278,7 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
 template <class Visitor>
 void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("local_map_frames", c.local_map_frames, "N_m: frames in the local map", AtLeast{1});
+  v("local_map_point", c.local_map_point, "point a map voxel keeps when observed again", OneOf{"first", "newest"});
   v("edge_neighbours", c.edge_neighbours, "N_ne: neighbours per edge feature", Range{2, kMaxFitNeighbours});
   v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature", Range{3, kMaxFitNeighbours});
   v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . z|", Range{0, 1});

@@ -252,23 +252,22 @@ std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureCo
   return times;
 }
 
-std::vector<std::vector<std::uint32_t>> rings_from_order(const std::vector<float>& times,
-                                                         const FeatureConfig& config, int expected_rings) {
-  // KITTI and the simulator store a scan ring by ring, each ring in firing
-  // order: the sweep time restarts at every ring change.
+// A ring is a run of points whose phase (fraction of a turn from the seam,
+// in the storage's turning sense) increases: the storage moves to the next
+// ring where the phase jumps back by more than half a turn.
+std::vector<std::vector<std::uint32_t>> split_rings(const std::vector<float>& phase, int expected_rings) {
   std::vector<std::vector<std::uint32_t>> rings;
   std::vector<std::uint32_t> current;
-  double last_time = -1.0;
-  const double wrap = 0.5 * config.sweep_duration;
-  for (std::size_t i = 0; i < times.size(); ++i) {
-    const double t = times[i];
-    if (t < 0.0) continue;
-    if (last_time >= 0.0 && t < last_time - wrap) {
+  double last = -1.0;
+  for (std::size_t i = 0; i < phase.size(); ++i) {
+    const double p = phase[i];
+    if (p < 0.0) continue;
+    if (last >= 0.0 && p < last - 0.5) {
       rings.push_back(std::move(current));
       current.clear();
     }
     current.push_back(static_cast<std::uint32_t>(i));
-    last_time = t;
+    last = p;
   }
   if (!current.empty()) rings.push_back(std::move(current));
   // Accept only if it looks like rings: many long runs, not more runs than
@@ -281,11 +280,67 @@ std::vector<std::vector<std::uint32_t>> rings_from_order(const std::vector<float
   if (long_runs < min_long || segments > max_rings) return {};
   return rings;
 }
+
+/// The phases in the order the points are stored, when it is not the
+/// sweep's: the sense is that of most small steps between consecutive points
+/// (at least 90 % of them; large steps are ring changes or gaps), the seam
+/// where the first ring starts. Empty when no sense dominates (the points are
+/// not stored along rings). `sweep_phase` is the phase in the sweep's own
+/// order; a phase is a linear function of the azimuth, so no angle is recomputed.
+std::vector<float> storage_phase(const std::vector<float>& sweep_phase) {
+  constexpr float kSmallStep = 5.0f / 360.0f;
+  std::size_t along = 0, against = 0;
+  float first = -1.0f, previous = -1.0f;
+  for (const float p : sweep_phase) {
+    if (p < 0.0f) continue;
+    if (first < 0.0f) first = p;
+    if (previous >= 0.0f) {
+      float step = p - previous;
+      if (step > 0.5f) step -= 1.0f;
+      if (step < -0.5f) step += 1.0f;
+      along += step > 0.0f && step < kSmallStep;
+      against += step < 0.0f && step > -kSmallStep;
+    }
+    previous = p;
+  }
+  const std::size_t steps = along + against;
+  if (steps < 100 || static_cast<double>(std::max(along, against)) < 0.9 * static_cast<double>(steps)) return {};
+  const float sense = along > against ? 1.0f : -1.0f;
+  std::vector<float> phase(sweep_phase.size(), -1.0f);
+  for (std::size_t i = 0; i < phase.size(); ++i) {
+    if (sweep_phase[i] < 0.0f) continue;
+    const float turned = sense * (sweep_phase[i] - first);
+    phase[i] = turned - std::floor(turned);
+  }
+  return phase;
+}
+
+/// Rings from the storage order, given every point's sweep time, split in
+/// two ways: in the sweep's own order (the simulator stores rings in firing
+/// order) and in the order detected in the scan (KITTI stores each ring
+/// counter-clockwise from azimuth 0, although the HDL-64E fires clockwise
+/// from behind). A seam in the wrong place cuts every ring in two and makes
+/// one run more than there are rings, so the split with fewer runs wins; the
+/// sweep's on a tie (its seam does not depend on where the first ring's
+/// returns begin).
+std::vector<std::vector<std::uint32_t>> rings_from_storage(const std::vector<float>& sweep_times,
+                                                           const FeatureConfig& config, int expected_rings) {
+  std::vector<float> sweep_phase(sweep_times.size());
+  const auto duration = static_cast<float>(config.sweep_duration);
+  std::transform(sweep_times.begin(), sweep_times.end(), sweep_phase.begin(),
+                 [duration](float t) { return t < 0.0f ? -1.0f : t / duration; });
+  auto rings = split_rings(sweep_phase, expected_rings);
+  const auto phase = storage_phase(sweep_phase);
+  if (phase.empty()) return rings;
+  auto detected = split_rings(phase, expected_rings);
+  if (rings.empty() || (!detected.empty() && detected.size() < rings.size())) return detected;
+  return rings;
+}
 }  // namespace
 
 std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
                                                               const FeatureConfig& config, int expected_rings) {
-  return rings_from_order(point_sweep_times(cloud, config), config, expected_rings);
+  return rings_from_storage(point_sweep_times(cloud, config), config, expected_rings);
 }
 
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
@@ -300,7 +355,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // even for scans whose points were moved by motion compensation), else from
   // the elevation angle.
   const std::vector<float> times = point_sweep_times(cloud, config);
-  auto ordered = config.ring_from_point_order ? rings_from_order(times, config, config.num_beams)
+  auto ordered = config.ring_from_point_order ? rings_from_storage(times, config, config.num_beams)
                                               : std::vector<std::vector<std::uint32_t>>{};
   if (!ordered.empty()) {
     buckets.resize(ordered.size());

@@ -93,10 +93,14 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<bool>& unreliable, const FeatureConfig& config,
                                    const std::vector<bool>& not_edge = {});
 
-/// Rings from the storage order (KITTI and the simulator write a scan ring by
-/// ring, each in firing order: a ring ends where the sweep time jumps back).
-/// Returns point indices per ring, or nothing when the order does not look
-/// like rings (then rings come from the elevation). expected_rings <= 0: unknown.
+/// Rings from the storage order. The simulator writes a scan ring by ring in
+/// firing order (a ring ends where the sweep time jumps back); real KITTI
+/// stores each ring counter-clockwise from azimuth 0 whatever the firing
+/// order: when the sweep's own order does not split the scan into rings, the
+/// sense is read from the steps between consecutive points and the seam from
+/// the first point. Returns point indices per ring, or
+/// nothing when the order does not look like rings (then rings come from the
+/// elevation). expected_rings <= 0: unknown.
 std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
                                                               const FeatureConfig& config, int expected_rings);
 

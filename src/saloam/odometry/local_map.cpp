@@ -134,11 +134,22 @@ int NeighbourGrid::nearest(const Eigen::Vector3d& q, ClassIndex c, int k, double
   return found;
 }
 
-SemanticLocalMap::SemanticLocalMap(int max_frames, ClassVoxelSizes voxel_size, double search_radius)
+MapVoxelPoint map_voxel_point(const OdometryConfig& config) {
+  return config.local_map_point == "newest" ? MapVoxelPoint::kNewest : MapVoxelPoint::kFirst;
+}
+
+SemanticLocalMap::SemanticLocalMap(int max_frames, ClassVoxelSizes voxel_size, double search_radius,
+                                   MapVoxelPoint keep)
     : max_frames_(std::max(1, max_frames)),
       voxel_size_(voxel_size),
+      keep_(keep),
       edges_(search_radius),
       planars_(search_radius) {}
+
+SemanticLocalMap SemanticLocalMap::from_config(const OdometryConfig& config) {
+  return SemanticLocalMap(config.local_map_frames, class_voxel_sizes(config), config.max_correspondence_distance,
+                          map_voxel_point(config));
+}
 
 void SemanticLocalMap::insert(Layer& layer, const FeatureCloud& cloud, std::uint64_t frame) {
   std::vector<VoxelKey> keys;
@@ -150,8 +161,11 @@ void SemanticLocalMap::insert(Layer& layer, const FeatureCloud& cloud, std::uint
     auto [it, inserted] = layer.voxels.try_emplace(key, Voxel{p, frame});
     if (!inserted) {
       if (it->second.frame == frame) continue;  // the first point of this frame stays
-      // The newest frame wins: it was registered last, so it agrees best
-      // with the next scans.
+      if (keep_ == MapVoxelPoint::kFirst) {
+        it.value().frame = frame;
+        keys.push_back(key);
+        continue;
+      }
       layer.points.erase(it->second.point, c);
       it.value() = Voxel{p, frame};
     }

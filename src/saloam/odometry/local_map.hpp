@@ -88,15 +88,34 @@ class NeighbourGrid {
   std::size_t size_ = 0;
 };
 
+/// Which point a local-map voxel keeps when a later frame observes it again.
+enum class MapVoxelPoint {
+  /// The first one: the map stays where the voxel was first registered, so a
+  /// scan is aligned to the places it shares with scans far back and the
+  /// drift grows only as fast as places leave the map (KISS-ICP's voxel map
+  /// keeps first points too).
+  kFirst,
+  /// The newest one: the map follows the latest registrations (the map of
+  /// "the last N_m frames" taken literally).
+  kNewest,
+};
+/// From the config's `local_map_point` ("first" or "newest").
+MapVoxelPoint map_voxel_point(const OdometryConfig& config);
+
 class SemanticLocalMap {
  public:
-  /// `search_radius`: the largest neighbour distance queries will ask for
-  /// (the registration's max correspondence distance).
-  SemanticLocalMap(int max_frames, ClassVoxelSizes voxel_size, double search_radius);
+  /// `max_frames` (N_m): a voxel leaves the map when the last N_m frames have
+  /// not observed it. `search_radius`: the largest neighbour distance queries
+  /// will ask for (the registration's max correspondence distance).
+  SemanticLocalMap(int max_frames, ClassVoxelSizes voxel_size, double search_radius,
+                   MapVoxelPoint keep = MapVoxelPoint::kFirst);
+  /// The map the odometry configured by `config` uses.
+  static SemanticLocalMap from_config(const OdometryConfig& config);
 
-  /// Adds one frame's features (already in the world frame): each class
-  /// voxel keeps the newest point that fell into it; the frame beyond N_m is
-  /// dropped, except for the voxels a newer frame took over.
+  /// Adds one frame's features (already in the world frame): a new class
+  /// voxel takes the frame's first point in it; a voxel already in the map
+  /// keeps its point or takes the frame's (see MapVoxelPoint) and counts as
+  /// observed by this frame. Then voxels no frame of the last N_m observed leave.
   void add_frame(const FeatureCloud& edges_world, const FeatureCloud& planars_world);
   [[nodiscard]] bool empty() const { return frame_count_ == 0; }
   [[nodiscard]] const NeighbourGrid& edges() const { return edges_.points; }
@@ -107,14 +126,14 @@ class SemanticLocalMap {
  private:
   struct Voxel {
     Eigen::Vector3d point;
-    std::uint64_t frame;
+    std::uint64_t frame;  ///< the last frame that observed the voxel
   };
   /// One feature type: the downsampling voxels (which point represents each
   /// voxel, and since which frame) and the searchable points they hold.
   struct Layer {
     explicit Layer(double search_radius) : points(search_radius) {}
     tsl::robin_map<VoxelKey, Voxel, VoxelKeyHash> voxels;
-    std::deque<std::vector<VoxelKey>> frame_keys;  ///< voxels written by each frame in the window
+    std::deque<std::vector<VoxelKey>> frame_keys;  ///< voxels observed by each frame in the window
     NeighbourGrid points;
   };
   void insert(Layer& layer, const FeatureCloud& cloud, std::uint64_t frame);
@@ -122,6 +141,7 @@ class SemanticLocalMap {
 
   int max_frames_;
   ClassVoxelSizes voxel_size_;
+  MapVoxelPoint keep_;
   std::uint64_t frame_count_ = 0;
   Layer edges_;
   Layer planars_;

@@ -25,7 +25,7 @@ SemanticOdometry::SemanticOdometry(OdometryConfig config)
     : config_(std::move(config)),
       settings_(RegistrationSettings::from_config(config_)),
       voxel_sizes_(class_voxel_sizes(config_)),
-      map_(config_.local_map_frames, voxel_sizes_, config_.max_correspondence_distance) {
+      map_(SemanticLocalMap::from_config(config_)) {
   if (config_.threads != 1) {
     const int threads = config_.threads > 0 ? config_.threads
                                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -153,7 +153,7 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
       // estimated, rebuild the map from the first and register again.
       const Vector6d first_motion = se3_log(sweep_poses_[0].inverse() * pose);
       const ScanFeatures first = deskewed(first_raw_, first_motion, prediction.period, mid);
-      map_ = SemanticLocalMap(config_.local_map_frames, voxel_sizes_, config_.max_correspondence_distance);
+      map_ = SemanticLocalMap::from_config(config_);
       map_.add_frame(transformed(first.edges, sweep_poses_[0]), transformed(first.planars, sweep_poses_[0]));
       revised_first_ = first;  // mid-sweep frame of sweep 0; moved to its pose instant in record_frame
       features = deskewed(measured, first_motion, prediction.period, mid);
