@@ -13,6 +13,7 @@
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/sim/class_shares.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sim/trajectories.hpp"
 
@@ -32,6 +33,7 @@ struct SimulateArgs {
   int azimuth_steps = 2083;
   bool no_skew = false;
   bool no_dynamic = false;
+  bool stats = false;
 };
 
 // Tr from a KITTI calib.txt (`Tr:` line) or from the per-sequence list
@@ -77,9 +79,18 @@ int run_simulate(const SimulateArgs& args) {
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
 
   const std::string source = args.trajectory.empty() ? "preset " + options.preset : args.trajectory;
+  if (args.out.empty()) {
+    if (!args.stats) throw ConfigError("--out is required (or --stats alone to measure the class shares)");
+    spdlog::info("class shares of {} ({} beams, seed {}), rendered in memory", source, options.beams, options.seed);
+    const SimulatedSequence sequence(options);
+    std::cout << fmt::format("ground-truth class shares over {} frames:\n", sequence.size())
+              << format_class_shares(measure_class_shares(sequence, options.show_progress));
+    return 0;
+  }
   spdlog::info("simulating {} ({} beams, seed {}, skew {}, labels {}) into {}", source, options.beams, options.seed,
                options.skew ? "on" : "off", args.labels, args.out);
   const SimulationSummary s = simulate_sequence(options, args.out);
+  if (args.stats) std::cout << "ground-truth class shares:\n" << format_class_shares(s.shares);
   std::cout << fmt::format("wrote {} frames, {} points ({:.0f} per frame) to {} in {:.1f} s ({:.2f} frames/s)\n", s.frames,
                            s.points, s.frames ? static_cast<double>(s.points) / static_cast<double>(s.frames) : 0.0, args.out,
                            s.seconds, s.seconds > 0 ? static_cast<double>(s.frames) / s.seconds : 0.0);
@@ -106,8 +117,8 @@ const CommandRegistration kRegistration{Command{
     "simulate", "Write a synthetic SemanticKITTI sequence (ray-cast HDL-64E in a procedural street world)", 10,
     [](CLI::App& app) {
       auto args = std::make_shared<SimulateArgs>();
-      app.add_option("--out", args->out, "Output sequence folder (velodyne/, labels/, poses.txt, calib.txt, times.txt)")
-          ->required();
+      app.add_option("--out", args->out,
+                     "Output sequence folder (velodyne/, labels/, poses.txt, calib.txt, times.txt); optional with --stats");
       app.add_option("--trajectory", args->trajectory, "KITTI ground-truth pose file (camera frame), e.g. poses/00.txt")
           ->check(CLI::ExistingFile);
       app.add_option("--calib", args->calib,
@@ -126,6 +137,8 @@ const CommandRegistration kRegistration{Command{
           ->check(CLI::Range(16, 8000));
       app.add_flag("--no-skew", args->no_skew, "Take each scan at one instant (no motion distortion)");
       app.add_flag("--no-dynamic", args->no_dynamic, "No moving cars or pedestrians");
+      app.add_flag("--stats", args->stats,
+                   "Print the ground-truth class shares against SemanticKITTI's; without --out, only measure them (nothing written)");
       return [args] { return run_simulate(*args); };
     }}};
 

@@ -279,13 +279,15 @@ TEST(Dynamic, SomeParkedVehiclesDifferBetweenPasses) {
   EXPECT_GT(timed, vehicles / 10);
   EXPECT_LT(timed, vehicles / 2);
   // Along the stretch driven twice (the first ~200 m), some vehicles are
-  // there on one pass and not on the other, most are there on both.
+  // there on one pass and not on the other, most are there on both. (Within
+  // 250 m: parking lanes are rarer since the world follows SemanticKITTI's
+  // class mix, and only one parked vehicle changes within 150 m.)
   const auto& poses = urban_loop();
   const double t_first = 50 * 0.1, t_second = (poses.size() - 150) * 0.1;
   const Eigen::Vector2d place = poses[50].translation().head<2>();
   std::set<std::uint16_t> changed, kept;
   for (const auto& p : urban_world().primitives()) {
-    if (p.instance == 0 || (p.center.cast<double>() - place).norm() > 150) continue;
+    if (p.instance == 0 || (p.center.cast<double>() - place).norm() > 250) continue;
     (p.present(t_first) != p.present(t_second) ? changed : kept).insert(p.instance);
   }
   EXPECT_GE(changed.size(), 2u);

@@ -1,5 +1,6 @@
 #include "saloam/odometry/semantic_odometry.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <thread>
 
@@ -14,6 +15,15 @@ using Clock = std::chrono::steady_clock;
 // with by more than this moves points by more than ~1 cm: de-skew again.
 constexpr double kRedeskewTranslation = 0.01;           // [m per frame]
 constexpr double kRedeskewRotation = 0.1 * M_PI / 180;  // [rad per frame]
+// The second frame is registered from the first frame's pose (no motion is
+// known yet), possibly a whole frame's travel (1.4 m at 7 m/s and 5 Hz) away,
+// more than the correspondence distance: the few re-association rounds that
+// suffice from a constant-velocity prediction stop it short (0.5 m of 1.4 m
+// along a street of hedges, and every later pose and loop against frame 0
+// inherits the error). It gets rounds until the pose settles.
+constexpr int kBootstrapOuterIterations = 10;
+constexpr double kBootstrapSettledTranslation = 0.01;           // [m]
+constexpr double kBootstrapSettledRotation = 0.1 * M_PI / 180;  // [rad]
 
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
@@ -139,8 +149,14 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
       return true;
     };
   }
+  RegistrationSettings settings = settings_;
+  if (k == 1) {
+    settings.outer_iterations = std::max(settings.outer_iterations, kBootstrapOuterIterations);
+    settings.reassociation_min_translation = std::max(settings.reassociation_min_translation, kBootstrapSettledTranslation);
+    settings.reassociation_min_rotation = std::max(settings.reassociation_min_rotation, kBootstrapSettledRotation);
+  }
   auto register_from = [&](const Pose& initial) {
-    RegistrationResult result = register_scan(features, map_, initial, settings_, refresh);
+    RegistrationResult result = register_scan(features, map_, initial, settings, refresh);
     last_stats_.association_rounds += result.associations;
     return result;
   };

@@ -1,6 +1,8 @@
 #include "saloam/sim/lidar.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -21,7 +23,32 @@ LidarModel LidarModel::hdl64e(int beams) {
   for (int i = 0; i < 32; ++i) all.push_back(-8.83 - (24.9 - 8.83) * i / 31.0);
   const int step = 64 / beams;
   for (int i = 0; i < 64; i += step) m.elevation_deg.push_back(all[static_cast<std::size_t>(i)]);
+  m.ego_body = kitti_ego_body();
   return m;
+}
+
+std::vector<Eigen::AlignedBox3d> LidarModel::kitti_ego_body() {
+  constexpr double kSensorHeight = 1.73, kBeltLine = 0.93, kRoof = 1.45;
+  return {Eigen::AlignedBox3d(Eigen::Vector3d(-2.39, -0.91, -kSensorHeight), Eigen::Vector3d(2.03, 0.91, kBeltLine - kSensorHeight)),
+          Eigen::AlignedBox3d(Eigen::Vector3d(-0.84, -0.45, -kSensorHeight), Eigen::Vector3d(0.30, 0.45, kRoof - kSensorHeight))};
+}
+
+bool LidarModel::hits_ego_body(const Eigen::Vector3d& direction) const {
+  // Slab test of the ray from the origin (outside every box) against each box.
+  return std::any_of(ego_body.begin(), ego_body.end(), [&](const Eigen::AlignedBox3d& box) {
+    double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+      if (std::abs(direction[a]) < 1e-12) {
+        if (box.min()[a] > 0.0 || box.max()[a] < 0.0) return false;
+        continue;
+      }
+      double lo = box.min()[a] / direction[a], hi = box.max()[a] / direction[a];
+      if (lo > hi) std::swap(lo, hi);
+      t0 = std::max(t0, lo);
+      t1 = std::min(t1, hi);
+    }
+    return t0 <= t1;
+  });
 }
 
 double LidarModel::column_fraction(int column) const { return (column + 0.5) / azimuth_steps; }
@@ -58,6 +85,18 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     cos_el[static_cast<std::size_t>(b)] = std::cos(e);
   }
 
+  // Rays the car's own body stops (the same in every sweep).
+  std::vector<std::uint8_t> blocked(grid.size(), 0);
+  for (int c = 0; c < columns && !lidar.ego_body.empty(); ++c) {
+    const double az = lidar.column_azimuth(c);
+    for (int b = 0; b < beams; ++b) {
+      const Eigen::Vector3d dir_s(cos_el[static_cast<std::size_t>(b)] * std::cos(az),
+                                  cos_el[static_cast<std::size_t>(b)] * std::sin(az), sin_el[static_cast<std::size_t>(b)]);
+      blocked[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)] =
+          lidar.hits_ego_body(dir_s) ? 1 : 0;
+    }
+  }
+
   std::vector<float> column_offset(static_cast<std::size_t>(columns), 0.0f);
   tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
     std::vector<Primitive> agents, near;
@@ -90,6 +129,7 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
         const Eigen::Vector3d dir = sensor.linear() * dir_s;
         Return& out = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
         out.valid = false;
+        if (blocked[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)]) continue;
         const RayHit hit = world.cast_ray(origin, dir, lidar.max_range, t, near, rng);
         // Draw every random number whether or not it is used, so that one
         // ray's outcome never shifts the noise of the next.

@@ -15,6 +15,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "saloam/core/types.hpp"
 #include "saloam/sim/world.hpp"
 
@@ -28,10 +30,25 @@ struct LidarModel {
   double dropout = 0.05;              ///< probability that a return is lost
   double sweep_period = 0.1;          ///< [s]
   double remission_noise = 0.04;
+  /// The recording car's body in the sensor frame (x forward, z up): rays
+  /// that meet it return nothing. Empty = a free-standing sensor.
+  std::vector<Eigen::AlignedBox3d> ego_body;
 
   /// HDL-64E: upper block of 32 beams from +2 to -8.33 deg, lower block of 32
   /// from -8.83 to -24.9 deg. With beams = 32 or 16, every 2nd / 4th beam.
+  /// Mounted on KITTI's car (kitti_ego_body()).
   static LidarModel hdl64e(int beams = 64);
+  /// KITTI's recording car seen from its roof-mounted HDL-64E (1.73 m above
+  /// the road): a box for the body below the belt line (0.93 m above the
+  /// road, from 2.03 m ahead of the sensor to 2.39 m behind it, 1.82 m wide)
+  /// and one for the roof (1.45 m, 0.84 m behind to 0.30 m ahead, 0.9 m
+  /// wide). Fitted to KITTI 00's scans (frames 0-8): straight ahead no return
+  /// comes from beams steeper than -21.5 deg (the hood), straight behind
+  /// none steeper than -18.5 deg, 40 deg off the rear about half of the
+  /// beams below -19.5 deg return, and to the sides every beam reaches the road.
+  static std::vector<Eigen::AlignedBox3d> kitti_ego_body();
+  /// True when a ray from the sensor along `direction` (sensor frame) meets the ego body.
+  [[nodiscard]] bool hits_ego_body(const Eigen::Vector3d& direction) const;
   [[nodiscard]] int beams() const { return static_cast<int>(elevation_deg.size()); }
   /// Azimuth [rad] and time fraction within the sweep of column c.
   [[nodiscard]] double column_azimuth(int column) const;

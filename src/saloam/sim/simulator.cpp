@@ -152,6 +152,7 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
     const double offset = std::abs(static_cast<double>(frame.sensor_offset));
     summary.max_sensor_offset = std::max(summary.max_sensor_offset, offset);
     if (offset > 0.0) ++summary.reseated_frames;
+    summary.shares.add(noisy ? frame.gt_labels : frame.cloud.label);
     if (noisy) {
       summary.score.add(frame.gt_labels, frame.cloud.label);
       write_scan_labels(out_dir / "labels_gt" / (frame_name(k) + ".label"), frame.gt_labels, frame.gt_instances);

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "saloam/core/types.hpp"
+#include "saloam/sim/class_shares.hpp"
 #include "saloam/sim/lidar.hpp"
 #include "saloam/sim/label_noise.hpp"
 #include "saloam/sim/world.hpp"
@@ -57,6 +58,7 @@ struct SimulationSummary {
   double miou = std::numeric_limits<double>::quiet_NaN();  ///< noisy labels vs truth
   double label_accuracy = std::numeric_limits<double>::quiet_NaN();
   SegmentationScore score;         ///< per-class IoU of the noisy labels
+  ClassShares shares;              ///< ground-truth class shares of the frames written
   bool interrupted = false;
   /// Frames where the sensor had to leave the trajectory's height to stay on
   /// the ground (inconsistent ground-truth heights), and the largest offset [m].

@@ -18,7 +18,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 enum Salt : std::uint64_t {
   kSaltRoad = 101, kSaltParking, kSaltLot, kSaltSidewalk, kSaltVerge, kSaltRural, kSaltBump, kSaltBump2,
-  kSaltBuildings, kSaltFences, kSaltTrees, kSaltPoles, kSaltCars, kSaltAgents, kSaltStructures
+  kSaltBuildings, kSaltFences, kSaltTrees, kSaltPoles, kSaltCars, kSaltAgents, kSaltStructures, kSaltVerges
 };
 
 }  // namespace
@@ -167,16 +167,20 @@ class WorldBuilder {
         const bool rural = noise_at(hash_combine(seed_, kSaltRural), c.x(), c.y(), 260.0) > 0.7;
         // Right-hand traffic: the path runs in the right lane; the oncoming
         // lane (3.2 m further left) and, on avenues, one more lane lie left.
+        // KITTI's towns are mostly two-lane streets: avenues are rare.
         z.road_right = static_cast<float>(1.75 + 0.55 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
-        const bool avenue = noise_at(hash_combine(seed_, kSaltRoad + 1000), c.x(), c.y(), 300.0) > 0.78;
+        const bool avenue = noise_at(hash_combine(seed_, kSaltRoad + 1000), c.x(), c.y(), 300.0) > 0.84;
         z.road_left = z.road_right + 3.2f + (avenue ? 3.3f : 0.0f);
         const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 55.0);
         const double lot = noise_at(hash_combine(seed_, kSaltLot), c.x(), c.y(), 70.0);
         z.parking = 0.0f;
-        if (!rural && park > 0.55) z.parking = 2.3f;
-        if (!rural && lot > 0.92) z.parking = 15.0f;
+        // Parking lanes and lots are rare in SemanticKITTI (1.5 % of all
+        // points, against 4 % for cars: most of its parked cars stand in
+        // driveways, yards and on the road's edge).
+        if (!rural && park > 0.735) z.parking = 2.3f;
+        if (!rural && lot > 0.985) z.parking = 12.0f;
         z.sidewalk = rural ? 0.0f
-                           : static_cast<float>(1.5 + 1.6 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
+                           : static_cast<float>(1.4 + 1.2 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
         const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
         z.verge = rural || verge < 0.72 ? 0 : (verge < 0.86 ? 1 : 2);
         const std::size_t i = idx(ix, iy);
@@ -194,7 +198,7 @@ class WorldBuilder {
     Rng rng(hash_combine(seed_, kSaltRoad + 7));
     PointSet junctions;
     const double len = w_.path_length();
-    for (double s = rng.uniform(20, 80); s < len - 10; s += rng.uniform(60, 180)) {
+    for (double s = rng.uniform(20, 80); s < len - 10; s += rng.uniform(100, 250)) {
       Eigen::Vector3d pos;
       Eigen::Vector2d dir;
       w_.path_point(s, pos, dir);
@@ -350,7 +354,7 @@ class WorldBuilder {
 
   // ------------------------------------------------------------ objects
 
-  void place_buildings() {
+  void place_buildings(double total_time) {
     for (int side = -1; side <= 1; side += 2) {
       Rng rng(hash3(seed_, kSaltBuildings, static_cast<std::uint64_t>(side + 5)));
       walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
@@ -362,14 +366,16 @@ class WorldBuilder {
         const double depth = rng.uniform(8, 18);
         const double pick = rng.uniform();
         const double height = pick < 0.12 ? rng.uniform(5, 8) : (pick < 0.75 ? rng.uniform(8, 16) : rng.uniform(16, 25));
-        const double setback = rng.chance(0.65) ? rng.uniform(3.5, 12) : rng.uniform(0.5, 2.5);
+        // Front gardens, or (in the older blocks) the facade at the back of the
+        // sidewalk: no strip of grass left between them.
+        const double setback = rng.chance(0.65) ? rng.uniform(3.5, 12) : rng.uniform(0.15, 0.6);
         const double yaw = rng.uniform(-0.035, 0.035);
         const double edge = street_edge(probe, side);
         for (int attempt = 0; attempt < 2; ++attempt, length *= 0.55) {
           const Eigen::Vector2d axis = Eigen::Rotation2Dd(yaw) * dir;
           const Eigen::Vector2d mleft(-axis.y(), axis.x());
           const Eigen::Vector2d c = p + 0.5 * length * axis + side * mleft * (edge + setback + 0.5 * depth);
-          if (!rect_free(c, axis, 0.5 * length + 0.5, 0.5 * depth + 0.5, 0.8, false)) continue;
+          if (!rect_free(c, axis, 0.5 * length + 0.1, 0.5 * depth + 0.1, 0.1, false)) continue;
           add_building(c, axis, 0.5 * length, 0.5 * depth, height, rng);
           mark_rect(c, axis, 0.5 * length + 0.8, 0.5 * depth + 0.8);
           // Front yard: hedge or fence along the property line, sometimes a tree.
@@ -378,13 +384,27 @@ class WorldBuilder {
           if (setback > 2.0) property_line(yard, axis, side * mleft, 0.5 * length, rng);
           // Garden: bushes and trees between the property line and the house
           // (front gardens in KITTI's towns are densely planted).
-          for (int k = 0; setback > 3.0 && k < static_cast<int>(length / 2.5); ++k) {
-            const Eigen::Vector2d g = p + rng.uniform(0.1, 0.9) * length * axis +
-                                      side * mleft * (edge + rng.uniform(1.4, setback - 0.8));
-            const double r = std::min(rng.uniform(0.6, 2.2), 0.5 * setback - 0.5);
-            if (r < 0.4 || !rect_free(g, {1, 0}, r, r, 0.5, false)) continue;
+          // (Each bush wholly between the property line, 1.6 m in, and the
+          // house, 0.8 m clear of it.)
+          for (int k = 0; setback > 3.0 && k < static_cast<int>(length * setback / 6.0); ++k) {
+            const double r = std::min(rng.uniform(0.8, 2.6), 0.5 * (setback - 2.4));
+            const double near = edge + 1.6 + r, far = edge + setback - 0.8 - r;
+            if (r < 0.4 || far < near) continue;
+            const Eigen::Vector2d g = p + rng.uniform(0.1, 0.9) * length * axis + side * mleft * rng.uniform(near, far);
+            if (!rect_free(g, axis, r, r, 0.5, false)) continue;
             if (r > 1.0 && rng.chance(0.45)) add_tree(g, r + 1.2, rng); else add_bush(g, r, rng);
-            mark_rect(g, {1, 0}, r, r);
+            mark_rect(g, axis, r, r);
+          }
+          // A car in the driveway of some front gardens (most of KITTI's parked
+          // cars are off the parking lanes, which hold 1.5 % of its points).
+          if (setback > 6.5 && rng.chance(0.45)) {
+            const Eigen::Vector2d d = p + rng.uniform(0.15, 0.85) * length * axis + side * mleft * (edge + 1.7 + 2.5);
+            const double car_length = rng.uniform(3.9, 4.9);
+            if (rect_free(d, mleft, 0.5 * car_length + 0.15, 1.05, 0.5, false)) {
+              add_vehicle(d, mleft * (rng.chance(0.5) ? 1.0 : -1.0), cls::kCar, car_length, rng.uniform(1.7, 1.9),
+                          rng.uniform(1.4, 1.65), rng, total_time);
+              mark_rect(d, mleft, 0.5 * car_length + 0.15, 1.05);
+            }
           }
           // Shrubs along the house front (foundation planting) on some plots.
           if (setback > 2.5 && rng.chance(0.5)) {
@@ -462,7 +482,9 @@ class WorldBuilder {
     const double pick = rng.uniform();
     if (pick < 0.08) return;
     if (pick < 0.58) {
-      add_hedge(c, axis, half_length, rng.uniform(0.35, 0.7), rng.uniform(0.9, 2.2), rng);
+      // Privacy hedges, mostly above the sensor's 1.73 m: the lawn behind them
+      // is out of sight of every beam pointing down.
+      add_hedge(c, axis, half_length, rng.uniform(0.35, 0.7), rng.uniform(1.5, 2.6), rng);
     } else {
       add_fence(c, axis, half_length, rng.uniform(1.0, 1.9), 0.5, rng);
       if (rng.chance(0.75)) planting_behind(c, axis, away, half_length, rng);
@@ -550,19 +572,46 @@ class WorldBuilder {
         const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
         const double length = rng.uniform(6, 30);
         const double pick = rng.uniform();
-        if (pick < (rural ? 0.25 : 0.1)) return length;  // open
+        if (pick < (rural ? 0.1 : 0.04)) return length;  // open
         // Country roads: wide belts of shrubs along the field edges.
         const double half_w = rural ? rng.uniform(0.6, 1.8) : rng.uniform(0.35, 0.8);
         // Street side of the hedge or fence at least 0.15 m behind the sidewalk.
-        const double off = edge + 0.15 + half_w + rng.uniform(0.0, rural ? 3.0 : 0.6);
+        const double off = edge + 0.15 + half_w + rng.uniform(0.0, rural ? 0.6 : 0.3);
         const Eigen::Vector2d c = p + 0.5 * length * dir + side * left * off;
-        if (pick < (rural ? 0.72 : 0.55)) {
-          if (!add_hedge(c, dir, 0.5 * length, half_w, rng.uniform(0.8, rural ? 3.5 : 2.4), rng)) return 2.0;
+        if (pick < (rural ? 0.6 : 0.5)) {
+          if (!add_hedge(c, dir, 0.5 * length, half_w, rng.uniform(1.4, rural ? 4.0 : 2.8), rng)) return 2.0;
         } else {
-          if (!add_fence(c, dir, 0.5 * length, rng.uniform(0.9, 2.0), 0.4, rng)) return 2.0;
-          if (rng.chance(rural ? 0.4 : 0.7)) planting_behind(c, dir, side * left, 0.5 * length, rng);
+          if (!add_fence(c, dir, 0.5 * length, rng.uniform(1.0, 2.2), 0.3, rng)) return 2.0;
+          if (rng.chance(rural ? 0.6 : 0.85)) planting_behind(c, dir, side * left, 0.5 * length, rng);
         }
-        return length + (rng.chance(0.6) ? 0.0 : rng.uniform(1, 6));
+        return length + (rng.chance(0.75) ? 0.0 : rng.uniform(1, 4));
+      });
+    }
+  }
+
+  // Shrub beds and low hedges on whatever verge is still bare behind the
+  // sidewalk (or the rural road's edge) once plots, fences and trees are
+  // placed: KITTI's streets are lined with planting, and SemanticKITTI has
+  // 3.4 times as many vegetation points as terrain points (26.7 % vs 7.8 %).
+  // Driveways and paths leave about one bed in six out.
+  void plant_verges() {
+    for (int side = -1; side <= 1; side += 2) {
+      Rng rng(hash3(seed_, kSaltVerges, static_cast<std::uint64_t>(side + 5)));
+      walk(rng.uniform(0, 3), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+        const Eigen::Vector2d left(-dir.y(), dir.x());
+        const double half_length = rng.uniform(0.8, 1.6);
+        if (rng.chance(0.16)) return 2 * half_length + rng.uniform(1.0, 4.0);
+        const double half_w = rng.uniform(0.4, 1.2);
+        const double edge = street_edge(p + side * left * 7.0, side);
+        const Eigen::Vector2d c = p + half_length * dir + side * left * (edge + 0.2 + half_w);
+        if (!rect_free(c, dir, half_length, half_w, 0.1, false)) return 1.0;
+        const double g = ground(c);
+        const double height = 0.5 + 1.3 * noise_at(hash_combine(seed_, kSaltVerges), c.x(), c.y(), 12.0) + rng.uniform(0.0, 0.3);
+        Primitive bed = box(cls::kVegetation, c, dir, half_length, half_w, g - 0.1, g + height, rng.uniform(0.35, 0.5));
+        bed.mean_free_path = static_cast<float>(rng.uniform(0.25, 0.5));
+        w_.primitives_.push_back(bed);
+        mark_rect(c, dir, half_length, half_w);
+        return 2 * half_length;
       });
     }
   }
@@ -634,19 +683,19 @@ class WorldBuilder {
     walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
       const bool rural_here = w_.zone_at(p.x(), p.y()).sidewalk == 0;
-      for (int k = 0; k < (rural_here ? 28 : 16); ++k) {
+      for (int k = 0; k < (rural_here ? 60 : 40); ++k) {
         const int side = rng.chance(0.5) ? -1 : 1;
-        const Eigen::Vector2d c = p + side * left * rng.uniform(6, 50) + dir * rng.uniform(-5, 5);
+        const Eigen::Vector2d c = p + side * left * rng.uniform(5, 60) + dir * rng.uniform(-5, 5);
         if (!inside_grid(c)) continue;
         const World::Zone zc = w_.zone_at(c.x(), c.y());
         if (w_.road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 2) continue;
         const double pick = rng.uniform();
-        if (pick < 0.3) {  // shrubs and tall weeds covering part of the grass
-          const double rx = rng.uniform(1.5, 4.5), ry = rx * rng.uniform(0.5, 1.0);
+        if (pick < 0.55) {  // shrubs and tall weeds covering part of the grass
+          const double rx = rng.uniform(2.0, 6.0), ry = rx * rng.uniform(0.5, 1.0);
           const double yaw = rng.uniform(0, kPi);
           const Eigen::Vector2d axis(std::cos(yaw), std::sin(yaw));
           if (!rect_free(c, axis, rx, ry, 0.8, false)) continue;
-          add_shrub_patch(c, axis, rx, ry, rng.uniform(0.5, 1.4), rng);
+          add_shrub_patch(c, axis, rx, ry, rng.uniform(0.8, 2.2), rng);
           mark_rect(c, axis, rx, ry);
           continue;
         }
@@ -662,7 +711,9 @@ class WorldBuilder {
 
   void add_tree(const Eigen::Vector2d& c, double crown, Rng& rng) {
     const double g = ground(c);
-    const double trunk_h = rng.uniform(1.8, 3.2);
+    // Crowns from 1.2-2.4 m up, as on KITTI's street and garden trees (maples,
+    // limes, fruit trees): the near-horizontal beams meet the foliage.
+    const double trunk_h = rng.uniform(1.2, 2.4);
     const double radius = rng.uniform(0.1, 0.25);
     w_.primitives_.push_back(cylinder(cls::kTrunk, c, radius, g, g + trunk_h + crown * 0.8, rng.uniform(0.25, 0.4)));
     const double rz = crown * rng.uniform(0.8, 1.4);
@@ -762,8 +813,9 @@ class WorldBuilder {
         }
         const bool lot = z.parking > 5;
         if (lot && label == cls::kTruck) label = cls::kCar, length = 4.5, width = 1.8, height = 1.5;
-        const bool present = rng.chance(lot ? 0.55 : 0.72);
-        double advance = lot ? 2.8 : length + rng.uniform(0.7, 2.0);
+        // Streets with a parking lane are nearly fully parked in KITTI's towns.
+        const bool present = rng.chance(lot ? 0.8 : 0.92);
+        double advance = lot ? 2.8 : length + rng.uniform(0.5, 1.4);
         if (!present) return advance;
         std::vector<Eigen::Vector2d> spots;
         Eigen::Vector2d axis = dir;
@@ -948,12 +1000,13 @@ World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed,
   builder.build_path(lidar_trajectory);
   builder.build_ground();
   const double total_time = static_cast<double>(lidar_trajectory.size() - 1) * options.frame_period;
-  builder.place_buildings();
+  builder.place_buildings(total_time);
   builder.place_parked_vehicles(total_time);
   builder.place_street_furniture();
   builder.place_boundaries();
   builder.place_trees();
   builder.place_structures();
+  builder.plant_verges();
   builder.place_agents(total_time);
   builder.build_grid();
   return world;
