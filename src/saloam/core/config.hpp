@@ -96,8 +96,8 @@ struct FeatureConfig {
 struct OdometryConfig {
   FeatureConfig features;
   /// N_m: a map voxel that none of the last N_m frames observed leaves the
-  /// map. Table I has 20 (config/paper.yaml); 40 (about 40 m of road) halves
-  /// the drift again with first points kept (docs/odometry.md).
+  /// map. Table I has 20 (config/paper.yaml); 40 frames, about 40 m of road,
+  /// drift less with first points kept (measured in docs/odometry.md).
   int local_map_frames = 40;
   /// The point a map voxel keeps when observed again: "first" (the map stays
   /// anchored where it was first registered) or "newest" (the map follows the

@@ -255,6 +255,20 @@ std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureCo
 // A ring is a run of points whose phase (fraction of a turn from the seam,
 // in the storage's turning sense) increases: the storage moves to the next
 // ring where the phase jumps back by more than half a turn.
+bool starts_next_ring(double last, double phase) { return last >= 0.0 && phase < last - 0.5; }
+
+/// How many runs split_rings cuts `phase` into, before its acceptance test.
+std::size_t run_count(const std::vector<float>& phase) {
+  std::size_t runs = 0;
+  double last = -1.0;
+  for (const float p : phase) {
+    if (p < 0.0f) continue;
+    runs += last < 0.0 || starts_next_ring(last, p);
+    last = p;
+  }
+  return runs;
+}
+
 std::vector<std::vector<std::uint32_t>> split_rings(const std::vector<float>& phase, int expected_rings) {
   std::vector<std::vector<std::uint32_t>> rings;
   std::vector<std::uint32_t> current;
@@ -262,7 +276,7 @@ std::vector<std::vector<std::uint32_t>> split_rings(const std::vector<float>& ph
   for (std::size_t i = 0; i < phase.size(); ++i) {
     const double p = phase[i];
     if (p < 0.0) continue;
-    if (last >= 0.0 && p < last - 0.5) {
+    if (starts_next_ring(last, p)) {
       rings.push_back(std::move(current));
       current.clear();
     }
@@ -331,9 +345,10 @@ std::vector<std::vector<std::uint32_t>> rings_from_storage(const std::vector<flo
                  [duration](float t) { return t < 0.0f ? -1.0f : t / duration; });
   auto rings = split_rings(sweep_phase, expected_rings);
   const auto phase = storage_phase(sweep_phase);
-  if (phase.empty()) return rings;
+  // Only a split with fewer runs can win: count them before cutting.
+  if (phase.empty() || (!rings.empty() && run_count(phase) >= rings.size())) return rings;
   auto detected = split_rings(phase, expected_rings);
-  if (rings.empty() || (!detected.empty() && detected.size() < rings.size())) return detected;
+  if (rings.empty() || !detected.empty()) return detected;
   return rings;
 }
 }  // namespace

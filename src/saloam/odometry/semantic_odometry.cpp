@@ -16,11 +16,11 @@ using Clock = std::chrono::steady_clock;
 constexpr double kRedeskewTranslation = 0.01;           // [m per frame]
 constexpr double kRedeskewRotation = 0.1 * M_PI / 180;  // [rad per frame]
 // The second frame is registered from the first frame's pose (no motion is
-// known yet), possibly a whole frame's travel (1.4 m at 7 m/s and 5 Hz) away,
-// more than the correspondence distance: the few re-association rounds that
-// suffice from a constant-velocity prediction stop it short (0.5 m of 1.4 m
-// along a street of hedges, and every later pose and loop against frame 0
-// inherits the error). It gets rounds until the pose settles.
+// known yet), possibly a whole frame's travel away, beyond the correspondence
+// distance: the few re-association rounds that suffice from a
+// constant-velocity prediction can stop short of it, and every later pose and
+// every loop against frame 0 would inherit the error. It gets rounds until
+// the pose settles.
 constexpr int kBootstrapOuterIterations = 10;
 constexpr double kBootstrapSettledTranslation = 0.01;           // [m]
 constexpr double kBootstrapSettledRotation = 0.1 * M_PI / 180;  // [rad]
