@@ -19,7 +19,7 @@ std::vector<Command>& command_registry() {
 
 void ConfigOptions::add_to(CLI::App& app) {
   app.add_option("--config", config_file,
-                 "YAML configuration file, or the name of a shipped one (real_kitti, saloam: see config/)");
+                 "YAML configuration file, or the name of a shipped one (paper, real_kitti, saloam: see config/)");
   app.add_option("--set", overrides, "Override a configuration value, e.g. --set odometry.alpha=0.2 (repeatable)")
       ->take_all();
 }
