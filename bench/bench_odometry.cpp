@@ -171,8 +171,9 @@ void BM_MapTreeDynamic(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_MapTreeDynamic)->Unit(benchmark::kMillisecond);
-// The structure the local map uses: points hashed into 1 m cells, updated
-// point by point (insert the new frame, erase the oldest), 5-NN within 1 m.
+// The structure the local map uses: points hashed into cells (2 m for a 1 m
+// search radius), updated point by point (insert the new frame, erase the
+// oldest), 5-NN within 1 m.
 void BM_NeighbourGrid(benchmark::State& state) {
   std::mt19937 rng(1);
   std::deque<std::vector<Eigen::Vector3d>> frames;

@@ -120,7 +120,7 @@ TEST(UnreliablePoints, RangeLimitsOcclusionAndGrazingBeams) {
 TEST(FeatureSelection, EdgesAtCornerPlanarsOnWallsWithLimits) {
   const auto ring = corner_ring();
   const auto c = ring_roughness(ring, 5);
-  const std::vector<bool> unreliable(ring.size(), false);
+  const PointMask unreliable(ring.size(), 0);
   FeatureConfig config;
   config.num_sectors = 1;
   config.edges_per_sector = 2;
@@ -139,7 +139,7 @@ TEST(FeatureSelection, EdgesAtCornerPlanarsOnWallsWithLimits) {
     for (std::size_t b = a + 1; b < sel.planars.size(); ++b) EXPECT_GT(std::abs(sel.planars[a] - sel.planars[b]), 5);
   }
   // Points marked not-edge (rough ground) give no edges but may be planar.
-  const auto planar_only = select_ring_features(ring, c, unreliable, config, std::vector<bool>(ring.size(), true));
+  const auto planar_only = select_ring_features(ring, c, unreliable, config, PointMask(ring.size(), 1));
   EXPECT_TRUE(planar_only.edges.empty());
   EXPECT_EQ(planar_only.planars.size(), 4u);
   // Threshold: with alpha above every roughness there are no edges.
@@ -152,12 +152,12 @@ TEST(FeatureSelection, PerSectorLimits) {
   for (int i = 0; i < 600; ++i) ring.emplace_back(10.0, -30.0 + 0.1 * i, 0.0);
   const auto c = ring_roughness(ring, 5);
   FeatureConfig config;  // N_r = 6, N_p = 50
-  const auto sel = select_ring_features(ring, c, std::vector<bool>(ring.size(), false), config);
+  const auto sel = select_ring_features(ring, c, PointMask(ring.size(), 0), config);
   EXPECT_TRUE(sel.edges.empty());
   // ~98 points per sector, one in 6 after suppression => ~16 per sector, never above N_p.
   EXPECT_GT(sel.planars.size(), 6u * 10);
   config.planars_per_sector = 3;
-  EXPECT_EQ(select_ring_features(ring, c, std::vector<bool>(ring.size(), false), config).planars.size(), 18u);
+  EXPECT_EQ(select_ring_features(ring, c, PointMask(ring.size(), 0), config).planars.size(), 18u);
 }
 
 TEST(SemanticClasses, DynamicAndUnlabeledAreNotUsed) {

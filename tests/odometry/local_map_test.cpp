@@ -69,10 +69,10 @@ TEST(NeighbourGrid, NearestEqualsBruteForce) {
   EXPECT_GT(full, 500);  // the test exercises full neighbour sets, not only sparse ones
 }
 
-TEST(NeighbourGrid, RadiusBeyondTheCellIsClamped) {
+TEST(NeighbourGrid, RadiusBeyondTheMaximumIsClamped) {
   NeighbourGrid grid(0.5);
   grid.insert({0.0, 0.0, 0.0}, 0);
-  grid.insert({0.9, 0.0, 0.0}, 0);  // two cells away from the query's cell
+  grid.insert({0.9, 0.0, 0.0}, 0);  // 0.8 m from the query: beyond the grid's 0.5 m
   Eigen::Vector3d p[2];
   double d2[2];
   EXPECT_EQ(grid.nearest({0.1, 0.0, 0.0}, 0, 2, 5.0, p, d2), 1);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <numeric>
 
@@ -95,14 +96,14 @@ std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int
   return c;
 }
 
-std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window,
-                                    double min_range, double max_range) {
+PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window, double min_range,
+                            double max_range) {
   const int n = static_cast<int>(ring.size());
-  std::vector<bool> bad(ring.size(), false);
+  PointMask bad(ring.size(), 0);
   std::vector<double> range(ring.size());
   for (int i = 0; i < n; ++i) {
     range[i] = ring[i].norm();
-    if (range[i] < min_range || range[i] > max_range) bad[i] = true;
+    if (range[i] < min_range || range[i] > max_range) bad[i] = 1;
   }
   for (int i = 0; i + 1 < n; ++i) {
     const double gap = (ring[i + 1] - ring[i]).norm();
@@ -116,14 +117,14 @@ std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, in
         // Occluded side: the farther points next to the jump lie on a surface
         // that continues behind the nearer object; their "edge" is an artefact.
         if (range[i] > range[i + 1]) {
-          for (int k = std::max(0, i - half_window + 1); k <= i; ++k) bad[k] = true;
+          for (int k = std::max(0, i - half_window + 1); k <= i; ++k) bad[k] = 1;
         } else {
-          for (int k = i + 1; k <= std::min(n - 1, i + half_window); ++k) bad[k] = true;
+          for (int k = i + 1; k <= std::min(n - 1, i + half_window); ++k) bad[k] = 1;
         }
       } else {
         // A hole in azimuth (no return): windows across it are not local.
         for (int k = std::max(0, i - half_window + 1); k <= std::min(n - 1, i + half_window); ++k) {
-          bad[k] = true;
+          bad[k] = 1;
         }
       }
     }
@@ -133,7 +134,7 @@ std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, in
   for (int i = 1; i + 1 < n; ++i) {
     const double limit = 0.0002 * range[i] * range[i];
     if ((ring[i] - ring[i - 1]).squaredNorm() > limit && (ring[i + 1] - ring[i]).squaredNorm() > limit) {
-      bad[i] = true;
+      bad[i] = 1;
     }
   }
   return bad;
@@ -141,26 +142,26 @@ std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, in
 
 RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<double>& roughness,
-                                   const std::vector<bool>& unreliable, const FeatureConfig& config,
-                                   const std::vector<bool>& not_edge) {
+                                   const PointMask& unreliable, const FeatureConfig& config,
+                                   const PointMask& not_edge) {
   RingSelection out;
   const int n = static_cast<int>(ring.size());
   const int w = config.roughness_half_window;
   if (n < 2 * w + 1) return out;
-  std::vector<bool> blocked(unreliable);
+  PointMask blocked(unreliable);
   const int first = w, last = n - w;  // points with a full window
   const int sectors = std::max(1, config.num_sectors);
   // Blocks the ring neighbours of a selected point, as long as they are
   // close in space (not across an occlusion).
   auto block_neighbours = [&](int i) {
-    blocked[i] = true;
+    blocked[i] = 1;
     for (int step : {-1, 1}) {
       for (int k = 1; k <= w; ++k) {
         const int j = i + step * k;
         const int prev = j - step;
         if (j < 0 || j >= n) break;
         if ((ring[j] - ring[prev]).squaredNorm() > 0.05) break;
-        blocked[j] = true;
+        blocked[j] = 1;
       }
     }
   };
@@ -175,29 +176,34 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
     return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(i);
   };
   auto index_of = [](std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); };
-  std::vector<std::uint64_t> order;
+  // Edges come from the roughest down to alpha, planar points from the
+  // smoothest up to alpha: two sorts of the two sides are cheaper than one of
+  // the sector, and visit the same keys in the same order.
+  std::vector<std::uint64_t> rough, smooth;
   for (int s = 0; s < sectors; ++s) {
     const int begin = first + (last - first) * s / sectors;
     const int end = first + (last - first) * (s + 1) / sectors;
     if (end <= begin) continue;
-    order.clear();
+    rough.clear();
+    smooth.clear();
     for (int i = begin; i < end; ++i) {
-      if (!blocked[i] && std::isfinite(roughness[i])) order.push_back(key(roughness[i], i));
+      if (blocked[i] || !std::isfinite(roughness[i])) continue;
+      if (roughness[i] > config.alpha) rough.push_back(key(roughness[i], i));
+      if (roughness[i] < config.alpha) smooth.push_back(key(roughness[i], i));
     }
-    std::sort(order.begin(), order.end());
+    std::sort(rough.begin(), rough.end(), std::greater<>{});
     int picked = 0;
-    for (auto it = order.rbegin(); it != order.rend() && picked < config.edges_per_sector; ++it) {
+    for (auto it = rough.begin(); it != rough.end() && picked < config.edges_per_sector; ++it) {
       const int i = index_of(*it);
-      if (roughness[i] <= config.alpha) break;
       if (blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
       out.edges.push_back(i);
       block_neighbours(i);
       ++picked;
     }
+    std::sort(smooth.begin(), smooth.end());
     picked = 0;
-    for (const auto k : order) {
-      const int i = index_of(k);
-      if (picked >= config.planars_per_sector || roughness[i] >= config.alpha) break;
+    for (auto it = smooth.begin(); it != smooth.end() && picked < config.planars_per_sector; ++it) {
+      const int i = index_of(*it);
       if (blocked[i]) continue;
       out.planars.push_back(i);
       block_neighbours(i);
@@ -406,17 +412,17 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
     auto unreliable =
         unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
-    std::vector<bool> not_edge;
+    PointMask not_edge;
     if (use_labels) {  // unusable classes must not take a sector's feature slots
       const bool ground_threshold = config.ground_edge_alpha > config.alpha;
-      if (ground_threshold) not_edge.assign(bucket.size(), false);
+      if (ground_threshold) not_edge.assign(bucket.size(), 0);
       for (std::size_t k = 0; k < bucket.size(); ++k) {
         const std::uint16_t label = cloud.label[bucket[k].index];
-        if (odometry_class(label) < 0) unreliable[k] = true;
+        if (odometry_class(label) < 0) unreliable[k] = 1;
         // Only points rough enough to be edges at all need the class lookup.
         if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
             is_ground(static_class(label))) {
-          not_edge[k] = true;
+          not_edge[k] = 1;
         }
       }
     }

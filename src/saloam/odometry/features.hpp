@@ -71,12 +71,15 @@ double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config);
 /// Points without a full window get +infinity.
 std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int half_window);
 
+/// One flag per point of a ring (bytes: cheaper to read and copy than bits).
+using PointMask = std::vector<std::uint8_t>;
+
 /// Marks points whose roughness is not trustworthy (LOAM Sec. V-A): returns
 /// too near or too far, occluded edges (a depth jump between ring neighbours:
 /// the farther side is hidden behind the nearer one), surfaces hit at a
 /// grazing angle (beam nearly parallel to the surface), and windows crossing
 /// gaps in azimuth.
-std::vector<bool> unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window,
+PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window,
                                     double min_range, double max_range);
 
 /// Selects features of one ring: split into N_r sectors; in each, up to N_e
@@ -90,8 +93,8 @@ struct RingSelection {
 /// `not_edge` (empty or one flag per point) marks points that may only be planar.
 RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<double>& roughness,
-                                   const std::vector<bool>& unreliable, const FeatureConfig& config,
-                                   const std::vector<bool>& not_edge = {});
+                                   const PointMask& unreliable, const FeatureConfig& config,
+                                   const PointMask& not_edge = {});
 
 /// Rings from the storage order. The simulator writes a scan ring by ring in
 /// firing order (a ring ends where the sweep time jumps back); real KITTI

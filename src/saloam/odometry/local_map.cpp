@@ -53,8 +53,8 @@ FeatureCloud voxel_downsample(const FeatureCloud& cloud, const ClassVoxelSizes& 
   return out;
 }
 
-NeighbourGrid::NeighbourGrid(double cell_size) : cell_size_(cell_size) {
-  if (!(cell_size > 0.0)) throw std::invalid_argument("NeighbourGrid: cell size must be positive");
+NeighbourGrid::NeighbourGrid(double max_radius) : cell_size_(2.0 * max_radius) {
+  if (!(max_radius > 0.0)) throw std::invalid_argument("NeighbourGrid: the search radius must be positive");
 }
 
 void NeighbourGrid::insert(const Eigen::Vector3d& p, ClassIndex c) {
@@ -77,45 +77,34 @@ bool NeighbourGrid::erase(const Eigen::Vector3d& p, ClassIndex c) {
   return true;
 }
 
-namespace {
-// The 27 cells around a query, own cell first, then faces, edges, corners:
-// near cells first fill the k best early, so that farther cells are skipped.
-constexpr std::array<std::array<int, 3>, 27> kNeighbourCells = [] {
-  std::array<std::array<int, 3>, 27> cells{};
-  int n = 0;
-  for (int nonzero = 0; nonzero <= 3; ++nonzero) {
-    for (int x = -1; x <= 1; ++x) {
-      for (int y = -1; y <= 1; ++y) {
-        for (int z = -1; z <= 1; ++z) {
-          if ((x != 0) + (y != 0) + (z != 0) == nonzero) cells[n++] = {x, y, z};
-        }
-      }
-    }
-  }
-  return cells;
-}();
-}  // namespace
-
 int NeighbourGrid::nearest(const Eigen::Vector3d& q, ClassIndex c, int k, double radius, Eigen::Vector3d* points,
                            double* squared_distances) const {
   if (k <= 0 || class_size_[c] == 0) return 0;
-  // A radius beyond the cell size could miss points outside the 27 cells.
-  radius = std::min(radius, cell_size_);
-  const VoxelKey centre = voxel_key(q, c, cell_size_);
-  // Distances from q to its cell's lower and upper faces along each axis.
-  const Eigen::Vector3d cell_origin = Eigen::Vector3d(centre.x, centre.y, centre.z) * cell_size_;
-  const Eigen::Vector3d below = q - cell_origin;
-  const Eigen::Vector3d above = Eigen::Vector3d::Constant(cell_size_) - below;
+  radius = std::min(radius, max_radius());
+  const VoxelKey own = voxel_key(q, c, cell_size_);
+  // Per axis: the neighbour cell on the side of the nearer face, and the
+  // distance from q to that face (the ball reaches no other cell).
+  std::array<int, 3> side{};
+  Eigen::Vector3d face;
+  const std::array<std::int32_t, 3> cell{own.x, own.y, own.z};
+  for (int a = 0; a < 3; ++a) {
+    const double below = q[a] - cell[static_cast<std::size_t>(a)] * cell_size_;
+    side[static_cast<std::size_t>(a)] = below < 0.5 * cell_size_ ? -1 : 1;
+    face[a] = below < 0.5 * cell_size_ ? below : cell_size_ - below;
+  }
   double bound = radius * radius;  // squared: the radius, then the k-th best distance
   int found = 0;
-  for (const auto& offset : kNeighbourCells) {
+  // Own cell first, then faces, edges, the corner: near cells fill the k best
+  // early, so that farther cells are skipped.
+  static constexpr std::array<std::array<int, 3>, 8> kOrder{
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}}};
+  for (const auto& use : kOrder) {
     double box = 0.0;  // squared distance from q to the neighbour cell
     for (int a = 0; a < 3; ++a) {
-      if (offset[a] < 0) box += below[a] * below[a];
-      if (offset[a] > 0) box += above[a] * above[a];
+      if (use[static_cast<std::size_t>(a)]) box += face[a] * face[a];
     }
     if (box > bound) continue;
-    const auto it = cells_.find(VoxelKey{centre.x + offset[0], centre.y + offset[1], centre.z + offset[2], c});
+    const auto it = cells_.find(VoxelKey{own.x + use[0] * side[0], own.y + use[1] * side[1], own.z + use[2] * side[2], c});
     if (it == cells_.end()) continue;
     for (const Eigen::Vector3d& p : it->second) {
       const double d2 = (p - q).squaredNorm();

@@ -100,6 +100,94 @@ void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const 
   }
 }
 
+// Matches every feature at pose T to a line or plane fitted to its nearest
+// map neighbours of its class (the expensive part: neighbour queries and fits).
+void associate(const FeatureCloud& edges, const FeatureCloud& planars, const SemanticLocalMap& map, const Pose& T,
+               const RegistrationSettings& settings, std::vector<EdgeMatch>& edge_matches,
+               std::vector<PlaneMatch>& plane_matches, RegistrationResult& result) {
+  const int ne = std::min(settings.edge_neighbours, kMaxNeighbours);
+  const int np = std::min(settings.planar_neighbours, kMaxNeighbours);
+  for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
+    std::array<Eigen::Vector3d, kMaxNeighbours> nb;
+    EdgeMatch m;
+    const Eigen::Vector3d q = T * edges.points[i];
+    if (gather(map.edges(), q, edges.classes[i], ne, settings.max_correspondence_distance, nb)) {
+      if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
+        m.line = *line;
+        m.valid = true;
+      }
+    }
+    edge_matches[i] = m;
+  });
+  for_each_index(planars.size(), settings.parallel, [&](std::size_t i) {
+    std::array<Eigen::Vector3d, kMaxNeighbours> nb;
+    PlaneMatch m;
+    const Eigen::Vector3d q = T * planars.points[i];
+    const ClassIndex c = planars.classes[i];
+    if (gather(map.planars(), q, c, np, settings.max_correspondence_distance, nb)) {
+      if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
+        if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.plane_normal_tolerance)) {
+          m.plane = *plane;
+          m.valid = true;
+        } else {
+          m.rejected_by_constraint = true;
+        }
+      }
+    }
+    plane_matches[i] = m;
+  });
+  ++result.associations;
+  result.edge_matches = 0;
+  result.planar_matches = 0;
+  result.rejected_by_constraint = 0;
+  for (const auto& m : edge_matches) result.edge_matches += m.valid;
+  for (const auto& m : plane_matches) {
+    result.planar_matches += m.valid;
+    result.rejected_by_constraint += m.rejected_by_constraint;
+  }
+}
+
+// Gauss-Newton over the given correspondences from T; false when a step is
+// not finite (T is then the last finite pose).
+bool solve(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
+           const std::vector<PlaneMatch>& plane_matches, const RegistrationSettings& settings, Pose& T,
+           RegistrationResult& result) {
+  const double k = settings.robust_kernel_scale;
+  for (int it = 0; it < settings.max_iterations; ++it) {
+    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+    Vector6d g = Vector6d::Zero();
+    for (std::size_t i = 0; i < edges.size(); ++i) {
+      if (!edge_matches[i].valid) continue;
+      Eigen::Matrix<double, 3, 6> J;
+      const Eigen::Vector3d r = point_to_line_residual(T, edges.points[i], edge_matches[i].line, &J);
+      const double w = settings.class_weight[edges.classes[i]] * huber_weight(r.norm(), k);
+      H.noalias() += w * J.transpose() * J;
+      g.noalias() += w * J.transpose() * r;
+    }
+    for (std::size_t i = 0; i < planars.size(); ++i) {
+      if (!plane_matches[i].valid) continue;
+      Eigen::Matrix<double, 1, 6> J;
+      const double r = point_to_plane_residual(T, planars.points[i], plane_matches[i].plane, &J);
+      const double w = settings.class_weight[planars.classes[i]] * huber_weight(r, k);
+      H.noalias() += w * J.transpose() * J;
+      g.noalias() += (w * r) * J.transpose();
+    }
+    // Small Levenberg-Marquardt damping keeps weakly constrained directions stable.
+    H.diagonal().array() += 1e-6 * H.diagonal().maxCoeff() + 1e-9;
+    const Vector6d delta = -H.ldlt().solve(g);
+    if (!delta.allFinite()) return false;
+    T = apply_update(delta, T);
+    ++result.iterations;
+    result.converged = delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6;
+    if (result.converged) break;
+  }
+  return true;
+}
+
+// Outer rounds: associate at the current pose, solve, refresh the scan (e.g.
+// de-skew it again). Re-associating only pays when the pose or the points
+// moved: a shift well below the map resolution leaves the neighbour sets
+// (nearly) unchanged.
 RegistrationResult register_features(const FeatureCloud& edges, const FeatureCloud& planars,
                                      const SemanticLocalMap& map, const Pose& initial,
                                      const RegistrationSettings& settings, const std::function<bool(const Pose&)>& refresh) {
@@ -108,87 +196,14 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   Pose T = initial;
   std::vector<EdgeMatch> edge_matches(edges.size());
   std::vector<PlaneMatch> plane_matches(planars.size());
-  const int ne = std::min(settings.edge_neighbours, kMaxNeighbours);
-  const int np = std::min(settings.planar_neighbours, kMaxNeighbours);
-
   for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
-    const Pose outer_start = T;
-    ++result.associations;
-    // Association at the current pose (the expensive part: neighbour queries and fits).
-    for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
-      std::array<Eigen::Vector3d, kMaxNeighbours> nb;
-      EdgeMatch m;
-      const Eigen::Vector3d q = T * edges.points[i];
-      if (gather(map.edges(), q, edges.classes[i], ne, settings.max_correspondence_distance, nb)) {
-        if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
-          m.line = *line;
-          m.valid = true;
-        }
-      }
-      edge_matches[i] = m;
-    });
-    for_each_index(planars.size(), settings.parallel, [&](std::size_t i) {
-      std::array<Eigen::Vector3d, kMaxNeighbours> nb;
-      PlaneMatch m;
-      const Eigen::Vector3d q = T * planars.points[i];
-      const ClassIndex c = planars.classes[i];
-      if (gather(map.planars(), q, c, np, settings.max_correspondence_distance, nb)) {
-        if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
-          if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.plane_normal_tolerance)) {
-            m.plane = *plane;
-            m.valid = true;
-          } else {
-            m.rejected_by_constraint = true;
-          }
-        }
-      }
-      plane_matches[i] = m;
-    });
-    int n_edges = 0, n_planes = 0, n_rejected = 0;
-    for (const auto& m : edge_matches) n_edges += m.valid;
-    for (const auto& m : plane_matches) {
-      n_planes += m.valid;
-      n_rejected += m.rejected_by_constraint;
-    }
-    result.edge_matches = n_edges;
-    result.planar_matches = n_planes;
-    result.rejected_by_constraint = n_rejected;
-    if (n_edges + n_planes < 20) return result;  // not enough to constrain 6 DoF reliably
-
-    for (int it = 0; it < settings.max_iterations; ++it) {
-      Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-      Vector6d g = Vector6d::Zero();
-      const double k = settings.robust_kernel_scale;
-      for (std::size_t i = 0; i < edges.size(); ++i) {
-        if (!edge_matches[i].valid) continue;
-        Eigen::Matrix<double, 3, 6> J;
-        const Eigen::Vector3d r = point_to_line_residual(T, edges.points[i], edge_matches[i].line, &J);
-        const double w = settings.class_weight[edges.classes[i]] * huber_weight(r.norm(), k);
-        H.noalias() += w * J.transpose() * J;
-        g.noalias() += w * J.transpose() * r;
-      }
-      for (std::size_t i = 0; i < planars.size(); ++i) {
-        if (!plane_matches[i].valid) continue;
-        Eigen::Matrix<double, 1, 6> J;
-        const double r = point_to_plane_residual(T, planars.points[i], plane_matches[i].plane, &J);
-        const double w = settings.class_weight[planars.classes[i]] * huber_weight(r, k);
-        H.noalias() += w * J.transpose() * J;
-        g.noalias() += (w * r) * J.transpose();
-      }
-      // Small Levenberg-Marquardt damping keeps weakly constrained directions stable.
-      H.diagonal().array() += 1e-6 * H.diagonal().maxCoeff() + 1e-9;
-      const Vector6d delta = -H.ldlt().solve(g);
-      if (!delta.allFinite()) return result;
-      T = apply_update(delta, T);
-      ++result.iterations;
-      result.converged = delta.head<3>().norm() < 1e-5 && delta.tail<3>().norm() < 1e-6;
-      if (result.converged) break;
-    }
+    const Pose round_start = T;
+    associate(edges, planars, map, T, settings, edge_matches, plane_matches, result);
+    if (result.correspondences() < 20) return result;  // not enough to constrain 6 DoF reliably
+    if (!solve(edges, planars, edge_matches, plane_matches, settings, T, result)) return result;
     if (outer + 1 >= settings.outer_iterations) break;
     const bool refreshed = refresh && refresh(T);
-    // Re-associating only pays when the pose or the points moved: a shift
-    // well below the map resolution leaves the neighbour sets (nearly) unchanged.
-    const Pose moved = outer_start.inverse() * T;
+    const Pose moved = round_start.inverse() * T;
     if (!refreshed && moved.translation().norm() < settings.reassociation_min_translation &&
         rotation_angle(moved) < settings.reassociation_min_rotation) {
       break;
