@@ -36,6 +36,13 @@ TEST(InstallCli, InstalledProgramFindsItsConfigurationsUnderThePrefix) {
   fs::remove(prefix / "share/saloam/config/real_kitti.yaml");
   EXPECT_NE(run_command("env -u SALOAM_DATA_DIR " + quoted(program) + " config --config real_kitti", &output), 0);
   EXPECT_NE(output.find((prefix / "share/saloam/config").string()), std::string::npos) << output;
+
+  // The trainer, when built (libtorch), installs beside saloam, where `saloam sgpr-train` finds it.
+  if (fs::exists(fs::path(SALOAM_TEST_BUILD_DIR) / "saloam-sgpr-train")) {
+    EXPECT_TRUE(fs::is_regular_file(prefix / "bin" / "saloam-sgpr-train"));
+    ASSERT_EQ(run_command(quoted(program) + " sgpr-train --help", &output), 0) << output;
+    EXPECT_NE(output.find("--pairs-per-epoch"), std::string::npos) << output;
+  }
 }
 
 }  // namespace

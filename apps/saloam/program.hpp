@@ -1,0 +1,28 @@
+#pragma once
+// What every saloam program does around its command: logging, -v / -q,
+// Ctrl-C, and one clear message and exit code for every error.
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace saloam::cli {
+
+/// Logs to stderr as "[level] message"; SPDLOG_LEVEL in the environment sets levels.
+void setup_logging();
+
+/// The -v / --verbose and -q / --quiet flags.
+struct Verbosity {
+  bool verbose = false;
+  bool quiet = false;
+  void add_to(CLI::App& app);
+  /// Sets the log level; call after parsing.
+  void apply() const;
+};
+
+/// Runs `command` and returns its exit code: Ctrl-C (or TERM) asks it to stop
+/// and keep what it has (130; a second Ctrl-C leaves at once); an error is
+/// logged as one message naming what failed (2).
+int run_guarded(const std::function<int()>& command);
+
+}  // namespace saloam::cli
