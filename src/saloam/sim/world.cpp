@@ -325,7 +325,31 @@ class World::GroundMarch {
     f_prev_ = f;
     double step = std::max(0.2, 0.04 * t_);
     if (d_.z() < -1e-3) step = std::max(step, 0.8 * f / -d_.z());
-    t_ += std::min(step, std::max(0.5, 0.35 * t_));
+    step = std::min(step, std::max(0.5, 0.35 * t_));
+    t_ += std::max(step, clear_step(f));
+  }
+  // How far the ray surely stays above the ground from its point at t_, f
+  // above it, without leaving the current rise tile: the ground rises at
+  // most the tile's bound per metre travelled horizontally (plus one step of
+  // kGroundStep), while the ray climbs d_z per metre. Rays over open, gently
+  // sloping ground then reach it, or leave it, in a few long steps.
+  double clear_step(double f) const {
+    if (f <= World::kGroundStep) return 0.0;
+    const World& w = world_;
+    const double tile = World::kRiseTile * w.options_.ground_cell;
+    const Eigen::Vector3d p = o_ + t_ * d_;
+    const double ux = (p.x() - w.origin_.x()) / tile, uy = (p.y() - w.origin_.y()) / tile;
+    const int tx = static_cast<int>(std::floor(ux)), ty = static_cast<int>(std::floor(uy));
+    if (tx < 0 || ty < 0 || tx >= w.rise_nx_ || ty >= w.rise_ny_) return 0.0;
+    const double rise = w.ground_rise_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(w.rise_nx_) +
+                                       static_cast<std::size_t>(tx)];
+    // Distance along the ray to the tile's edge.
+    double exit = max_t_;
+    if (std::abs(d_.x()) > 1e-12) exit = std::min(exit, ((d_.x() > 0 ? tx + 1 - ux : ux - tx) * tile) / std::abs(d_.x()));
+    if (std::abs(d_.y()) > 1e-12) exit = std::min(exit, ((d_.y() > 0 ? ty + 1 - uy : uy - ty) * tile) / std::abs(d_.y()));
+    const double closing = rise * std::hypot(d_.x(), d_.y()) - d_.z();
+    const double clear = closing > 0.0 ? 0.9 * (f - World::kGroundStep) / closing : max_t_;
+    return std::min(clear, exit);
   }
   // Illinois variant of regula falsi on [t_prev (above), t (below)].
   double refine(double f_below) const {

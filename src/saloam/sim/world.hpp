@@ -176,6 +176,13 @@ class World {
     float distance, height, bump, pad;
   };
   std::vector<PackedCell> packed_;  ///< distance_, height_, bump_ interleaved
+  /// Within each tile of kRiseTile x kRiseTile raster cells, the ground
+  /// rises at most ground_rise_[tile] per metre along any horizontal
+  /// direction, plus steps of at most kGroundStep (curbs, zone edges).
+  static constexpr int kRiseTile = 8;
+  static constexpr double kGroundStep = 0.5;  ///< [m]
+  int rise_nx_ = 0, rise_ny_ = 0;
+  std::vector<float> ground_rise_;
   std::vector<Zone> zones_;
   // Static objects and their 2D grid (CSR).
   std::vector<Primitive> primitives_;

@@ -4,6 +4,7 @@
 // once, not twice), moving agents, and the ray-casting grid.
 
 #include <algorithm>
+#include <cstdio>
 #include <cmath>
 #include <unordered_map>
 
@@ -191,7 +192,44 @@ class WorldBuilder {
     }
     w_.packed_.resize(n);
     for (std::size_t i = 0; i < n; ++i) w_.packed_[i] = {w_.distance_[i], w_.height_[i], w_.bump_[i], 0.0f};
+    bound_ground_rise();
     occupied_.assign(n, 0);
+  }
+
+  // Bounds on how fast the ground surface rises along any horizontal
+  // direction [m per m], tile by tile, away from curbs and zone edges
+  // (World::kGroundStep): the height and the bump are bilinear between raster
+  // nodes, so each changes along a direction at most by its largest x step
+  // plus its largest y step per cell; the verge fades the bump in over 12 m.
+  // A tile's bound covers the raster patches that reach into it.
+  void bound_ground_rise() {
+    const int tile = World::kRiseTile;
+    w_.rise_nx_ = (w_.nx_ + tile - 1) / tile;
+    w_.rise_ny_ = (w_.ny_ + tile - 1) / tile;
+    w_.ground_rise_.assign(static_cast<std::size_t>(w_.rise_nx_) * static_cast<std::size_t>(w_.rise_ny_), 0.0f);
+    auto idx = [&](int ix, int iy) {
+      return static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.nx_) + static_cast<std::size_t>(ix);
+    };
+    for (int iy = 0; iy < w_.ny_; ++iy) {
+      for (int ix = 0; ix < w_.nx_; ++ix) {
+        const std::size_t i = idx(ix, iy);
+        float step_height = 0.0f, step_bump = 0.0f;
+        for (const std::size_t j : {ix + 1 < w_.nx_ ? idx(ix + 1, iy) : i, iy + 1 < w_.ny_ ? idx(ix, iy + 1) : i}) {
+          step_height = std::max(step_height, std::abs(w_.height_[j] - w_.height_[i]));
+          step_bump = std::max(step_bump, std::abs(w_.bump_[j] - w_.bump_[i]));
+        }
+        const float rise = static_cast<float>(2.0 * (step_height + step_bump) / w_.options_.ground_cell +
+                                              std::abs(w_.bump_[i]) / 12.0 + 1e-3);
+        // The node's patches span [ix - 1, ix + 1]: every tile they reach.
+        for (int ty = std::max(0, iy - 1) / tile; ty <= std::min(w_.ny_ - 1, iy + 1) / tile; ++ty) {
+          for (int tx = std::max(0, ix - 1) / tile; tx <= std::min(w_.nx_ - 1, ix + 1) / tile; ++tx) {
+            float& bound = w_.ground_rise_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(w_.rise_nx_) +
+                                           static_cast<std::size_t>(tx)];
+            bound = std::max(bound, rise);
+          }
+        }
+      }
+    }
   }
 
   void add_side_streets(std::vector<Eigen::Vector3d>& centres, std::vector<Eigen::Vector2d>& dirs) {
