@@ -45,6 +45,7 @@ struct PlaceEvalArgs {
   PlaceEvalConfig protocol;
   bool no_instances = false;
   bool save_graphs = false;
+  std::string graphs;  ///< read the graphs from here (--save-graphs output) instead of building them
   bool save_scores = false;
   bool no_calib = false;
 };
@@ -146,7 +147,24 @@ int run_place_eval(const PlaceEvalArgs& args) {
   std::mutex skipped_mutex;
   std::vector<std::string> skipped;
   const char* describe_label = sgpr ? "graphs + embeddings" : uses_ssc(detector) ? "semantic scan contexts" : "scan contexts";
+  if (!args.graphs.empty() && !sgpr) throw ConfigError("--graphs needs an SGPR method (sgpr, hybrid)");
+  if (!args.graphs.empty() && uses_scan_context(detector))
+    throw ConfigError("--graphs: --method hybrid also needs the scans; use --method sgpr");
+  if (!args.graphs.empty() && !std::filesystem::is_directory(args.graphs))
+    throw InputError(args.graphs, "graph folder (--graphs) not found");
   for_each_frame(n, describe_label, [&](std::size_t i) {
+    if (!args.graphs.empty()) {
+      // The graphs of an earlier run (--save-graphs): only the network runs,
+      // so several models are compared on the very same graphs.
+      const auto start = std::chrono::steady_clock::now();
+      descriptors[i] = recognizer.describe_graph(read_graph_json(std::filesystem::path(args.graphs) / (frame_name(i) + ".json")));
+      if (args.save_graphs) write_graph_json(out / "graphs" / (frame_name(i) + ".json"), descriptors[i].graph);
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      double expected = describe_seconds.load();
+      while (!describe_seconds.compare_exchange_weak(expected, expected + s)) {
+      }
+      return;
+    }
     LabelledCloud cloud;
     try {
       cloud = reader.load_scan(i);
@@ -213,6 +231,7 @@ int run_place_eval(const PlaceEvalArgs& args) {
     info["mean_nodes"] = described ? mean_nodes / static_cast<double>(described) : 0.0;
   }
   info["labels"] = args.labels.empty() ? std::string("labels/") : args.labels;
+  if (!args.graphs.empty()) info["graphs"] = std::filesystem::absolute(args.graphs).string();
   info["positive_distance"] = args.protocol.positive_distance;
   info["negative_distance"] = args.protocol.negative_distance;
   info["exclude_recent"] = args.protocol.exclude_recent;
@@ -267,6 +286,9 @@ const CommandRegistration kRegistration{Command{
           ->capture_default_str();
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
       app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");
+      app.add_option("--graphs", args->graphs,
+                     "SGPR: read every frame's graph from DIR/NNNNNN.json (an earlier run's OUT/graphs/) instead of "
+                     "building it from the scan; compares models on the same graphs without rebuilding them");
       app.add_flag("--save-scores", args->save_scores, "Also write every pair's score to OUT/pair_scores.csv");
       app.add_flag("--no-calib", args->no_calib,
                    "No calib.txt needed: match distances from poses.txt as given (LiDAR-frame poses)");

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <iterator>
 #include <random>
 
 #include <fmt/format.h>
@@ -161,6 +162,29 @@ TEST(LoopCli, GraphAndPlaceEvalOnASyntheticRevisit) {
     EXPECT_GT(f1, 0.0) << method;
     EXPECT_LE(f1, 1.0) << method;
   }
+  // --graphs: the graphs saved by one run give the same scores without the scans' graphs being rebuilt.
+  ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method sgpr --save-graphs --save-scores --out {}",
+                                                        quoted(seq), quoted(tmp / "saved"))),
+                                 &output),
+            0)
+      << output;
+  ASSERT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method sgpr --graphs {} --save-scores --out {}",
+                                                        quoted(seq), quoted(tmp / "saved" / "graphs"),
+                                                        quoted(tmp / "reused"))),
+                                 &output),
+            0)
+      << output;
+  auto text = [](const std::filesystem::path& f) {
+    std::ifstream in(f);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  EXPECT_EQ(text(tmp / "saved" / "pair_scores.csv"), text(tmp / "reused" / "pair_scores.csv"));
+  EXPECT_FALSE(text(tmp / "reused" / "pair_scores.csv").empty());
+  EXPECT_NE(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method ssc --graphs {}", quoted(seq),
+                                                        quoted(tmp / "saved" / "graphs"))),
+                                 &output),
+            0);
+  EXPECT_NE(output.find("--graphs needs an SGPR method"), std::string::npos) << output;
   // Scan Context sees the same street again: the revisit pairs outrank the far pairs.
   const auto sc = nlohmann::json::parse(std::ifstream(tmp / "eval_scancontext/summary.json"));
   EXPECT_GT(sc["max_f1"].get<double>(), 0.5);

@@ -52,6 +52,14 @@ PlaceDescriptor PlaceRecognizer::describe(const LabelledCloud& scan) const {
   return d;
 }
 
+PlaceDescriptor PlaceRecognizer::describe_graph(SemanticGraph graph) const {
+  if (!uses_sgpr(detector_)) throw std::logic_error("PlaceRecognizer::describe_graph: the detector does not use SGPR");
+  PlaceDescriptor d;
+  d.graph = std::move(graph);
+  d.embedding = network_->embed(d.graph);
+  return d;
+}
+
 std::vector<PlaceMatch> PlaceRecognizer::match(const PlaceDescriptor& query,
                                                std::span<const PlaceDescriptor* const> candidates) const {
   std::vector<PlaceMatch> matches(candidates.size());

@@ -65,6 +65,9 @@ class PlaceRecognizer {
 
   /// The descriptor of a scan in its sensor frame (SGPR needs labels).
   [[nodiscard]] PlaceDescriptor describe(const LabelledCloud& scan) const;
+  /// The SGPR descriptor of an already built graph (e.g. one saved by
+  /// `place-eval --save-graphs`); std::logic_error when the detector is not SGPR.
+  [[nodiscard]] PlaceDescriptor describe_graph(SemanticGraph graph) const;
   /// Scores of (query, candidate) for every candidate, in order. SGPR
   /// evaluates the query as the first graph, as in place-eval.
   [[nodiscard]] std::vector<PlaceMatch> match(const PlaceDescriptor& query,
