@@ -6,7 +6,9 @@
 #       scratch corpus build-fuzz/work/NAME/corpus; crash inputs land in
 #       build-fuzz/work/NAME/ (crash-*, timeout-*, oom-*)
 #   scripts/fuzz.sh merge NAME            minimises fuzz/corpus/NAME plus the
-#       scratch corpus back into fuzz/corpus/NAME (-merge=1)
+#       scratch corpus back into fuzz/corpus/NAME (-merge=1); scratch inputs
+#       over 16 KB are left out so that the committed corpora stay small
+#       (only the .sgw seeds, whole SGPR models, are larger)
 #   scripts/fuzz.sh list                  the harness names
 # Every run is capped: inputs at the harness's max_len, 2 GB of memory
 # (-rss_limit_mb, and -malloc_limit_mb for one allocation) and 10 s per input.
@@ -61,10 +63,11 @@ case "$command" in
   merge)
     name="${1:?harness name}"; check_name "$name"
     work="$BUILD_DIR/work/$name"
-    merged="$work/merged"
-    rm -rf "$merged" && mkdir -p "$merged"
+    merged="$work/merged" small="$work/small"
+    rm -rf "$merged" "$small" && mkdir -p "$merged" "$small"
+    find "$work/corpus" -type f -size -16385c -exec cp {} "$small/" \;
     # shellcheck disable=SC2046
-    "$BUILD_DIR/fuzz/fuzz_$name" $(limits "$name") -merge=1 "$merged" "fuzz/corpus/$name" "$work/corpus"
+    "$BUILD_DIR/fuzz/fuzz_$name" $(limits "$name") -merge=1 "$merged" "fuzz/corpus/$name" "$small"
     rm -rf "fuzz/corpus/$name" && mkdir -p "fuzz/corpus/$name"
     cp "$merged"/* "fuzz/corpus/$name/"
     echo "fuzz/corpus/$name: $(ls "fuzz/corpus/$name" | wc -l) files, $(du -sb "fuzz/corpus/$name" | cut -f1) bytes"
