@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <limits>
+#include <span>
 
 #include "saloam/core/error.hpp"
 #include "saloam/io/scan_io.hpp"
@@ -139,6 +141,40 @@ TEST(ScanIo, ReadsRealKittiScan) {
   for (const auto& p : scan.points) max_range = std::max(max_range, static_cast<double>(p.norm()));
   EXPECT_GT(max_range, 50.0);
   EXPECT_LT(max_range, 130.0);
+}
+
+}  // namespace
+}  // namespace saloam
+
+namespace saloam {
+namespace {
+
+std::span<const std::byte> byte_span(const std::vector<char>& bytes) { return std::as_bytes(std::span(bytes)); }
+
+// parse_scan / parse_label_bytes (read_scan's checks on bytes in memory)
+// name the file they are given.
+TEST(ScanIo, ParsingBytesNamesTheGivenFiles) {
+  testing::TempDir dir;
+  const auto cloud = make_cloud(3);
+  write_scan_bin(dir / "a.bin", cloud);
+  write_scan_labels(dir / "a.label", cloud);
+  auto bytes_of = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return std::vector<char>((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  const auto bin = bytes_of(dir / "a.bin"), labels = bytes_of(dir / "a.label");
+  const auto parsed = parse_scan(byte_span(bin), "x.bin", byte_span(labels), "x.label");
+  EXPECT_EQ(parsed.size(), 3u);
+  EXPECT_EQ(parsed.label, cloud.label);
+  EXPECT_EQ(parsed.instance, cloud.instance);
+
+  expect_input_error([&] { (void)parse_scan(byte_span({}), "x.bin"); }, "x.bin", "empty scan");
+  const std::vector<char> two_labels(labels.begin(), labels.begin() + 8);
+  expect_input_error([&] { (void)parse_scan(byte_span(bin), "x.bin", byte_span(two_labels), "x.label"); },
+                     "x.label", "2 labels for 3 points in x.bin");
+  expect_input_error([&] { (void)parse_label_bytes(byte_span({'a'}), "y.label"); }, "y.label", "not a multiple of 4");
+  // An empty label file is no labels (and no memcpy from a null pointer).
+  EXPECT_TRUE(parse_label_bytes(byte_span({}), "y.label").empty());
 }
 
 }  // namespace

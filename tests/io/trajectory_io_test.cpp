@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <sstream>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
@@ -235,6 +236,60 @@ TEST(Calibration, TrMustBeRigidAndMayBeIndented) {
   EXPECT_NE(msg.find("squeezed.txt: line 2: rotation of 'Tr' is not orthonormal"), std::string::npos) << msg;
   write_text(dir / "bom.txt", "\xEF\xBB\xBF" + tr_line(Eigen::Matrix3d::Identity()));
   EXPECT_TRUE(read_velo_to_cam(dir / "bom.txt").isApprox(Pose(Eigen::Translation3d(1, 2, 3))));
+}
+
+}  // namespace
+}  // namespace saloam
+
+namespace saloam {
+namespace {
+
+// The stream readers (what the path readers and the fuzz harnesses call)
+// name the file they are given in every error, and read what the path
+// readers read.
+TEST(TrajectoryIo, StreamReadersMatchPathReadersAndNameTheirSource) {
+  testing::TempDir dir;
+  const auto poses = spiral(4);
+  write_kitti_poses(dir / "poses.txt", poses);
+  std::ifstream kitti(dir / "poses.txt");
+  const auto from_stream = read_kitti_poses(kitti, "given.txt");
+  ASSERT_EQ(from_stream.size(), poses.size());
+  EXPECT_TRUE(from_stream.back().isApprox(read_kitti_poses(dir / "poses.txt").back()));
+
+  auto error_of = [](auto read) -> std::string {
+    try {
+      read();
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.file(), "named.txt");
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(error_of([] {
+              std::istringstream in("1 2 3\n");
+              (void)read_kitti_poses(in, "named.txt");
+            }),
+            "named.txt: line 1: expected 12 numbers (KITTI 3x4 pose), found 3");
+  EXPECT_EQ(error_of([] {
+              std::istringstream in("");
+              (void)read_tum_trajectory(in, "named.txt");
+            }),
+            "named.txt: no poses in file");
+  EXPECT_EQ(error_of([] {
+              std::istringstream in("0.1\n0.1\n");
+              (void)read_times(in, "named.txt");
+            }).substr(0, 18),
+            "named.txt: line 2:");
+  EXPECT_EQ(error_of([] {
+              std::istringstream in("x y\n");
+              (void)read_trajectory(in, "named.txt");
+            }),
+            "named.txt: line 1: 'x' is not a number");
+  EXPECT_EQ(error_of([] {
+              std::istringstream in("P0: 1 2 3\n");
+              (void)read_velo_to_cam(in, "named.txt");
+            }),
+            "named.txt: no 'Tr:' line (velodyne to camera 0 transform)");
 }
 
 }  // namespace

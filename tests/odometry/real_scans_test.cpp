@@ -25,7 +25,7 @@ constexpr double kMaxRotationErrorDeg = 0.2;
 std::vector<LabelledCloud> load_scans() {
   std::vector<LabelledCloud> scans;
   for (int i = 0; i < 6; ++i) {
-    char name[32];
+    char name[48];  // room for any int, so that g++ -O1 sees no truncation
     std::snprintf(name, sizeof(name), "data/kitti/scans_00/%06d.bin", i);
     scans.push_back(read_scan(testing::shared_file(name)));
   }

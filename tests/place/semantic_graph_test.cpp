@@ -294,6 +294,15 @@ TEST(GraphJson, MalformedGraphsAreClearErrors) {
   EXPECT_NE(error_of(R"({"nodes": [1], "centers": [[0,0,0]], "edges": [[0,3]], "weights": [1]})").find("edges[0]"),
             std::string::npos);
   EXPECT_NE(error_of(R"({"nodes": [1], "centers": [[0,0,0]], "pose": [1,2]})").find("pose"), std::string::npos);
+  // Integers beyond 32 bits are out of range, not wrapped (4294967299 = 2^32 + 3 once read as class 3).
+  EXPECT_NE(error_of(R"({"nodes": [4294967299], "centers": [[0,0,0]]})").find("nodes[0] = 4294967299 is not a node class"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"nodes": [-4294967295], "centers": [[0,0,0]]})").find("not a node class"), std::string::npos);
+  EXPECT_NE(error_of(R"({"nodes": [18446744073709551615], "centers": [[0,0,0]]})").find("not a node class"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"nodes": [1, 2], "centers": [[0,0,0], [1,1,1]], "edges": [[0, 4294967297]], "weights": [1]})")
+                .find("edges[0] refers to a node that does not exist"),
+            std::string::npos);
   EXPECT_NE(std::string(error_of("")).find("not valid JSON"), std::string::npos);
   try {
     (void)read_graph_json(dir / "missing.json");

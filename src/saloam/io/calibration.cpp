@@ -41,11 +41,15 @@ std::string trimmed(const std::string& text) {
 }  // namespace
 
 Pose read_velo_to_cam(const std::filesystem::path& file, int sequence) {
+  auto in = open_text_file(file, "calibration file");
+  return read_velo_to_cam(in, file, sequence);
+}
+
+Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int sequence) {
   std::optional<Pose> keyed;  // the wanted "KEY:" line
   std::optional<Pose> bare;   // the first line with 12 numbers and no key
   const std::string wanted = sequence >= 0 ? fmt::format("{:02d}", sequence) : std::string("Tr");
-  require_file(file, "calibration file");
-  for_each_text_line(file, [&](const std::string& line, std::size_t line_no) {
+  for_each_text_line(in, file, [&](const std::string& line, std::size_t line_no) {
     if (keyed) return;
     const auto colon = line.find(':');
     const std::string key = colon == std::string::npos ? "" : trimmed(line.substr(0, colon));

@@ -5,6 +5,7 @@
 //   Q_i = T_L0<-Li = Tr^-1 * P_i * Tr  and back  P_i = Tr * Q_i * Tr^-1.
 
 #include <filesystem>
+#include <istream>
 #include <vector>
 
 #include "saloam/core/types.hpp"
@@ -15,6 +16,8 @@ namespace saloam {
 /// 12 numbers, or lines "NN: 12 numbers" (the per-sequence list in
 /// ../shared/data/kitti/calib_velo_to_cam.txt; pass `sequence` to pick one).
 Pose read_velo_to_cam(const std::filesystem::path& file, int sequence = -1);
+/// The same over an open stream; `file` names it in errors.
+Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int sequence = -1);
 /// Writes a calib.txt with P0..P3 (KITTI's rectified projections) and `Tr:`.
 void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam);
 

@@ -36,47 +36,56 @@ void write_bytes(const std::filesystem::path& file, const void* data, std::size_
   if (!out) throw InputError(file, "write failed (disk full?)");
 }
 
+constexpr std::size_t kPointBytes = 4 * sizeof(float);
+
+void check_scan_size(std::size_t size, const std::filesystem::path& bin_file) {
+  if (size == 0) throw InputError(bin_file, "empty scan (0 bytes)");
+  if (size % kPointBytes != 0) {
+    throw InputError(bin_file,
+                     fmt::format("size {} bytes is not a multiple of 16 (x, y, z, remission as float32): "
+                                 "truncated or not a KITTI .bin scan",
+                                 size));
+  }
+}
+
 }  // namespace
 
-std::vector<std::uint32_t> read_label_file(const std::filesystem::path& label_file) {
-  const auto bytes = read_bytes(label_file);
+std::vector<std::uint32_t> parse_label_bytes(std::span<const std::byte> bytes, const std::filesystem::path& label_file) {
   if (bytes.size() % sizeof(std::uint32_t) != 0) {
     throw InputError(label_file, fmt::format("size {} bytes is not a multiple of 4 (truncated label file?)",
                                              bytes.size()));
   }
   std::vector<std::uint32_t> labels(bytes.size() / sizeof(std::uint32_t));
-  std::memcpy(labels.data(), bytes.data(), bytes.size());
+  if (!labels.empty()) std::memcpy(labels.data(), bytes.data(), bytes.size());
   return labels;
 }
 
-LabelledCloud read_scan(const std::filesystem::path& bin_file,
-                        const std::optional<std::filesystem::path>& label_file, ScanReadStats* stats) {
-  constexpr std::size_t kPointBytes = 4 * sizeof(float);
-  const auto bytes = read_bytes(bin_file);
-  if (bytes.empty()) throw InputError(bin_file, "empty scan (0 bytes)");
-  if (bytes.size() % kPointBytes != 0) {
-    throw InputError(bin_file,
-                     fmt::format("size {} bytes is not a multiple of 16 (x, y, z, remission as float32): "
-                                 "truncated or not a KITTI .bin scan",
-                                 bytes.size()));
-  }
-  const std::size_t n = bytes.size() / kPointBytes;
+std::vector<std::uint32_t> read_label_file(const std::filesystem::path& label_file) {
+  const auto bytes = read_bytes(label_file);
+  return parse_label_bytes(std::as_bytes(std::span<const char>(bytes)), label_file);
+}
+
+LabelledCloud parse_scan(std::span<const std::byte> bin, const std::filesystem::path& bin_file,
+                         std::optional<std::span<const std::byte>> label_bytes,
+                         const std::filesystem::path& label_file, ScanReadStats* stats) {
+  check_scan_size(bin.size(), bin_file);
+  const std::size_t n = bin.size() / kPointBytes;
   std::vector<float> raw(n * 4);
-  std::memcpy(raw.data(), bytes.data(), bytes.size());
+  std::memcpy(raw.data(), bin.data(), bin.size());
 
   std::vector<std::uint32_t> labels;
-  if (label_file) {
-    labels = read_label_file(*label_file);
+  if (label_bytes) {
+    labels = parse_label_bytes(*label_bytes, label_file);
     if (labels.size() != n) {
-      throw InputError(*label_file, fmt::format("{} labels for {} points in {}", labels.size(), n,
-                                                bin_file.filename().string()));
+      throw InputError(label_file, fmt::format("{} labels for {} points in {}", labels.size(), n,
+                                               bin_file.filename().string()));
     }
   }
 
   ScanReadStats local;
   local.points_in_file = n;
   LabelledCloud cloud;
-  cloud.has_labels = label_file.has_value();
+  cloud.has_labels = label_bytes.has_value();
   cloud.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const float* p = &raw[4 * i];
@@ -99,11 +108,23 @@ LabelledCloud read_scan(const std::filesystem::path& bin_file,
                  local.dropped_nonfinite, n);
   }
   if (local.unknown_labels > 0) {
-    spdlog::warn("{}: {} points carry class ids unknown to SemanticKITTI", label_file->string(),
+    spdlog::warn("{}: {} points carry class ids unknown to SemanticKITTI", label_file.string(),
                  local.unknown_labels);
   }
   if (stats) *stats = local;
   return cloud;
+}
+
+LabelledCloud read_scan(const std::filesystem::path& bin_file,
+                        const std::optional<std::filesystem::path>& label_file, ScanReadStats* stats) {
+  const auto bin = read_bytes(bin_file);
+  check_scan_size(bin.size(), bin_file);  // the .bin file's problems first, then the .label file's
+  std::optional<std::vector<char>> labels;
+  if (label_file) labels = read_bytes(*label_file);
+  std::optional<std::span<const std::byte>> label_bytes;
+  if (labels) label_bytes = std::as_bytes(std::span<const char>(*labels));
+  return parse_scan(std::as_bytes(std::span<const char>(bin)), bin_file, label_bytes,
+                    label_file.value_or(std::filesystem::path{}), stats);
 }
 
 void write_scan_bin(const std::filesystem::path& bin_file, const LabelledCloud& cloud) {

@@ -6,6 +6,8 @@
 #include <cstddef>
 #include <filesystem>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include "saloam/core/types.hpp"
 
@@ -25,6 +27,13 @@ LabelledCloud read_scan(const std::filesystem::path& bin_file,
                         const std::optional<std::filesystem::path>& label_file = std::nullopt,
                         ScanReadStats* stats = nullptr);
 
+/// read_scan on bytes already in memory: `bin` holds a .bin file's content,
+/// `labels` (when given) its .label file's; `bin_file` and `label_file` name
+/// them in errors. The same checks and InputErrors as read_scan.
+LabelledCloud parse_scan(std::span<const std::byte> bin, const std::filesystem::path& bin_file,
+                         std::optional<std::span<const std::byte>> labels = std::nullopt,
+                         const std::filesystem::path& label_file = {}, ScanReadStats* stats = nullptr);
+
 /// Writes the points as a KITTI .bin file.
 void write_scan_bin(const std::filesystem::path& bin_file, const LabelledCloud& cloud);
 /// Writes the labels (class | instance << 16) as a .label file.
@@ -33,7 +42,10 @@ void write_scan_labels(const std::filesystem::path& label_file, const LabelledCl
 void write_scan_labels(const std::filesystem::path& label_file, const std::vector<std::uint16_t>& labels,
                        const std::vector<std::uint16_t>& instances);
 
-/// Reads only a .label file: one uint32 per point.
+/// Reads only a .label file: one uint32 per point. InputError when it is
+/// missing or its size is not a multiple of 4.
 std::vector<std::uint32_t> read_label_file(const std::filesystem::path& label_file);
+/// read_label_file on the file's bytes (`label_file` names it in errors).
+std::vector<std::uint32_t> parse_label_bytes(std::span<const std::byte> bytes, const std::filesystem::path& label_file);
 
 }  // namespace saloam

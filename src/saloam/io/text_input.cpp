@@ -16,11 +16,21 @@ constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
 }  // namespace
 
-void for_each_text_line(const std::filesystem::path& file,
-                        const std::function<void(const std::string& line, std::size_t line_no)>& on_line) {
-  require_file(file);
+std::ifstream open_text_file(const std::filesystem::path& file, std::string_view what) {
+  require_file(file, what);
   std::ifstream in(file);
   if (!in) throw InputError(file, "cannot open for reading");
+  return in;
+}
+
+void for_each_text_line(const std::filesystem::path& file,
+                        const std::function<void(const std::string& line, std::size_t line_no)>& on_line) {
+  auto in = open_text_file(file);
+  for_each_text_line(in, file, on_line);
+}
+
+void for_each_text_line(std::istream& in, const std::filesystem::path& file,
+                        const std::function<void(const std::string& line, std::size_t line_no)>& on_line) {
   std::string line;
   std::size_t line_no = 0;
   while (std::getline(in, line)) {

@@ -7,7 +7,10 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
+#include <istream>
+#include <fstream>
 #include <string>
+#include <string_view>
 
 #include "saloam/core/types.hpp"
 
@@ -17,6 +20,12 @@ namespace saloam {
 /// when the file is missing, a directory, or unreadable.
 void for_each_text_line(const std::filesystem::path& file,
                         const std::function<void(const std::string& line, std::size_t line_no)>& on_line);
+/// The same over an open stream; `file` names it in errors (a read error).
+void for_each_text_line(std::istream& in, const std::filesystem::path& file,
+                        const std::function<void(const std::string& line, std::size_t line_no)>& on_line);
+/// Opens `file` for reading: InputError when it is missing, a directory, or
+/// unreadable (`what` names the kind of file in the message).
+std::ifstream open_text_file(const std::filesystem::path& file, std::string_view what = "file");
 
 /// T with its rotation projected back onto SO(3). InputError (file, line)
 /// when the rotation is not one: ||R^T R - I|| > kRotationTolerance (a scale

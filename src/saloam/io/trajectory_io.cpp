@@ -48,8 +48,8 @@ std::vector<double> parse_numbers(const std::string& line, const std::filesystem
 }
 
 template <class OnLine>
-void for_each_data_line(const std::filesystem::path& file, OnLine&& on_line) {
-  for_each_text_line(file, [&](const std::string& line, std::size_t line_no) {
+void for_each_data_line(std::istream& in, const std::filesystem::path& file, OnLine&& on_line) {
+  for_each_text_line(in, file, [&](const std::string& line, std::size_t line_no) {
     if (!is_blank_or_comment(line)) on_line(parse_numbers(line, file, line_no), line_no);
   });
 }
@@ -76,8 +76,13 @@ Pose tum_pose(const std::vector<double>& v, const std::filesystem::path& file, s
 }  // namespace
 
 std::vector<Pose> read_kitti_poses(const std::filesystem::path& file) {
+  auto in = open_text_file(file);
+  return read_kitti_poses(in, file);
+}
+
+std::vector<Pose> read_kitti_poses(std::istream& in, const std::filesystem::path& file) {
   std::vector<Pose> poses;
-  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 12) {
       throw InputError(file, fmt::format("line {}: expected 12 numbers (KITTI 3x4 pose), found {}", line_no, v.size()));
     }
@@ -100,9 +105,14 @@ void write_kitti_poses(const std::filesystem::path& file, const std::vector<Pose
 }
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
+  auto in = open_text_file(file);
+  return read_tum_trajectory(in, file);
+}
+
+Trajectory read_tum_trajectory(std::istream& in, const std::filesystem::path& file) {
   Trajectory traj;
   std::size_t previous_line = 0;
-  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 8) {
       throw InputError(file, fmt::format("line {}: expected 8 numbers (TUM: t x y z qx qy qz qw), found {}", line_no,
                                          v.size()));
@@ -132,10 +142,15 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
 }
 
 Trajectory read_trajectory(const std::filesystem::path& file, TrajectoryFormat* format) {
+  auto in = open_text_file(file);
+  return read_trajectory(in, file, format);
+}
+
+Trajectory read_trajectory(std::istream& in, const std::filesystem::path& file, TrajectoryFormat* format) {
   Trajectory traj;
   std::size_t columns = 0;
   std::size_t previous_line = 0;
-  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (columns == 0) {
       columns = v.size();
       if (columns != 12 && columns != 8) {
@@ -160,9 +175,14 @@ Trajectory read_trajectory(const std::filesystem::path& file, TrajectoryFormat* 
 }
 
 std::vector<double> read_times(const std::filesystem::path& file) {
+  auto in = open_text_file(file);
+  return read_times(in, file);
+}
+
+std::vector<double> read_times(std::istream& in, const std::filesystem::path& file) {
   std::vector<double> times;
   std::size_t previous_line = 0;
-  for_each_data_line(file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 1) throw InputError(file, fmt::format("line {}: expected one timestamp, found {} numbers", line_no, v.size()));
     if (!times.empty()) check_time_increases(times.back(), previous_line, v[0], file, line_no);
     times.push_back(v[0]);

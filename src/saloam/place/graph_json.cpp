@@ -1,7 +1,9 @@
 #include "saloam/place/graph_json.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
@@ -31,16 +33,26 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
     if (!std::isfinite(d)) fail(what + " is not finite");
     return d;
   };
+  // An integer's value as it is in the file: get<int>() would wrap a large
+  // one (4294967299 would read as class 3), so compare in 64 bits.
+  auto integer = [](const nlohmann::json& v) -> std::int64_t {
+    if (v.is_number_unsigned()) {
+      const auto u = v.get<std::uint64_t>();
+      constexpr auto kMax = static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max());
+      return static_cast<std::int64_t>(u > kMax ? kMax : u);
+    }
+    return v.get<std::int64_t>();
+  };
   SemanticGraph graph;
   if (!json.contains("nodes") || !json["nodes"].is_array()) fail("missing array 'nodes'");
   if (!json.contains("centers") || !json["centers"].is_array()) fail("missing array 'centers'");
   for (std::size_t i = 0; i < json["nodes"].size(); ++i) {
     const auto& v = json["nodes"][i];
     if (!v.is_number_integer()) fail("nodes[" + std::to_string(i) + "] is not an integer");
-    const int label = v.get<int>();
+    const std::int64_t label = integer(v);
     if (label < 0 || label >= kNumNodeClasses)
-      fail("nodes[" + std::to_string(i) + "] = " + std::to_string(label) + " is not a node class 0..11");
-    graph.nodes.push_back(label);
+      fail("nodes[" + std::to_string(i) + "] = " + v.dump() + " is not a node class 0..11");
+    graph.nodes.push_back(static_cast<int>(label));
   }
   for (std::size_t i = 0; i < json["centers"].size(); ++i) {
     const auto& c = json["centers"][i];
@@ -57,10 +69,10 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
       const std::string what = "edges[" + std::to_string(i) + "]";
       if (!e.is_array() || e.size() != 2 || !e[0].is_number_integer() || !e[1].is_number_integer())
         fail(what + " is not a pair of node indices");
-      const int a = e[0].get<int>(), b = e[1].get<int>();
-      const int n = static_cast<int>(graph.nodes.size());
+      const std::int64_t a = integer(e[0]), b = integer(e[1]);
+      const auto n = static_cast<std::int64_t>(graph.nodes.size());
       if (a < 0 || b < 0 || a >= n || b >= n) fail(what + " refers to a node that does not exist");
-      graph.edges.push_back({a, b});
+      graph.edges.push_back({static_cast<int>(a), static_cast<int>(b)});
     }
   }
   if (json.contains("weights")) {
@@ -92,13 +104,17 @@ SemanticGraph read_graph_json(const std::filesystem::path& file) {
   require_file(file, "graph file");
   std::ifstream in(file);
   if (!in) throw InputError(file, "graph file not found or not readable");
+  return parse_graph_json(in, file);
+}
+
+SemanticGraph parse_graph_json(std::istream& in, const std::filesystem::path& source) {
   nlohmann::json json;
   try {
     json = nlohmann::json::parse(in);
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(file, std::string("not valid JSON: ") + e.what());
+    throw InputError(source, std::string("not valid JSON: ") + e.what());
   }
-  return graph_from_json(json, file);
+  return graph_from_json(json, source);
 }
 
 }  // namespace saloam

@@ -7,6 +7,7 @@
 // graphs carry only nodes, centers and pose).
 
 #include <filesystem>
+#include <istream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -24,5 +25,8 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
 void write_graph_json(const std::filesystem::path& file, const SemanticGraph& graph);
 /// Reads a graph file; InputError when missing, not JSON or malformed.
 SemanticGraph read_graph_json(const std::filesystem::path& file);
+/// Parses a graph from an open stream (`source` names it in errors); the same
+/// InputErrors as read_graph_json.
+SemanticGraph parse_graph_json(std::istream& in, const std::filesystem::path& source);
 
 }  // namespace saloam
