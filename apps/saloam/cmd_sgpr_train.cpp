@@ -22,10 +22,10 @@ namespace {
 constexpr const char* kTrainer = "saloam-sgpr-train";
 
 int forward_to_trainer(const std::vector<std::string>& arguments) {
+  const auto bin = program_dir();
+  const auto trainer = bin ? *bin / kTrainer : std::filesystem::path(kTrainer);
   std::error_code error;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", error);
-  const auto trainer = self.parent_path() / kTrainer;
-  if (error || !std::filesystem::is_regular_file(trainer)) {
+  if (!bin || !std::filesystem::is_regular_file(trainer, error)) {
     spdlog::error("this saloam was built without libtorch: sgpr-train is not available (install libtorch-dev, e.g. "
                   "scripts/install_deps.sh, and rebuild; the trainer is the program {})",
                   trainer.string());

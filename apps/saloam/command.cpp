@@ -30,13 +30,20 @@ SaloamConfig ConfigOptions::resolve() const {
   return config;
 }
 
-namespace {
-
-std::optional<std::filesystem::path> installed_data_dir() {
+std::optional<std::filesystem::path> program_dir() {
   std::error_code error;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
   if (error) return std::nullopt;
-  const auto dir = (exe.parent_path() / SALOAM_INSTALL_DATA_RELATIVE).lexically_normal();
+  return exe.parent_path();
+}
+
+namespace {
+
+std::optional<std::filesystem::path> installed_data_dir() {
+  const auto bin = program_dir();
+  if (!bin) return std::nullopt;
+  const auto dir = (*bin / SALOAM_INSTALL_DATA_RELATIVE).lexically_normal();
+  std::error_code error;
   if (!std::filesystem::is_directory(dir / "config", error)) return std::nullopt;
   return dir;
 }

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,10 @@ struct ConfigOptions {
   void add_to(CLI::App& app);
   [[nodiscard]] SaloamConfig resolve() const;
 };
+
+/// The folder of the running program (from /proc/self/exe); none when it
+/// cannot be read. Installed data and the trainer are found from it.
+std::optional<std::filesystem::path> program_dir();
 
 /// Where saloam's own data lie (config/*.yaml, models/): $SALOAM_DATA_DIR when
 /// set; else <prefix>/share/saloam when the program runs installed as
