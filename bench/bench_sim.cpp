@@ -47,11 +47,12 @@ void BM_SimulateScan(benchmark::State& state) {
   tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(1)));
   const World& world = urban_world();
   const LidarModel lidar = LidarModel::hdl64e(beams);
+  const SweepRays rays(lidar);
   SimulationOptions options;
   std::size_t frame = 50, points = 0, frames = 0;
   for (auto _ : state) {
     const SweepSpec sweep = sweep_for_frame(urban_loop(), frame, options);
-    const SimulatedScan scan = simulate_scan(world, lidar, sweep);
+    const SimulatedScan scan = simulate_scan(world, lidar, rays, sweep);
     points += scan.cloud.size();
     ++frames;
     frame = 50 + (frame + 37) % 800;  // different places of the loop

@@ -47,7 +47,7 @@ void SemanticMap::insert(const LabelledCloud& scan, const Pose& world_from_senso
 
 LabelledCloud SemanticMap::to_cloud() const {
   // Sorted by voxel key so that the output does not depend on hash order.
-  std::vector<const std::pair<const Eigen::Vector3i, Voxel>*> entries;
+  std::vector<const decltype(voxels_)::value_type*> entries;
   entries.reserve(voxels_.size());
   for (const auto& e : voxels_) entries.push_back(&e);
   std::sort(entries.begin(), entries.end(), [](const auto* a, const auto* b) {

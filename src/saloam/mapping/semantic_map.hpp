@@ -5,10 +5,10 @@
 // the static world. Used for the map output of a run and for its pictures.
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
+#include <tsl/robin_map.h>
 
 #include "saloam/core/types.hpp"
 
@@ -47,14 +47,21 @@ class SemanticMap {
   };
   struct KeyHash {
     std::size_t operator()(const Eigen::Vector3i& k) const {
-      return (static_cast<std::size_t>(k.x()) * 73856093u) ^ (static_cast<std::size_t>(k.y()) * 19349669u) ^
-             (static_cast<std::size_t>(k.z()) * 83492791u);
+      // Spatial hash mixed down to the low bits, which the open-addressing
+      // table indexes its buckets by.
+      std::uint64_t h = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.x())) * 73856093u ^
+                        static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.y())) * 19349669u ^
+                        static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.z())) * 83492791u;
+      h ^= h >> 29;
+      h *= 0xbf58476d1ce4e5b9ull;
+      h ^= h >> 32;
+      return static_cast<std::size_t>(h);
     }
   };
 
   SemanticMapOptions options_;
   bool has_labels_ = false;
-  std::unordered_map<Eigen::Vector3i, Voxel, KeyHash> voxels_;
+  tsl::robin_map<Eigen::Vector3i, Voxel, KeyHash> voxels_;
 };
 
 }  // namespace saloam

@@ -48,15 +48,22 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
                                                 const LabelNoiseOptions& options) {
   const std::size_t n = scan.cloud.size();
   if (scan.ring.size() != n || scan.column.size() != n) throw ConfigError("scan without range-image indices");
-  // Ground-truth learning classes on the range image (-1 = no return).
-  std::vector<std::int32_t> image(static_cast<std::size_t>(beams) * static_cast<std::size_t>(columns), -1);
+  if (beams <= 0 || columns <= 0 || options.boundary_columns < 0 || options.boundary_columns >= columns ||
+      options.block_rings <= 0 || options.block_columns <= 0) {
+    throw ConfigError("label noise: range image or neighbourhood sizes out of range");
+  }
+  // Ground-truth learning class per range-image cell (kNoReturn where none).
+  constexpr std::uint8_t kNoReturn = 0xFF;
+  const auto cell = [columns](int ring, int column) {
+    return static_cast<std::size_t>(ring) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column);
+  };
+  std::vector<std::uint8_t> image(static_cast<std::size_t>(beams) * static_cast<std::size_t>(columns), kNoReturn);
   std::vector<std::uint8_t> truth(n);
   for (std::size_t i = 0; i < n; ++i) {
     std::uint8_t c = to_learning_class(scan.cloud.label[i]);
     if (c == 0) c = kBuilding;  // other-structure etc.: the network calls it something solid
     truth[i] = c;
-    image[static_cast<std::size_t>(scan.ring[i]) * static_cast<std::size_t>(columns) + scan.column[i]] =
-        static_cast<std::int32_t>(i);
+    image[cell(scan.ring[i], scan.column[i])] = c;
   }
   std::vector<std::uint8_t> out(truth);
   Rng rng(hash_combine(seed, 0x1abe1ull));
@@ -66,13 +73,16 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
     const int r = scan.ring[i], c = scan.column[i];
     std::array<std::uint8_t, 16> other{};
     int n_other = 0, n_seen = 0;
-    for (int dr = -1; dr <= 1; ++dr) {
+    for (int rr = std::max(r - 1, 0); rr <= std::min(r + 1, beams - 1); ++rr) {
       for (int dc = -options.boundary_columns; dc <= options.boundary_columns; ++dc) {
-        const int rr = r + dr, cc = (c + dc + columns) % columns;
-        if ((dr == 0 && dc == 0) || rr < 0 || rr >= beams) continue;
-        const std::int32_t j = image[static_cast<std::size_t>(rr) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(cc)];
-        if (j >= 0) ++n_seen;
-        if (j >= 0 && truth[static_cast<std::size_t>(j)] != truth[i] && n_other < 16) other[static_cast<std::size_t>(n_other++)] = truth[static_cast<std::size_t>(j)];
+        if (rr == r && dc == 0) continue;
+        int cc = c + dc;  // wraps around the turn
+        if (cc < 0) cc += columns;
+        if (cc >= columns) cc -= columns;
+        const std::uint8_t k = image[cell(rr, cc)];
+        if (k == kNoReturn) continue;
+        ++n_seen;
+        if (k != truth[i] && n_other < 16) other[static_cast<std::size_t>(n_other++)] = k;
       }
     }
     const double u = rng.uniform(), v = rng.uniform();
@@ -81,16 +91,27 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
     if (n_other > 0 && u < options.boundary_flip * share) out[i] = other[static_cast<std::size_t>(v * n_other)];
   }
 
-  // 2. Correlated confusions between similar classes, blob by blob.
+  // 2. Correlated confusions between similar classes, blob by blob: every
+  // point of one class in one block of the range image shares the outcome
+  // (drawn from the block's own seed; remembered while the points, stored
+  // ring by ring, stay in the same block and class).
+  struct Blob {
+    int block_ring = -1, block_column = -1;
+    std::uint8_t truth = 0;
+    std::uint8_t label = 0;  // what its points are called; 0 = their true class
+  } blob;
   for (std::size_t i = 0; i < n; ++i) {
-    const std::uint64_t block = hash3(static_cast<std::uint64_t>(scan.ring[i] / options.block_rings),
-                                      static_cast<std::uint64_t>(scan.column[i] / options.block_columns), truth[i]);
-    Rng blob(hash_combine(seed, block));
-    const Confusion conf = confusion_of(truth[i]);
-    if (blob.uniform() < conf.rate * options.confusion_scale) {
-      const double pick = blob.uniform();
-      out[i] = conf.to[pick < 0.6 ? 0 : (pick < 0.85 ? 1 : 2)];
+    const int block_ring = scan.ring[i] / options.block_rings, block_column = scan.column[i] / options.block_columns;
+    if (block_ring != blob.block_ring || block_column != blob.block_column || truth[i] != blob.truth) {
+      blob = {block_ring, block_column, truth[i], 0};
+      Rng draw(hash_combine(seed, hash3(static_cast<std::uint64_t>(block_ring), static_cast<std::uint64_t>(block_column), truth[i])));
+      const Confusion conf = confusion_of(truth[i]);
+      if (draw.uniform() < conf.rate * options.confusion_scale) {
+        const double pick = draw.uniform();
+        blob.label = conf.to[pick < 0.6 ? 0 : (pick < 0.85 ? 1 : 2)];
+      }
     }
+    if (blob.label != 0) out[i] = blob.label;
   }
 
   // 3. A few plainly wrong labels, drawn from the common classes (networks

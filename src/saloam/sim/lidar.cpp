@@ -67,9 +67,37 @@ std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const Li
   return out;
 }
 
-SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep) {
-  const int columns = lidar.azimuth_steps, beams = lidar.beams();
+SweepRays::SweepRays(const LidarModel& lidar) : columns(lidar.azimuth_steps) {
+  const int beams = lidar.beams();
   if (columns <= 0 || beams <= 0) throw ConfigError("lidar model needs beams and azimuth steps");
+  for (int b = 0; b < beams; ++b) {
+    const double e = lidar.elevation_deg[static_cast<std::size_t>(b)] * kPi / 180.0;
+    sin_el.push_back(std::sin(e));
+    cos_el.push_back(std::cos(e));
+  }
+  for (int c = 0; c < columns; ++c) {
+    const double az = lidar.column_azimuth(c);
+    cos_az.push_back(std::cos(az));
+    sin_az.push_back(std::sin(az));
+  }
+  blocked.assign(static_cast<std::size_t>(beams) * static_cast<std::size_t>(columns), 0);
+  for (int b = 0; b < beams && !lidar.ego_body.empty(); ++b) {
+    for (int c = 0; c < columns; ++c) {
+      blocked[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)] =
+          lidar.hits_ego_body(direction(b, c)) ? 1 : 0;
+    }
+  }
+}
+
+SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep) {
+  return simulate_scan(world, lidar, SweepRays(lidar), sweep);
+}
+
+SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepRays& rays, const SweepSpec& sweep) {
+  const int columns = lidar.azimuth_steps, beams = lidar.beams();
+  if (rays.columns != columns || static_cast<int>(rays.sin_el.size()) != beams) {
+    throw ConfigError("ray table of another lidar model");
+  }
   struct Return {
     Eigen::Vector3f point;
     float remission;
@@ -78,24 +106,6 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     bool valid;
   };
   std::vector<Return> grid(static_cast<std::size_t>(columns) * static_cast<std::size_t>(beams));
-  std::vector<double> sin_el(static_cast<std::size_t>(beams)), cos_el(static_cast<std::size_t>(beams));
-  for (int b = 0; b < beams; ++b) {
-    const double e = lidar.elevation_deg[static_cast<std::size_t>(b)] * kPi / 180.0;
-    sin_el[static_cast<std::size_t>(b)] = std::sin(e);
-    cos_el[static_cast<std::size_t>(b)] = std::cos(e);
-  }
-
-  // Rays the car's own body stops (the same in every sweep).
-  std::vector<std::uint8_t> blocked(grid.size(), 0);
-  for (int c = 0; c < columns && !lidar.ego_body.empty(); ++c) {
-    const double az = lidar.column_azimuth(c);
-    for (int b = 0; b < beams; ++b) {
-      const Eigen::Vector3d dir_s(cos_el[static_cast<std::size_t>(b)] * std::cos(az),
-                                  cos_el[static_cast<std::size_t>(b)] * std::sin(az), sin_el[static_cast<std::size_t>(b)]);
-      blocked[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)] =
-          lidar.hits_ego_body(dir_s) ? 1 : 0;
-    }
-  }
 
   std::vector<float> column_offset(static_cast<std::size_t>(columns), 0.0f);
   tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
@@ -104,12 +114,12 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       const double frac = lidar.column_fraction(c);
       const Pose sensor = column_pose(lidar, sweep, c);
       const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
-      const double az = lidar.column_azimuth(c);
-      const double cos_az = std::cos(az), sin_az = std::sin(az);
+      const double cos_az = rays.cos_az[static_cast<std::size_t>(c)], sin_az = rays.sin_az[static_cast<std::size_t>(c)];
       // The sensor stays on a car on the ground (World::sensor_origin); the
       // points are in the sensor frame, so a height error of the pose, if
       // any, shows up as it does in real data: between poses and scans.
-      const Eigen::Vector3d origin = world.sensor_origin(sensor.translation());
+      const World::RayOrigin rays_from = world.ray_origin(world.sensor_origin(sensor.translation()));
+      const Eigen::Vector3d& origin = rays_from.position;
       column_offset[static_cast<std::size_t>(c)] = static_cast<float>(origin.z() - sensor.translation().z());
       // Moving objects at this column's time, kept only near the column's vertical plane.
       world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
@@ -124,13 +134,12 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       }
       Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
       for (int b = 0; b < beams; ++b) {
-        const Eigen::Vector3d dir_s(cos_el[static_cast<std::size_t>(b)] * cos_az, cos_el[static_cast<std::size_t>(b)] * sin_az,
-                                    sin_el[static_cast<std::size_t>(b)]);
+        const Eigen::Vector3d dir_s = rays.direction(b, c);
         const Eigen::Vector3d dir = sensor.linear() * dir_s;
         Return& out = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
         out.valid = false;
-        if (blocked[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)]) continue;
-        const RayHit hit = world.cast_ray(origin, dir, lidar.max_range, t, near, rng);
+        if (rays.is_blocked(b, c)) continue;
+        const RayHit hit = world.cast_ray(rays_from, dir, lidar.max_range, t, near, rng);
         // Draw every random number whether or not it is used, so that one
         // ray's outcome never shifts the noise of the next.
         const double noise = rng.normal() * lidar.range_noise;

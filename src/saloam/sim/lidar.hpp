@@ -86,8 +86,30 @@ Pose column_pose(const LidarModel& lidar, const SweepSpec& sweep, int column);
 /// pose: an exact de-skew with the true motion (for tests and ground truth).
 std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const LidarModel& lidar, const SweepSpec& sweep);
 
+/// The sensor-frame geometry of a sweep's rays, the same in every sweep:
+/// beam elevations, column azimuths and the rays that the car's own body
+/// stops. Computed once per LiDAR instead of once per scan.
+struct SweepRays {
+  explicit SweepRays(const LidarModel& lidar);
+  std::vector<double> sin_el, cos_el;  ///< per beam
+  std::vector<double> cos_az, sin_az;  ///< per column (LidarModel::column_azimuth)
+  std::vector<std::uint8_t> blocked;   ///< beam-major, beams x columns: 1 = the ego body stops the ray
+  int columns = 0;
+
+  /// Unit direction of ray (beam, column) in the sensor frame (x forward, z up).
+  [[nodiscard]] Eigen::Vector3d direction(int beam, int column) const {
+    const auto b = static_cast<std::size_t>(beam), c = static_cast<std::size_t>(column);
+    return {cos_el[b] * cos_az[c], cos_el[b] * sin_az[c], sin_el[b]};
+  }
+  [[nodiscard]] bool is_blocked(int beam, int column) const {
+    return blocked[static_cast<std::size_t>(beam) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)] != 0;
+  }
+};
+
 /// Ray casts one sweep (columns in parallel; the output does not depend on
-/// the number of threads).
+/// the number of threads). `rays` must come from the same `lidar`.
+SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepRays& rays, const SweepSpec& sweep);
+/// The same, computing the ray table on the way (one-off scans).
 SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepSpec& sweep);
 
 }  // namespace saloam

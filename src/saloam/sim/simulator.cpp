@@ -90,6 +90,7 @@ SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
       trajectory_(source_lidar_trajectory(options)),
       frames_(selected_frames(options, trajectory_.size())),
       lidar_(lidar_for(options)),
+      rays_(lidar_),
       world_(world_for(trajectory_, options)),
       velo_to_cam_(output_velo_to_cam(options)) {
   // Re-based so that the first selected frame is the origin.
@@ -110,7 +111,7 @@ SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
 
 SimulatedFrame SimulatedSequence::render(std::size_t k) const {
   const SweepSpec sweep = sweep_for_frame(trajectory_, frames_.at(k), options_);
-  SimulatedScan scan = simulate_scan(world_, lidar_, sweep);
+  SimulatedScan scan = simulate_scan(world_, lidar_, rays_, sweep);
   if (scan.cloud.size() == 0) {
     const Eigen::Vector3d p = sweep.start.translation();
     throw std::runtime_error(fmt::format("simulated frame {} (source pose {}, sensor at {:.2f} {:.2f} {:.2f}) has no points",

@@ -116,6 +116,7 @@ class SimulatedSequence {
   std::vector<Pose> trajectory_;  ///< source trajectory, LiDAR frame
   std::vector<std::size_t> frames_;
   LidarModel lidar_;
+  SweepRays rays_;
   World world_;
   Pose velo_to_cam_ = Pose::Identity();
   std::vector<Pose> camera_poses_, sensor_camera_poses_;

@@ -289,8 +289,8 @@ Eigen::Vector3d World::sensor_origin(const Eigen::Vector3d& pose_origin) const {
 // those of marching the whole way, whatever was asked on the way.
 class World::GroundMarch {
  public:
-  GroundMarch(const World& world, const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_t)
-      : world_(world), o_(o), d_(d), max_t_(max_t), f_prev_(above(0.0)) {
+  GroundMarch(const World& world, const RayOrigin& o, const Eigen::Vector3d& d, double max_t)
+      : world_(world), o_(o.position), d_(d), d_xy_(std::hypot(d.x(), d.y())), max_t_(max_t), f_prev_(o.clearance) {
     if (f_prev_ <= 0) finish(0.0);
   }
 
@@ -347,7 +347,7 @@ class World::GroundMarch {
     double exit = max_t_;
     if (std::abs(d_.x()) > 1e-12) exit = std::min(exit, ((d_.x() > 0 ? tx + 1 - ux : ux - tx) * tile) / std::abs(d_.x()));
     if (std::abs(d_.y()) > 1e-12) exit = std::min(exit, ((d_.y() > 0 ? ty + 1 - uy : uy - ty) * tile) / std::abs(d_.y()));
-    const double closing = rise * std::hypot(d_.x(), d_.y()) - d_.z();
+    const double closing = rise * d_xy_ - d_.z();
     const double clear = closing > 0.0 ? 0.9 * (f - World::kGroundStep) / closing : max_t_;
     return std::min(clear, exit);
   }
@@ -375,18 +375,24 @@ class World::GroundMarch {
 
   const World& world_;
   const Eigen::Vector3d o_, d_;
+  const double d_xy_;  ///< horizontal length of the direction
   const double max_t_;
   double t_prev_ = 0.0, f_prev_, t_ = 1.0;
   bool done_ = false;
   double crossing_ = kInf;
 };
 
-RayHit World::cast_ray(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double max_range, double t,
+World::RayOrigin World::ray_origin(const Eigen::Vector3d& position) const {
+  return {position, position.z() - ground_height(position.x(), position.y())};
+}
+
+RayHit World::cast_ray(const RayOrigin& origin, const Eigen::Vector3d& d, double max_range, double t,
                        std::span<const Primitive> dynamic, Rng& rng) const {
+  const Eigen::Vector3d& o = origin.position;
   RayHit best;
   // The nearest surface so far is the ground or the nearest object; the
   // ground is marched only as far as the comparisons below need.
-  GroundMarch ground(*this, o, d, max_range);
+  GroundMarch ground(*this, origin, d, max_range);
   double object_t = max_range + 1e-9;  // nearest object (or glass) so far, capped at the range
   const auto nearer = [&](double x) { return x < object_t && ground.beyond(x); };
   const Primitive* best_p = nullptr;

@@ -136,10 +136,17 @@ class World {
   [[nodiscard]] double ego_arc_length(double t) const;
   [[nodiscard]] double path_length() const { return path_s_.empty() ? 0.0 : path_s_.back(); }
 
+  /// Where rays start and how high that is above the ground (positive =
+  /// above), shared by every ray cast from there.
+  struct RayOrigin {
+    Eigen::Vector3d position;
+    double clearance;
+  };
+  [[nodiscard]] RayOrigin ray_origin(const Eigen::Vector3d& position) const;
   /// Casts one ray (unit direction) against ground, static objects present at
   /// time t and the given dynamic primitives. `rng` drives porous surfaces.
-  [[nodiscard]] RayHit cast_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& direction, double max_range,
-                                double t, std::span<const Primitive> dynamic, Rng& rng) const;
+  [[nodiscard]] RayHit cast_ray(const RayOrigin& origin, const Eigen::Vector3d& direction, double max_range, double t,
+                                std::span<const Primitive> dynamic, Rng& rng) const;
 
  private:
   friend class WorldBuilder;
