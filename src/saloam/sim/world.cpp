@@ -248,12 +248,12 @@ GroundInfo World::ground_from(const FieldSample& s) const {
     return g;
   }
   if (d < park) {
-    g.height = base + 0.02;
+    g.height = base + kParkingRise;
     g.label = cls::kParking;
     g.remission = 0.26f;
     return g;
   }
-  const double curb = z.sidewalk > 0 ? 0.13 : 0.0;
+  const double curb = z.sidewalk > 0 ? kCurbHeight : 0.0;
   if (d < walk) {
     g.height = base + curb;
     g.label = cls::kSidewalk;
@@ -326,7 +326,43 @@ class World::GroundMarch {
     double step = std::max(0.2, 0.04 * t_);
     if (d_.z() < -1e-3) step = std::max(step, 0.8 * f / -d_.z());
     step = std::min(step, std::max(0.5, 0.35 * t_));
-    t_ += std::max(step, clear_step(f));
+    t_ = std::max(t_ + std::max(step, clear_step(f)), first_contact());
+  }
+  // The first range from t_ on where the ray may reach down to the ground:
+  // tile by tile along the ray, its height against the highest the ground
+  // gets in the tile. Over flat streets and open land that skips every tile
+  // up to the one where the ray comes down.
+  double first_contact() const {
+    const World& w = world_;
+    const double tile = World::kRiseTile * w.options_.ground_cell;
+    const Eigen::Vector3d p = o_ + t_ * d_;
+    const double ux = (p.x() - w.origin_.x()) / tile, uy = (p.y() - w.origin_.y()) / tile;
+    int tx = static_cast<int>(std::floor(ux)), ty = static_cast<int>(std::floor(uy));
+    // Ranges at which the ray leaves the current tile column / row (2D DDA).
+    const double dt_x = std::abs(d_.x()) > 1e-12 ? tile / std::abs(d_.x()) : kInf;
+    const double dt_y = std::abs(d_.y()) > 1e-12 ? tile / std::abs(d_.y()) : kInf;
+    double next_x = t_ + (d_.x() >= 0 ? tx + 1 - ux : ux - tx) * dt_x;
+    double next_y = t_ + (d_.y() >= 0 ? ty + 1 - uy : uy - ty) * dt_y;
+    double t = t_;
+    while (t < max_t_ && tx >= 0 && ty >= 0 && tx < w.rise_nx_ && ty < w.rise_ny_) {
+      const double top = w.ground_top_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(w.rise_nx_) +
+                                       static_cast<std::size_t>(tx)];
+      const double exit = std::min({next_x, next_y, max_t_});
+      const double lowest = o_.z() + (d_.z() < 0.0 ? exit : t) * d_.z();  // the ray's lowest point in the tile
+      if (lowest <= top) {
+        // It comes down to the tile's top within the tile (or starts below it).
+        return d_.z() < 0.0 ? std::max(t, (o_.z() - top) / -d_.z()) : t;
+      }
+      t = exit;
+      if (next_x < next_y) {
+        tx += d_.x() >= 0 ? 1 : -1;
+        next_x += dt_x;
+      } else {
+        ty += d_.y() >= 0 ? 1 : -1;
+        next_y += dt_y;
+      }
+    }
+    return t;
   }
   // How far the ray surely stays above the ground from its point at t_, f
   // above it, without leaving the current rise tile: the ground rises at

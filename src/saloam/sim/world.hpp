@@ -188,8 +188,13 @@ class World {
   /// direction, plus steps of at most kGroundStep (curbs, zone edges).
   static constexpr int kRiseTile = 8;
   static constexpr double kGroundStep = 0.5;  ///< [m]
+  /// Height of the curb (sidewalks and verges) and of parking lanes above
+  /// the road surface [m].
+  static constexpr double kCurbHeight = 0.13, kParkingRise = 0.02;
   int rise_nx_ = 0, rise_ny_ = 0;
   std::vector<float> ground_rise_;
+  /// The highest the ground gets anywhere in each tile [m] (an upper bound).
+  std::vector<float> ground_top_;
   std::vector<Zone> zones_;
   // Static objects and their 2D grid (CSR).
   std::vector<Primitive> primitives_;

@@ -4,6 +4,7 @@
 // once, not twice), moving agents, and the ray-casting grid.
 
 #include <algorithm>
+#include <limits>
 #include <cstdio>
 #include <cmath>
 #include <unordered_map>
@@ -201,12 +202,18 @@ class WorldBuilder {
   // (World::kGroundStep): the height and the bump are bilinear between raster
   // nodes, so each changes along a direction at most by its largest x step
   // plus its largest y step per cell; the verge fades the bump in over 12 m.
-  // A tile's bound covers the raster patches that reach into it.
+  // And on how high the ground gets in each tile: a bilinear value is at most
+  // its largest node. A tile's bounds cover the raster patches that reach
+  // into it.
   void bound_ground_rise() {
     const int tile = World::kRiseTile;
     w_.rise_nx_ = (w_.nx_ + tile - 1) / tile;
     w_.rise_ny_ = (w_.ny_ + tile - 1) / tile;
-    w_.ground_rise_.assign(static_cast<std::size_t>(w_.rise_nx_) * static_cast<std::size_t>(w_.rise_ny_), 0.0f);
+    const std::size_t tiles = static_cast<std::size_t>(w_.rise_nx_) * static_cast<std::size_t>(w_.rise_ny_);
+    w_.ground_rise_.assign(tiles, 0.0f);
+    // Highest raster height and bump reaching into each tile: the ground
+    // (World::ground_from) is at most their sum plus the curb.
+    std::vector<float> top_height(tiles, -std::numeric_limits<float>::infinity()), top_bump(tiles, 0.0f);
     auto idx = [&](int ix, int iy) {
       return static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.nx_) + static_cast<std::size_t>(ix);
     };
@@ -223,12 +230,17 @@ class WorldBuilder {
         // The node's patches span [ix - 1, ix + 1]: every tile they reach.
         for (int ty = std::max(0, iy - 1) / tile; ty <= std::min(w_.ny_ - 1, iy + 1) / tile; ++ty) {
           for (int tx = std::max(0, ix - 1) / tile; tx <= std::min(w_.nx_ - 1, ix + 1) / tile; ++tx) {
-            float& bound = w_.ground_rise_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(w_.rise_nx_) +
-                                           static_cast<std::size_t>(tx)];
-            bound = std::max(bound, rise);
+            const std::size_t t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(w_.rise_nx_) + static_cast<std::size_t>(tx);
+            w_.ground_rise_[t] = std::max(w_.ground_rise_[t], rise);
+            top_height[t] = std::max(top_height[t], w_.height_[i]);
+            top_bump[t] = std::max(top_bump[t], w_.bump_[i]);
           }
         }
       }
+    }
+    w_.ground_top_.resize(tiles);
+    for (std::size_t t = 0; t < tiles; ++t) {
+      w_.ground_top_[t] = static_cast<float>(top_height[t] + std::max(World::kCurbHeight, World::kParkingRise) + top_bump[t] + 1e-3);
     }
   }
 
