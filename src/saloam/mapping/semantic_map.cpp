@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "saloam/core/semantic_classes.hpp"
 
@@ -21,7 +22,12 @@ void SemanticMap::insert(const LabelledCloud& scan, const Pose& world_from_senso
     if (scan.points[i].squaredNorm() > max_range_sq) continue;
     const Eigen::Vector3f p = T * scan.points[i];
     const Eigen::Vector3i key((p * inv_voxel).array().floor().cast<int>());
-    Voxel& v = voxels_[key];
+    const auto [it, inserted] = index_.try_emplace(key, static_cast<std::uint32_t>(voxels_.size()));
+    if (inserted) {
+      keys_.push_back(key);
+      voxels_.emplace_back();
+    }
+    Voxel& v = voxels_[it->second];
     v.sum += p;
     v.remission_sum += scan.remission[i];
     ++v.count;
@@ -46,18 +52,17 @@ void SemanticMap::insert(const LabelledCloud& scan, const Pose& world_from_senso
 }
 
 LabelledCloud SemanticMap::to_cloud() const {
-  // Sorted by voxel key so that the output does not depend on hash order.
-  std::vector<const decltype(voxels_)::value_type*> entries;
-  entries.reserve(voxels_.size());
-  for (const auto& e : voxels_) entries.push_back(&e);
-  std::sort(entries.begin(), entries.end(), [](const auto* a, const auto* b) {
-    return std::lexicographical_compare(a->first.data(), a->first.data() + 3, b->first.data(), b->first.data() + 3);
+  // Sorted by voxel key so that the output does not depend on the order of insertion.
+  std::vector<std::uint32_t> order(voxels_.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return std::lexicographical_compare(keys_[a].data(), keys_[a].data() + 3, keys_[b].data(), keys_[b].data() + 3);
   });
   LabelledCloud cloud;
   cloud.has_labels = has_labels_;
-  cloud.reserve(entries.size());
-  for (const auto* e : entries) {
-    const Voxel& v = e->second;
+  cloud.reserve(order.size());
+  for (const std::uint32_t i : order) {
+    const Voxel& v = voxels_[i];
     const int best = static_cast<int>(std::max_element(v.votes, v.votes + 4) - v.votes);
     const float n = static_cast<float>(v.count);
     cloud.push_back(v.sum / n, v.remission_sum / n, v.labels[best], v.instances[best]);

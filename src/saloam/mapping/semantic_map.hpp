@@ -61,7 +61,12 @@ class SemanticMap {
 
   SemanticMapOptions options_;
   bool has_labels_ = false;
-  tsl::robin_map<Eigen::Vector3i, Voxel, KeyHash> voxels_;
+  // Voxels in insertion order, found by key through a compact index (the
+  // global map holds millions: an open-addressing table of whole voxels at
+  // its load factor would take several times their size).
+  tsl::robin_map<Eigen::Vector3i, std::uint32_t, KeyHash> index_;
+  std::vector<Eigen::Vector3i> keys_;
+  std::vector<Voxel> voxels_;
 };
 
 }  // namespace saloam

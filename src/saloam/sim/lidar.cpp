@@ -130,7 +130,8 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       for (const auto& p : agents) {
         const Eigen::Vector2d rel = p.center.cast<double>() - origin.head<2>();
         const double along = rel.dot(h2), across = std::abs(rel.x() * h2.y() - rel.y() * h2.x());
-        if (along > -p.footprint_radius() && across < p.footprint_radius() + 0.05) near.push_back(p);
+        const double radius = p.footprint_radius();
+        if (along > -radius && across < radius + 0.05) near.push_back(p);
       }
       Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
       for (int b = 0; b < beams; ++b) {
