@@ -77,7 +77,8 @@ int ring_from_elevation(double elevation_deg, BeamLayout layout) {
 double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config) {
   const double start = config.sweep_start_azimuth_deg * M_PI / 180.0;
   double turned = config.sweep_clockwise ? start - azimuth_rad : azimuth_rad - start;
-  turned = std::fmod(turned, 2.0 * M_PI);
+  // fmod returns its argument unchanged below one turn, the usual case.
+  if (std::abs(turned) >= 2.0 * M_PI) turned = std::fmod(turned, 2.0 * M_PI);
   if (turned < 0.0) turned += 2.0 * M_PI;
   return turned / (2.0 * M_PI) * config.sweep_duration;
 }
@@ -102,16 +103,17 @@ PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_w
   const int n = static_cast<int>(ring.size());
   PointMask bad(ring.size(), 0);
   std::vector<double> range(ring.size());
+  std::vector<double> gap_sq(ring.size(), 0.0);  // gap_sq[i] = |X_{i+1} - X_i|^2
   for (int i = 0; i < n; ++i) {
     range[i] = ring[i].norm();
     if (range[i] < min_range || range[i] > max_range) bad[i] = 1;
+    if (i + 1 < n) gap_sq[i] = (ring[i + 1] - ring[i]).squaredNorm();
   }
   for (int i = 0; i + 1 < n; ++i) {
-    const double gap = (ring[i + 1] - ring[i]).norm();
     // Neighbouring returns far apart relative to their range: either a depth
     // jump (occlusion) or a hole in azimuth. Angular step of the HDL-64E is
     // ~0.17 deg (3e-3 rad); 0.3 m at 10 m is ~10 steps.
-    if (gap > 0.03 * std::max(range[i], 1.0) + 0.1) {
+    if (std::sqrt(gap_sq[i]) > 0.03 * std::max(range[i], 1.0) + 0.1) {
       const double near = std::min(range[i], range[i + 1]);
       const bool depth_jump = std::abs(range[i] - range[i + 1]) > 0.1 * near + 0.1;
       if (depth_jump) {
@@ -134,9 +136,7 @@ PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_w
   // to the range (LOAM's 0.0002 * range^2 on the squared gap).
   for (int i = 1; i + 1 < n; ++i) {
     const double limit = 0.0002 * range[i] * range[i];
-    if ((ring[i] - ring[i - 1]).squaredNorm() > limit && (ring[i + 1] - ring[i]).squaredNorm() > limit) {
-      bad[i] = 1;
-    }
+    if (gap_sq[i - 1] > limit && gap_sq[i] > limit) bad[i] = 1;
   }
   return bad;
 }
@@ -387,60 +387,65 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
   return rings_from_storage(point_sweep_times(cloud, config), config, expected_rings);
 }
 
-ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
-                              bool parallel) {
-  ScanFeatures out;
+namespace {
+/// Rings from the elevation angle (for scans not stored ring by ring), each
+/// ordered in time so that ring neighbours are neighbours in azimuth.
+std::vector<std::vector<std::uint32_t>> rings_from_elevation(const LabelledCloud& cloud,
+                                                             const std::vector<float>& times,
+                                                             const FeatureConfig& config) {
   struct Entry {
     float time;
     std::uint32_t index;
   };
-  std::vector<std::vector<Entry>> buckets;
-  // Rings from the point order when the scan is stored ring by ring (exact
-  // even for scans whose points were moved by motion compensation), else from
-  // the elevation angle.
-  const std::vector<float> times = point_sweep_times(cloud, config);
-  auto ordered = config.ring_from_point_order ? rings_from_storage(times, config, config.num_beams)
-                                              : std::vector<std::vector<std::uint32_t>>{};
-  if (!ordered.empty()) {
-    buckets.resize(ordered.size());
-    for (std::size_t r = 0; r < ordered.size(); ++r) {
-      buckets[r].reserve(ordered[r].size());
-      for (const auto i : ordered[r]) buckets[r].push_back({times[i], i});
-    }
-  } else {
-    const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
-    const int num_rings = ring_count(layout);
-    buckets.resize(num_rings);
-    for (auto& b : buckets) b.reserve(cloud.size() / num_rings * 2);
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const Eigen::Vector3f& p = cloud.points[i];
-      if (times[i] < 0.0f) continue;
-      const double horizontal = std::hypot(p.x(), p.y());
-      const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
-      if (ring < 0) continue;
-      buckets[ring].push_back({times[i], static_cast<std::uint32_t>(i)});
-    }
-    // Order each ring in time so that ring neighbours are neighbours in azimuth.
-    for (auto& bucket : buckets) {
-      std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
-    }
+  const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
+  const int num_rings = ring_count(layout);
+  std::vector<std::vector<Entry>> buckets(num_rings);
+  for (auto& b : buckets) b.reserve(cloud.size() / num_rings * 2);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (times[i] < 0.0f) continue;
+    const double horizontal = std::hypot(p.x(), p.y());
+    const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
+    if (ring < 0) continue;
+    buckets[ring].push_back({times[i], static_cast<std::uint32_t>(i)});
   }
+  std::vector<std::vector<std::uint32_t>> rings(buckets.size());
+  for (std::size_t r = 0; r < buckets.size(); ++r) {
+    auto& bucket = buckets[r];
+    std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
+    rings[r].reserve(bucket.size());
+    for (const Entry& e : bucket) rings[r].push_back(e.index);
+  }
+  return rings;
+}
+}  // namespace
+
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
+                              bool parallel) {
+  ScanFeatures out;
+  // Rings (point indices in azimuth order) from the point order when the scan
+  // is stored ring by ring (exact even for scans whose points were moved by
+  // motion compensation), else from the elevation angle.
+  const std::vector<float> times = point_sweep_times(cloud, config);
+  std::vector<std::vector<std::uint32_t>> rings;
+  if (config.ring_from_point_order) rings = rings_from_storage(times, config, config.num_beams);
+  if (rings.empty()) rings = rings_from_elevation(cloud, times, config);
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.
-  std::vector<ScanFeatures> per_ring(buckets.size());
+  std::vector<ScanFeatures> per_ring(rings.size());
   auto process_ring = [&](std::size_t r) {
-    const auto& bucket = buckets[r];
-    std::vector<Eigen::Vector3d> ring_points(bucket.size());
-    for (std::size_t k = 0; k < bucket.size(); ++k) ring_points[k] = cloud.points[bucket[k].index].cast<double>();
+    const auto& ring = rings[r];
+    std::vector<Eigen::Vector3d> ring_points(ring.size());
+    for (std::size_t k = 0; k < ring.size(); ++k) ring_points[k] = cloud.points[ring[k]].cast<double>();
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
     auto unreliable =
         unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
     PointMask not_edge;
     if (use_labels) {  // unusable classes must not take a sector's feature slots
       const bool ground_threshold = config.ground_edge_alpha > config.alpha;
-      if (ground_threshold) not_edge.assign(bucket.size(), 0);
-      for (std::size_t k = 0; k < bucket.size(); ++k) {
-        const std::uint16_t label = cloud.label[bucket[k].index];
+      if (ground_threshold) not_edge.assign(ring.size(), 0);
+      for (std::size_t k = 0; k < ring.size(); ++k) {
+        const std::uint16_t label = cloud.label[ring[k]];
         if (odometry_class(label) < 0) unreliable[k] = 1;
         // Only points rough enough to be edges at all need the class lookup.
         if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
@@ -452,22 +457,22 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
     const auto selection = select_ring_features(ring_points, roughness, unreliable, config, not_edge);
     auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
       for (const int k : indices) {
-        const auto& e = bucket[k];
+        const std::uint32_t i = ring[k];
         int c = 0;
         if (use_labels) {
-          c = odometry_class(cloud.label[e.index]);
+          c = odometry_class(cloud.label[i]);
           if (c < 0) continue;
         }
-        target.push_back(ring_points[k], static_cast<ClassIndex>(c), e.time);
+        target.push_back(ring_points[k], static_cast<ClassIndex>(c), times[i]);
       }
     };
     emit(selection.edges, per_ring[r].edges);
     emit(selection.planars, per_ring[r].planars);
   };
   if (parallel) {
-    tbb::parallel_for(std::size_t{0}, buckets.size(), process_ring);
+    tbb::parallel_for(std::size_t{0}, rings.size(), process_ring);
   } else {
-    for (std::size_t r = 0; r < buckets.size(); ++r) process_ring(r);
+    for (std::size_t r = 0; r < rings.size(); ++r) process_ring(r);
   }
   auto append = [](FeatureCloud& to, const FeatureCloud& from) {
     to.points.insert(to.points.end(), from.points.begin(), from.points.end());
