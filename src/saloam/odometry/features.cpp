@@ -98,6 +98,16 @@ std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int
   return c;
 }
 
+namespace {
+/// sqrt(squared) > limit (limit > 0), without the square root when the
+/// squared value is clearly below limit^2 (the usual case): the result is
+/// the same as comparing the rounded square root.
+bool exceeds(double squared, double limit) {
+  if (squared < 0.99 * limit * limit) return false;
+  return std::sqrt(squared) > limit;
+}
+}  // namespace
+
 PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window, double min_range,
                             double max_range) {
   const int n = static_cast<int>(ring.size());
@@ -113,7 +123,7 @@ PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_w
     // Neighbouring returns far apart relative to their range: either a depth
     // jump (occlusion) or a hole in azimuth. Angular step of the HDL-64E is
     // ~0.17 deg (3e-3 rad); 0.3 m at 10 m is ~10 steps.
-    if (std::sqrt(gap_sq[i]) > 0.03 * std::max(range[i], 1.0) + 0.1) {
+    if (exceeds(gap_sq[i], 0.03 * std::max(range[i], 1.0) + 0.1)) {
       const double near = std::min(range[i], range[i + 1]);
       const bool depth_jump = std::abs(range[i] - range[i + 1]) > 0.1 * near + 0.1;
       if (depth_jump) {
@@ -207,13 +217,22 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
     const int begin = first + (last - first) * s / sectors;
     const int end = first + (last - first) * (s + 1) / sectors;
     if (end <= begin) continue;
-    rough.clear();
-    smooth.clear();
+    // Each key is written to both lists and kept where it belongs: whether
+    // a point is rough is not predictable, a branch on it mostly mispredicts.
+    rough.resize(static_cast<std::size_t>(end - begin));
+    smooth.resize(static_cast<std::size_t>(end - begin));
+    std::size_t num_rough = 0, num_smooth = 0;
     for (int i = begin; i < end; ++i) {
-      if (blocked[i] || !std::isfinite(roughness[i])) continue;
-      if (roughness[i] > config.alpha) rough.push_back(key(roughness[i], i));
-      if (roughness[i] < config.alpha) smooth.push_back(key(roughness[i], i));
+      const double c = roughness[i];
+      const bool usable = !blocked[i] && std::isfinite(c);
+      const std::uint64_t k = key(c, i);
+      rough[num_rough] = k;
+      smooth[num_smooth] = k;
+      num_rough += usable && c > config.alpha;
+      num_smooth += usable && c < config.alpha;
     }
+    rough.resize(num_rough);
+    smooth.resize(num_smooth);
     sort_keys_pushed_in_index_order(rough, scratch);
     int picked = 0;
     for (auto it = rough.rbegin(); it != rough.rend() && picked < config.edges_per_sector; ++it) {
@@ -260,15 +279,24 @@ ClassIndex class_group(ClassIndex c) {
   return c < table.size() ? table[c] : c;
 }
 
-int odometry_class(std::uint16_t raw_label) {
-  // Raw ids are below 260; a table avoids the class-table search per point.
-  static const std::array<std::int8_t, 512> table = [] {
-    std::array<std::int8_t, 512> t{};
+namespace {
+/// odometry_class of the raw labels below 512 (raw ids are below 260): a
+/// table avoids the class-table search per point.
+using OdometryClassTable = std::array<std::int8_t, 512>;
+const OdometryClassTable& odometry_class_table() {
+  static const OdometryClassTable table = [] {
+    OdometryClassTable t{};
     for (std::size_t id = 0; id < t.size(); ++id) t[id] = static_cast<std::int8_t>(compute_odometry_class(static_cast<std::uint16_t>(id)));
     return t;
   }();
+  return table;
+}
+int odometry_class(const OdometryClassTable& table, std::uint16_t raw_label) {
   return raw_label < table.size() ? table[raw_label] : compute_odometry_class(raw_label);
 }
+}  // namespace
+
+int odometry_class(std::uint16_t raw_label) { return odometry_class(odometry_class_table(), raw_label); }
 
 namespace {
 std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config) {
@@ -433,6 +461,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.
   std::vector<ScanFeatures> per_ring(rings.size());
+  const OdometryClassTable& class_table = odometry_class_table();
   auto process_ring = [&](std::size_t r) {
     const auto& ring = rings[r];
     std::vector<Eigen::Vector3d> ring_points(ring.size());
@@ -446,7 +475,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
       if (ground_threshold) not_edge.assign(ring.size(), 0);
       for (std::size_t k = 0; k < ring.size(); ++k) {
         const std::uint16_t label = cloud.label[ring[k]];
-        if (odometry_class(label) < 0) unreliable[k] = 1;
+        unreliable[k] |= odometry_class(class_table, label) < 0;
         // Only points rough enough to be edges at all need the class lookup.
         if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
             is_ground(static_class(label))) {
@@ -460,7 +489,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
         const std::uint32_t i = ring[k];
         int c = 0;
         if (use_labels) {
-          c = odometry_class(cloud.label[i]);
+          c = odometry_class(class_table, cloud.label[i]);
           if (c < 0) continue;
         }
         target.push_back(ring_points[k], static_cast<ClassIndex>(c), times[i]);
