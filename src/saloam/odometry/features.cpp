@@ -74,13 +74,31 @@ int ring_from_elevation(double elevation_deg, BeamLayout layout) {
   return -1;
 }
 
+namespace {
+/// sweep_time_from_azimuth with the start angle converted once per scan.
+class SweepClock {
+ public:
+  explicit SweepClock(const FeatureConfig& config)
+      : start_(config.sweep_start_azimuth_deg * M_PI / 180.0),
+        clockwise_(config.sweep_clockwise),
+        duration_(config.sweep_duration) {}
+  [[nodiscard]] double time(double azimuth_rad) const {
+    double turned = clockwise_ ? start_ - azimuth_rad : azimuth_rad - start_;
+    // fmod returns its argument unchanged below one turn, the usual case.
+    if (std::abs(turned) >= 2.0 * M_PI) turned = std::fmod(turned, 2.0 * M_PI);
+    if (turned < 0.0) turned += 2.0 * M_PI;
+    return turned / (2.0 * M_PI) * duration_;
+  }
+
+ private:
+  double start_;  ///< [rad]
+  bool clockwise_;
+  double duration_;  ///< [s]
+};
+}  // namespace
+
 double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config) {
-  const double start = config.sweep_start_azimuth_deg * M_PI / 180.0;
-  double turned = config.sweep_clockwise ? start - azimuth_rad : azimuth_rad - start;
-  // fmod returns its argument unchanged below one turn, the usual case.
-  if (std::abs(turned) >= 2.0 * M_PI) turned = std::fmod(turned, 2.0 * M_PI);
-  if (turned < 0.0) turned += 2.0 * M_PI;
-  return turned / (2.0 * M_PI) * config.sweep_duration;
+  return SweepClock(config).time(azimuth_rad);
 }
 
 std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int half_window) {
@@ -301,10 +319,11 @@ int odometry_class(std::uint16_t raw_label) { return odometry_class(odometry_cla
 namespace {
 std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config) {
   std::vector<float> times(cloud.size(), -1.0f);  // -1: on the sensor axis, unusable
+  const SweepClock clock(config);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
     if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) continue;
-    times[i] = static_cast<float>(sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config));
+    times[i] = static_cast<float>(clock.time(std::atan2(p.y(), p.x())));
   }
   return times;
 }
@@ -361,17 +380,18 @@ std::vector<std::vector<std::uint32_t>> split_rings(const std::vector<float>& ph
 std::vector<float> storage_phase(const std::vector<float>& sweep_phase) {
   constexpr float kSmallStep = 5.0f / 360.0f;
   std::size_t along = 0, against = 0;
-  float first = -1.0f, previous = -1.0f;
-  for (const float p : sweep_phase) {
+  const auto valid = std::find_if(sweep_phase.begin(), sweep_phase.end(), [](float p) { return p >= 0.0f; });
+  if (valid == sweep_phase.end()) return {};
+  const float first = *valid;
+  float previous = first;
+  for (auto it = valid + 1; it != sweep_phase.end(); ++it) {
+    const float p = *it;
     if (p < 0.0f) continue;
-    if (first < 0.0f) first = p;
-    if (previous >= 0.0f) {
-      float step = p - previous;
-      if (step > 0.5f) step -= 1.0f;
-      if (step < -0.5f) step += 1.0f;
-      along += step > 0.0f && step < kSmallStep;
-      against += step < 0.0f && step > -kSmallStep;
-    }
+    float step = p - previous;
+    if (step > 0.5f) step -= 1.0f;
+    if (step < -0.5f) step += 1.0f;
+    along += step > 0.0f && step < kSmallStep;
+    against += step < 0.0f && step > -kSmallStep;
     previous = p;
   }
   const std::size_t steps = along + against;
