@@ -126,16 +126,24 @@ bool exceeds(double squared, double limit) {
 }
 }  // namespace
 
-PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window, double min_range,
-                            double max_range) {
+namespace {
+/// Squared distances between ring neighbours: gap_sq[i] = |X_{i+1} - X_i|^2
+/// (the last is 0). The tests for unreliable points and the suppression of
+/// selected points' neighbours both read them.
+std::vector<double> squared_gaps(const std::vector<Eigen::Vector3d>& ring) {
+  std::vector<double> gap_sq(ring.size(), 0.0);
+  for (std::size_t i = 0; i + 1 < ring.size(); ++i) gap_sq[i] = (ring[i + 1] - ring[i]).squaredNorm();
+  return gap_sq;
+}
+
+PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, const std::vector<double>& gap_sq,
+                            int half_window, double min_range, double max_range) {
   const int n = static_cast<int>(ring.size());
   PointMask bad(ring.size(), 0);
   std::vector<double> range(ring.size());
-  std::vector<double> gap_sq(ring.size(), 0.0);  // gap_sq[i] = |X_{i+1} - X_i|^2
   for (int i = 0; i < n; ++i) {
     range[i] = ring[i].norm();
     if (range[i] < min_range || range[i] > max_range) bad[i] = 1;
-    if (i + 1 < n) gap_sq[i] = (ring[i + 1] - ring[i]).squaredNorm();
   }
   for (int i = 0; i + 1 < n; ++i) {
     // Neighbouring returns far apart relative to their range: either a depth
@@ -168,6 +176,12 @@ PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_w
   }
   return bad;
 }
+}  // namespace
+
+PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window, double min_range,
+                            double max_range) {
+  return unreliable_points(ring, squared_gaps(ring), half_window, min_range, max_range);
+}
 
 namespace {
 /// Sorts keys (32-bit sort value above a 32-bit index) that were pushed in
@@ -194,12 +208,12 @@ void sort_keys_pushed_in_index_order(std::vector<std::uint64_t>& keys, std::vect
 }
 }  // namespace
 
-RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
-                                   const std::vector<double>& roughness,
+namespace {
+RingSelection select_ring_features(const std::vector<double>& gap_sq, const std::vector<double>& roughness,
                                    const PointMask& unreliable, const FeatureConfig& config,
                                    const PointMask& not_edge) {
   RingSelection out;
-  const int n = static_cast<int>(ring.size());
+  const int n = static_cast<int>(gap_sq.size());
   const int w = config.roughness_half_window;
   if (n < 2 * w + 1) return out;
   PointMask blocked(unreliable);
@@ -214,7 +228,7 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
         const int j = i + step * k;
         const int prev = j - step;
         if (j < 0 || j >= n) break;
-        if ((ring[j] - ring[prev]).squaredNorm() > 0.05) break;
+        if (gap_sq[std::min(j, prev)] > 0.05) break;
         blocked[j] = 1;
       }
     }
@@ -271,6 +285,14 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
     }
   }
   return out;
+}
+}  // namespace
+
+RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
+                                   const std::vector<double>& roughness,
+                                   const PointMask& unreliable, const FeatureConfig& config,
+                                   const PointMask& not_edge) {
+  return select_ring_features(squared_gaps(ring), roughness, unreliable, config, not_edge);
 }
 
 namespace {
@@ -487,8 +509,9 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
     std::vector<Eigen::Vector3d> ring_points(ring.size());
     for (std::size_t k = 0; k < ring.size(); ++k) ring_points[k] = cloud.points[ring[k]].cast<double>();
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
+    const auto gap_sq = squared_gaps(ring_points);
     auto unreliable =
-        unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
+        unreliable_points(ring_points, gap_sq, config.roughness_half_window, config.min_range, config.max_range);
     PointMask not_edge;
     if (use_labels) {  // unusable classes must not take a sector's feature slots
       const bool ground_threshold = config.ground_edge_alpha > config.alpha;
@@ -503,7 +526,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
         }
       }
     }
-    const auto selection = select_ring_features(ring_points, roughness, unreliable, config, not_edge);
+    const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
     auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
       for (const int k : indices) {
         const std::uint32_t i = ring[k];
