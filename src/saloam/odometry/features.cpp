@@ -244,41 +244,40 @@ RingSelection select_ring_features(const std::vector<double>& gap_sq, const std:
     return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(i);
   };
   auto index_of = [](std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); };
-  std::vector<std::uint64_t> rough, smooth, scratch;
+  // One sort of the sector's usable points serves both kinds: edges are
+  // taken from its rough end down, planar points from its smooth end up.
+  // Rounding to float keeps the order, so only keys whose float equals
+  // alpha's can be on either side, and the loops test each key's roughness.
+  const std::uint64_t alpha_bits = key(config.alpha, 0) >> 32;
+  auto roughness_bits = [](std::uint64_t k) { return k >> 32; };
+  std::vector<std::uint64_t> keys, scratch;
   for (int s = 0; s < sectors; ++s) {
     const int begin = first + (last - first) * s / sectors;
     const int end = first + (last - first) * (s + 1) / sectors;
     if (end <= begin) continue;
-    // Each key is written to both lists and kept where it belongs: whether
-    // a point is rough is not predictable, a branch on it mostly mispredicts.
-    rough.resize(static_cast<std::size_t>(end - begin));
-    smooth.resize(static_cast<std::size_t>(end - begin));
-    std::size_t num_rough = 0, num_smooth = 0;
+    keys.resize(static_cast<std::size_t>(end - begin));
+    std::size_t count = 0;
     for (int i = begin; i < end; ++i) {
       const double c = roughness[i];
-      const bool usable = !blocked[i] && std::isfinite(c);
-      const std::uint64_t k = key(c, i);
-      rough[num_rough] = k;
-      smooth[num_smooth] = k;
-      num_rough += usable && c > config.alpha;
-      num_smooth += usable && c < config.alpha;
+      keys[count] = key(c, i);
+      count += !blocked[i] && std::isfinite(c) && c != config.alpha;  // no branch: roughness is unpredictable
     }
-    rough.resize(num_rough);
-    smooth.resize(num_smooth);
-    sort_keys_pushed_in_index_order(rough, scratch);
+    keys.resize(count);
+    sort_keys_pushed_in_index_order(keys, scratch);
     int picked = 0;
-    for (auto it = rough.rbegin(); it != rough.rend() && picked < config.edges_per_sector; ++it) {
+    for (auto it = keys.rbegin(); it != keys.rend() && picked < config.edges_per_sector; ++it) {
+      if (roughness_bits(*it) < alpha_bits) break;  // all smoother than alpha from here
       const int i = index_of(*it);
-      if (blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
+      if (!(roughness[i] > config.alpha) || blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
       out.edges.push_back(i);
       block_neighbours(i);
       ++picked;
     }
-    sort_keys_pushed_in_index_order(smooth, scratch);
     picked = 0;
-    for (auto it = smooth.begin(); it != smooth.end() && picked < config.planars_per_sector; ++it) {
+    for (auto it = keys.begin(); it != keys.end() && picked < config.planars_per_sector; ++it) {
+      if (roughness_bits(*it) > alpha_bits) break;  // all rougher than alpha from here
       const int i = index_of(*it);
-      if (blocked[i]) continue;
+      if (!(roughness[i] < config.alpha) || blocked[i]) continue;
       out.planars.push_back(i);
       block_neighbours(i);
       ++picked;
