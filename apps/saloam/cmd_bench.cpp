@@ -10,6 +10,7 @@
 #include <iostream>
 #include <memory>
 #include <numeric>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -91,13 +92,21 @@ int run_bench(const BenchOptions& options) {
   progress.finish();
   if (wall_ms.empty()) return 130;
 
-  std::vector<double> features, deskew, registration, map;
-  for (const auto& t : odometry.timings()) {
-    features.push_back(t.features_ms);
-    deskew.push_back(t.deskew_downsample_ms);
-    registration.push_back(t.registration_ms);
-    map.push_back(t.map_update_ms);
-  }
+  struct StageTimes {
+    std::vector<double> features, deskew, registration, map;
+  };
+  auto stage_times = [](const std::vector<FrameTimings>& timings) {
+    StageTimes s;
+    for (const auto& t : timings) {
+      s.features.push_back(t.features_ms);
+      s.deskew.push_back(t.deskew_downsample_ms);
+      s.registration.push_back(t.registration_ms);
+      s.map.push_back(t.map_update_ms);
+    }
+    return s;
+  };
+  const StageTimes wall_stages = stage_times(odometry.timings());
+  const StageTimes cpu_stages = stage_times(odometry.cpu_timings());
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   const Summary total = summarize(wall_ms);
@@ -117,11 +126,22 @@ int run_bench(const BenchOptions& options) {
   }
   double load[3] = {0, 0, 0};
   if (getloadavg(load, 3) > 0) std::cout << fmt::format("load average {:.2f} (wall time suffers above the core count)\n", load[0]);
-  std::cout << "stage (wall)       median ms   mean ms    max ms\n";
-  for (const auto& [name, v] : {std::pair{"features", &features}, std::pair{"deskew+downsample", &deskew},
-                                std::pair{"registration", &registration}, std::pair{"map update", &map}}) {
-    const Summary s = summarize(*v);
-    std::cout << fmt::format("{:<18} {:>9.2f} {:>9.2f} {:>9.2f}\n", name, s.median, s.mean, s.max);
+  // With one thread the stage's CPU time is its cost, whatever else runs on the machine.
+  const bool cpu_columns = options.threads == 1;
+  std::cout << "stage (wall)       median ms   mean ms    max ms" << (cpu_columns ? "   cpu: median ms   mean ms" : "")
+            << "\n";
+  for (const auto& [name, wall, cpu] :
+       {std::tuple{"features", &wall_stages.features, &cpu_stages.features},
+        std::tuple{"deskew+downsample", &wall_stages.deskew, &cpu_stages.deskew},
+        std::tuple{"registration", &wall_stages.registration, &cpu_stages.registration},
+        std::tuple{"map update", &wall_stages.map, &cpu_stages.map}}) {
+    const Summary s = summarize(*wall);
+    std::cout << fmt::format("{:<18} {:>9.2f} {:>9.2f} {:>9.2f}", name, s.median, s.mean, s.max);
+    if (cpu_columns) {
+      const Summary c = summarize(*cpu);
+      std::cout << fmt::format("   {:>14.2f} {:>9.2f}", c.median, c.mean);
+    }
+    std::cout << "\n";
   }
   const double n = static_cast<double>(wall_ms.size());
   std::cout << fmt::format("per frame (mean): {:.0f} edge + {:.0f} planar features, local map {:.0f} edge + {:.0f} "

@@ -12,12 +12,34 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
+namespace {
+/// Rodrigues' formula for a unit axis, given the sine and cosine of the
+/// angle: the arithmetic of Eigen::AngleAxis::toRotationMatrix, so that
+/// se3_exp can share one sine and cosine between rotation and Jacobian.
+Eigen::Matrix3d rotation_from_axis_angle(const Eigen::Vector3d& axis, double sin_angle, double cos_angle) {
+  const Eigen::Vector3d sin_axis = sin_angle * axis;
+  const Eigen::Vector3d cos1_axis = (1.0 - cos_angle) * axis;
+  Eigen::Matrix3d R;
+  double tmp = cos1_axis.x() * axis.y();
+  R(0, 1) = tmp - sin_axis.z();
+  R(1, 0) = tmp + sin_axis.z();
+  tmp = cos1_axis.x() * axis.z();
+  R(0, 2) = tmp + sin_axis.y();
+  R(2, 0) = tmp - sin_axis.y();
+  tmp = cos1_axis.y() * axis.z();
+  R(1, 2) = tmp - sin_axis.x();
+  R(2, 1) = tmp + sin_axis.x();
+  R.diagonal() = cos1_axis.cwiseProduct(axis).array() + cos_angle;
+  return R;
+}
+}  // namespace
+
 Eigen::Matrix3d so3_exp(const Eigen::Vector3d& phi) {
   const double theta = phi.norm();
   if (theta < 1e-10) {
     return orthonormalize(Eigen::Matrix3d::Identity() + skew(phi));
   }
-  return Eigen::AngleAxisd(theta, phi / theta).toRotationMatrix();
+  return rotation_from_axis_angle(phi / theta, std::sin(theta), std::cos(theta));
 }
 
 Eigen::Vector3d so3_log(const Eigen::Matrix3d& R) {
@@ -33,19 +55,29 @@ Eigen::Vector3d so3_log(const Eigen::Matrix3d& R) {
 
 namespace {
 // Left Jacobian of SO(3) and its inverse, used to couple rotation and translation.
+// Below this angle the Jacobians use their series.
+constexpr double kSeriesAngle = 1e-6;
+
+/// The left Jacobian for theta = |phi| >= kSeriesAngle, given sin and cos of theta.
+Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi, double theta, double sin_theta, double cos_theta) {
+  const Eigen::Matrix3d K = skew(phi);
+  const double t2 = theta * theta;
+  return Eigen::Matrix3d::Identity() + (1.0 - cos_theta) / t2 * K + (theta - sin_theta) / (t2 * theta) * K * K;
+}
+
 Eigen::Matrix3d so3_left_jacobian(const Eigen::Vector3d& phi) {
   const double theta = phi.norm();
-  const Eigen::Matrix3d K = skew(phi);
-  if (theta < 1e-6) return Eigen::Matrix3d::Identity() + 0.5 * K + K * K / 6.0;
-  const double t2 = theta * theta;
-  return Eigen::Matrix3d::Identity() + (1.0 - std::cos(theta)) / t2 * K +
-         (theta - std::sin(theta)) / (t2 * theta) * K * K;
+  if (theta < kSeriesAngle) {
+    const Eigen::Matrix3d K = skew(phi);
+    return Eigen::Matrix3d::Identity() + 0.5 * K + K * K / 6.0;
+  }
+  return so3_left_jacobian(phi, theta, std::sin(theta), std::cos(theta));
 }
 
 Eigen::Matrix3d so3_left_jacobian_inverse(const Eigen::Vector3d& phi) {
   const double theta = phi.norm();
   const Eigen::Matrix3d K = skew(phi);
-  if (theta < 1e-6) return Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 12.0;
+  if (theta < kSeriesAngle) return Eigen::Matrix3d::Identity() - 0.5 * K + K * K / 12.0;
   const double half = 0.5 * theta;
   const double cot_half = std::cos(half) / std::sin(half);
   return Eigen::Matrix3d::Identity() - 0.5 * K +
@@ -57,8 +89,16 @@ Pose se3_exp(const Vector6d& xi) {
   const Eigen::Vector3d rho = xi.head<3>();
   const Eigen::Vector3d phi = xi.tail<3>();
   Pose T = Pose::Identity();
-  T.linear() = so3_exp(phi);
-  T.translation() = so3_left_jacobian(phi) * rho;
+  const double theta = phi.norm();
+  if (theta < kSeriesAngle) {
+    T.linear() = so3_exp(phi);
+    T.translation() = so3_left_jacobian(phi) * rho;
+    return T;
+  }
+  // One sine and cosine for both (de-skewing calls this for every point).
+  const double sin_theta = std::sin(theta), cos_theta = std::cos(theta);
+  T.linear() = rotation_from_axis_angle(phi / theta, sin_theta, cos_theta);
+  T.translation() = so3_left_jacobian(phi, theta, sin_theta, cos_theta) * rho;
   return T;
 }
 

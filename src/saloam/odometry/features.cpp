@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 
@@ -73,12 +74,31 @@ int ring_from_elevation(double elevation_deg, BeamLayout layout) {
   return -1;
 }
 
+namespace {
+/// sweep_time_from_azimuth with the start angle converted once per scan.
+class SweepClock {
+ public:
+  explicit SweepClock(const FeatureConfig& config)
+      : start_(config.sweep_start_azimuth_deg * M_PI / 180.0),
+        clockwise_(config.sweep_clockwise),
+        duration_(config.sweep_duration) {}
+  [[nodiscard]] double time(double azimuth_rad) const {
+    double turned = clockwise_ ? start_ - azimuth_rad : azimuth_rad - start_;
+    // fmod returns its argument unchanged below one turn, the usual case.
+    if (std::abs(turned) >= 2.0 * M_PI) turned = std::fmod(turned, 2.0 * M_PI);
+    if (turned < 0.0) turned += 2.0 * M_PI;
+    return turned / (2.0 * M_PI) * duration_;
+  }
+
+ private:
+  double start_;  ///< [rad]
+  bool clockwise_;
+  double duration_;  ///< [s]
+};
+}  // namespace
+
 double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config) {
-  const double start = config.sweep_start_azimuth_deg * M_PI / 180.0;
-  double turned = config.sweep_clockwise ? start - azimuth_rad : azimuth_rad - start;
-  turned = std::fmod(turned, 2.0 * M_PI);
-  if (turned < 0.0) turned += 2.0 * M_PI;
-  return turned / (2.0 * M_PI) * config.sweep_duration;
+  return SweepClock(config).time(azimuth_rad);
 }
 
 std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int half_window) {
@@ -96,8 +116,28 @@ std::vector<double> ring_roughness(const std::vector<Eigen::Vector3d>& ring, int
   return c;
 }
 
-PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window, double min_range,
-                            double max_range) {
+namespace {
+/// sqrt(squared) > limit (limit > 0), without the square root when the
+/// squared value is clearly below limit^2 (the usual case): the result is
+/// the same as comparing the rounded square root.
+bool exceeds(double squared, double limit) {
+  if (squared < 0.99 * limit * limit) return false;
+  return std::sqrt(squared) > limit;
+}
+}  // namespace
+
+namespace {
+/// Squared distances between ring neighbours: gap_sq[i] = |X_{i+1} - X_i|^2
+/// (the last is 0). The tests for unreliable points and the suppression of
+/// selected points' neighbours both read them.
+std::vector<double> squared_gaps(const std::vector<Eigen::Vector3d>& ring) {
+  std::vector<double> gap_sq(ring.size(), 0.0);
+  for (std::size_t i = 0; i + 1 < ring.size(); ++i) gap_sq[i] = (ring[i + 1] - ring[i]).squaredNorm();
+  return gap_sq;
+}
+
+PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, const std::vector<double>& gap_sq,
+                            int half_window, double min_range, double max_range) {
   const int n = static_cast<int>(ring.size());
   PointMask bad(ring.size(), 0);
   std::vector<double> range(ring.size());
@@ -106,11 +146,10 @@ PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_w
     if (range[i] < min_range || range[i] > max_range) bad[i] = 1;
   }
   for (int i = 0; i + 1 < n; ++i) {
-    const double gap = (ring[i + 1] - ring[i]).norm();
     // Neighbouring returns far apart relative to their range: either a depth
     // jump (occlusion) or a hole in azimuth. Angular step of the HDL-64E is
     // ~0.17 deg (3e-3 rad); 0.3 m at 10 m is ~10 steps.
-    if (gap > 0.03 * std::max(range[i], 1.0) + 0.1) {
+    if (exceeds(gap_sq[i], 0.03 * std::max(range[i], 1.0) + 0.1)) {
       const double near = std::min(range[i], range[i + 1]);
       const bool depth_jump = std::abs(range[i] - range[i + 1]) > 0.1 * near + 0.1;
       if (depth_jump) {
@@ -133,19 +172,48 @@ PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_w
   // to the range (LOAM's 0.0002 * range^2 on the squared gap).
   for (int i = 1; i + 1 < n; ++i) {
     const double limit = 0.0002 * range[i] * range[i];
-    if ((ring[i] - ring[i - 1]).squaredNorm() > limit && (ring[i + 1] - ring[i]).squaredNorm() > limit) {
-      bad[i] = 1;
-    }
+    if (gap_sq[i - 1] > limit && gap_sq[i] > limit) bad[i] = 1;
   }
   return bad;
 }
+}  // namespace
 
-RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
-                                   const std::vector<double>& roughness,
+PointMask unreliable_points(const std::vector<Eigen::Vector3d>& ring, int half_window, double min_range,
+                            double max_range) {
+  return unreliable_points(ring, squared_gaps(ring), half_window, min_range, max_range);
+}
+
+namespace {
+/// Sorts keys (32-bit sort value above a 32-bit index) that were pushed in
+/// increasing index order: a stable radix sort on the upper half, one pass per
+/// byte that is not the same in every key, keeps equal values in index order
+/// and so gives the same order as a comparison sort of the whole keys, in
+/// linear time (a sector's few hundred keys sort several times faster).
+void sort_keys_pushed_in_index_order(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& scratch) {
+  if (keys.size() < 2) return;
+  constexpr int kFirstByte = 4, kBytes = 8;
+  std::array<std::array<std::uint32_t, 256>, kBytes - kFirstByte> counts{};
+  for (const std::uint64_t k : keys) {
+    for (int b = kFirstByte; b < kBytes; ++b) ++counts[b - kFirstByte][(k >> (8 * b)) & 0xff];
+  }
+  scratch.resize(keys.size());
+  for (int b = kFirstByte; b < kBytes; ++b) {
+    auto& count = counts[b - kFirstByte];
+    if (count[(keys.front() >> (8 * b)) & 0xff] == keys.size()) continue;  // one bucket: nothing moves
+    std::uint32_t offset = 0;
+    for (auto& c : count) offset += std::exchange(c, offset);
+    for (const std::uint64_t k : keys) scratch[count[(k >> (8 * b)) & 0xff]++] = k;
+    keys.swap(scratch);
+  }
+}
+}  // namespace
+
+namespace {
+RingSelection select_ring_features(const std::vector<double>& gap_sq, const std::vector<double>& roughness,
                                    const PointMask& unreliable, const FeatureConfig& config,
                                    const PointMask& not_edge) {
   RingSelection out;
-  const int n = static_cast<int>(ring.size());
+  const int n = static_cast<int>(gap_sq.size());
   const int w = config.roughness_half_window;
   if (n < 2 * w + 1) return out;
   PointMask blocked(unreliable);
@@ -160,15 +228,15 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
         const int j = i + step * k;
         const int prev = j - step;
         if (j < 0 || j >= n) break;
-        if ((ring[j] - ring[prev]).squaredNorm() > 0.05) break;
+        if (gap_sq[std::min(j, prev)] > 0.05) break;
         blocked[j] = 1;
       }
     }
   };
   // Sort keys: the roughness as float bits (order-preserving for
-  // non-negative values) above the index, so that a plain integer sort
-  // orders by roughness, ties by position; about twice as fast as sorting
-  // (double, int) pairs, and the ring's features are the same.
+  // non-negative values) above the index: ascending keys order by roughness,
+  // ties by position, and the ring's features are the same as with a
+  // comparison sort on (roughness, index).
   auto key = [](double c, int i) {
     std::uint32_t bits = 0;
     const float f = static_cast<float>(c);
@@ -176,41 +244,54 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
     return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(i);
   };
   auto index_of = [](std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); };
-  // Edges come from the roughest down to alpha, planar points from the
-  // smoothest up to alpha: two sorts of the two sides are cheaper than one of
-  // the sector, and visit the same keys in the same order.
-  std::vector<std::uint64_t> rough, smooth;
+  // One sort of the sector's usable points serves both kinds: edges are
+  // taken from its rough end down, planar points from its smooth end up.
+  // Rounding to float keeps the order, so only keys whose float equals
+  // alpha's can be on either side, and the loops test each key's roughness.
+  const std::uint64_t alpha_bits = key(config.alpha, 0) >> 32;
+  auto roughness_bits = [](std::uint64_t k) { return k >> 32; };
+  std::vector<std::uint64_t> keys, scratch;
   for (int s = 0; s < sectors; ++s) {
     const int begin = first + (last - first) * s / sectors;
     const int end = first + (last - first) * (s + 1) / sectors;
     if (end <= begin) continue;
-    rough.clear();
-    smooth.clear();
+    keys.resize(static_cast<std::size_t>(end - begin));
+    std::size_t count = 0;
     for (int i = begin; i < end; ++i) {
-      if (blocked[i] || !std::isfinite(roughness[i])) continue;
-      if (roughness[i] > config.alpha) rough.push_back(key(roughness[i], i));
-      if (roughness[i] < config.alpha) smooth.push_back(key(roughness[i], i));
+      const double c = roughness[i];
+      keys[count] = key(c, i);
+      count += !blocked[i] && std::isfinite(c) && c != config.alpha;  // no branch: roughness is unpredictable
     }
-    std::sort(rough.begin(), rough.end(), std::greater<>{});
+    keys.resize(count);
+    sort_keys_pushed_in_index_order(keys, scratch);
     int picked = 0;
-    for (auto it = rough.begin(); it != rough.end() && picked < config.edges_per_sector; ++it) {
+    for (auto it = keys.rbegin(); it != keys.rend() && picked < config.edges_per_sector; ++it) {
+      if (roughness_bits(*it) < alpha_bits) break;  // all smoother than alpha from here
       const int i = index_of(*it);
-      if (blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
+      if (!(roughness[i] > config.alpha) || blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
       out.edges.push_back(i);
       block_neighbours(i);
       ++picked;
     }
-    std::sort(smooth.begin(), smooth.end());
     picked = 0;
-    for (auto it = smooth.begin(); it != smooth.end() && picked < config.planars_per_sector; ++it) {
+    for (auto it = keys.begin(); it != keys.end() && picked < config.planars_per_sector; ++it) {
+      if (roughness_bits(*it) > alpha_bits) break;  // all rougher than alpha from here
       const int i = index_of(*it);
-      if (blocked[i]) continue;
+      if (!(roughness[i] < config.alpha) || blocked[i]) continue;
       out.planars.push_back(i);
       block_neighbours(i);
       ++picked;
     }
   }
   return out;
+}
+}  // namespace
+
+RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
+                                   const std::vector<double>& roughness,
+                                   const PointMask& unreliable, const FeatureConfig& config,
+                                   const PointMask& not_edge) {
+  return select_ring_features(squared_gaps(ring), roughness, unreliable, config, not_edge);
 }
 
 namespace {
@@ -237,23 +318,33 @@ ClassIndex class_group(ClassIndex c) {
   return c < table.size() ? table[c] : c;
 }
 
-int odometry_class(std::uint16_t raw_label) {
-  // Raw ids are below 260; a table avoids the class-table search per point.
-  static const std::array<std::int8_t, 512> table = [] {
-    std::array<std::int8_t, 512> t{};
+namespace {
+/// odometry_class of the raw labels below 512 (raw ids are below 260): a
+/// table avoids the class-table search per point.
+using OdometryClassTable = std::array<std::int8_t, 512>;
+const OdometryClassTable& odometry_class_table() {
+  static const OdometryClassTable table = [] {
+    OdometryClassTable t{};
     for (std::size_t id = 0; id < t.size(); ++id) t[id] = static_cast<std::int8_t>(compute_odometry_class(static_cast<std::uint16_t>(id)));
     return t;
   }();
+  return table;
+}
+int odometry_class(const OdometryClassTable& table, std::uint16_t raw_label) {
   return raw_label < table.size() ? table[raw_label] : compute_odometry_class(raw_label);
 }
+}  // namespace
+
+int odometry_class(std::uint16_t raw_label) { return odometry_class(odometry_class_table(), raw_label); }
 
 namespace {
 std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config) {
   std::vector<float> times(cloud.size(), -1.0f);  // -1: on the sensor axis, unusable
+  const SweepClock clock(config);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const Eigen::Vector3f& p = cloud.points[i];
     if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) continue;
-    times[i] = static_cast<float>(sweep_time_from_azimuth(std::atan2(p.y(), p.x()), config));
+    times[i] = static_cast<float>(clock.time(std::atan2(p.y(), p.x())));
   }
   return times;
 }
@@ -310,17 +401,18 @@ std::vector<std::vector<std::uint32_t>> split_rings(const std::vector<float>& ph
 std::vector<float> storage_phase(const std::vector<float>& sweep_phase) {
   constexpr float kSmallStep = 5.0f / 360.0f;
   std::size_t along = 0, against = 0;
-  float first = -1.0f, previous = -1.0f;
-  for (const float p : sweep_phase) {
+  const auto valid = std::find_if(sweep_phase.begin(), sweep_phase.end(), [](float p) { return p >= 0.0f; });
+  if (valid == sweep_phase.end()) return {};
+  const float first = *valid;
+  float previous = first;
+  for (auto it = valid + 1; it != sweep_phase.end(); ++it) {
+    const float p = *it;
     if (p < 0.0f) continue;
-    if (first < 0.0f) first = p;
-    if (previous >= 0.0f) {
-      float step = p - previous;
-      if (step > 0.5f) step -= 1.0f;
-      if (step < -0.5f) step += 1.0f;
-      along += step > 0.0f && step < kSmallStep;
-      against += step < 0.0f && step > -kSmallStep;
-    }
+    float step = p - previous;
+    if (step > 0.5f) step -= 1.0f;
+    if (step < -0.5f) step += 1.0f;
+    along += step > 0.0f && step < kSmallStep;
+    against += step < 0.0f && step > -kSmallStep;
     previous = p;
   }
   const std::size_t steps = along + against;
@@ -364,61 +456,68 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
   return rings_from_storage(point_sweep_times(cloud, config), config, expected_rings);
 }
 
-ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
-                              bool parallel) {
-  ScanFeatures out;
+namespace {
+/// Rings from the elevation angle (for scans not stored ring by ring), each
+/// ordered in time so that ring neighbours are neighbours in azimuth.
+std::vector<std::vector<std::uint32_t>> rings_from_elevation(const LabelledCloud& cloud,
+                                                             const std::vector<float>& times,
+                                                             const FeatureConfig& config) {
   struct Entry {
     float time;
     std::uint32_t index;
   };
-  std::vector<std::vector<Entry>> buckets;
-  // Rings from the point order when the scan is stored ring by ring (exact
-  // even for scans whose points were moved by motion compensation), else from
-  // the elevation angle.
-  const std::vector<float> times = point_sweep_times(cloud, config);
-  auto ordered = config.ring_from_point_order ? rings_from_storage(times, config, config.num_beams)
-                                              : std::vector<std::vector<std::uint32_t>>{};
-  if (!ordered.empty()) {
-    buckets.resize(ordered.size());
-    for (std::size_t r = 0; r < ordered.size(); ++r) {
-      buckets[r].reserve(ordered[r].size());
-      for (const auto i : ordered[r]) buckets[r].push_back({times[i], i});
-    }
-  } else {
-    const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
-    const int num_rings = ring_count(layout);
-    buckets.resize(num_rings);
-    for (auto& b : buckets) b.reserve(cloud.size() / num_rings * 2);
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const Eigen::Vector3f& p = cloud.points[i];
-      if (times[i] < 0.0f) continue;
-      const double horizontal = std::hypot(p.x(), p.y());
-      const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
-      if (ring < 0) continue;
-      buckets[ring].push_back({times[i], static_cast<std::uint32_t>(i)});
-    }
-    // Order each ring in time so that ring neighbours are neighbours in azimuth.
-    for (auto& bucket : buckets) {
-      std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
-    }
+  const BeamLayout layout = detect_beam_layout(cloud.points, config.num_beams);
+  const int num_rings = ring_count(layout);
+  std::vector<std::vector<Entry>> buckets(num_rings);
+  for (auto& b : buckets) b.reserve(cloud.size() / num_rings * 2);
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (times[i] < 0.0f) continue;
+    const double horizontal = std::hypot(p.x(), p.y());
+    const int ring = ring_from_elevation(std::atan2(p.z(), horizontal) * 180.0 / M_PI, layout);
+    if (ring < 0) continue;
+    buckets[ring].push_back({times[i], static_cast<std::uint32_t>(i)});
   }
+  std::vector<std::vector<std::uint32_t>> rings(buckets.size());
+  for (std::size_t r = 0; r < buckets.size(); ++r) {
+    auto& bucket = buckets[r];
+    std::sort(bucket.begin(), bucket.end(), [](const Entry& a, const Entry& b) { return a.time < b.time; });
+    rings[r].reserve(bucket.size());
+    for (const Entry& e : bucket) rings[r].push_back(e.index);
+  }
+  return rings;
+}
+}  // namespace
+
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
+                              bool parallel) {
+  ScanFeatures out;
+  // Rings (point indices in azimuth order) from the point order when the scan
+  // is stored ring by ring (exact even for scans whose points were moved by
+  // motion compensation), else from the elevation angle.
+  const std::vector<float> times = point_sweep_times(cloud, config);
+  std::vector<std::vector<std::uint32_t>> rings;
+  if (config.ring_from_point_order) rings = rings_from_storage(times, config, config.num_beams);
+  if (rings.empty()) rings = rings_from_elevation(cloud, times, config);
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.
-  std::vector<ScanFeatures> per_ring(buckets.size());
+  std::vector<ScanFeatures> per_ring(rings.size());
+  const OdometryClassTable& class_table = odometry_class_table();
   auto process_ring = [&](std::size_t r) {
-    const auto& bucket = buckets[r];
-    std::vector<Eigen::Vector3d> ring_points(bucket.size());
-    for (std::size_t k = 0; k < bucket.size(); ++k) ring_points[k] = cloud.points[bucket[k].index].cast<double>();
+    const auto& ring = rings[r];
+    std::vector<Eigen::Vector3d> ring_points(ring.size());
+    for (std::size_t k = 0; k < ring.size(); ++k) ring_points[k] = cloud.points[ring[k]].cast<double>();
     const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
+    const auto gap_sq = squared_gaps(ring_points);
     auto unreliable =
-        unreliable_points(ring_points, config.roughness_half_window, config.min_range, config.max_range);
+        unreliable_points(ring_points, gap_sq, config.roughness_half_window, config.min_range, config.max_range);
     PointMask not_edge;
     if (use_labels) {  // unusable classes must not take a sector's feature slots
       const bool ground_threshold = config.ground_edge_alpha > config.alpha;
-      if (ground_threshold) not_edge.assign(bucket.size(), 0);
-      for (std::size_t k = 0; k < bucket.size(); ++k) {
-        const std::uint16_t label = cloud.label[bucket[k].index];
-        if (odometry_class(label) < 0) unreliable[k] = 1;
+      if (ground_threshold) not_edge.assign(ring.size(), 0);
+      for (std::size_t k = 0; k < ring.size(); ++k) {
+        const std::uint16_t label = cloud.label[ring[k]];
+        unreliable[k] |= odometry_class(class_table, label) < 0;
         // Only points rough enough to be edges at all need the class lookup.
         if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
             is_ground(static_class(label))) {
@@ -426,25 +525,25 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
         }
       }
     }
-    const auto selection = select_ring_features(ring_points, roughness, unreliable, config, not_edge);
+    const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
     auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
       for (const int k : indices) {
-        const auto& e = bucket[k];
+        const std::uint32_t i = ring[k];
         int c = 0;
         if (use_labels) {
-          c = odometry_class(cloud.label[e.index]);
+          c = odometry_class(class_table, cloud.label[i]);
           if (c < 0) continue;
         }
-        target.push_back(ring_points[k], static_cast<ClassIndex>(c), e.time);
+        target.push_back(ring_points[k], static_cast<ClassIndex>(c), times[i]);
       }
     };
     emit(selection.edges, per_ring[r].edges);
     emit(selection.planars, per_ring[r].planars);
   };
   if (parallel) {
-    tbb::parallel_for(std::size_t{0}, buckets.size(), process_ring);
+    tbb::parallel_for(std::size_t{0}, rings.size(), process_ring);
   } else {
-    for (std::size_t r = 0; r < buckets.size(); ++r) process_ring(r);
+    for (std::size_t r = 0; r < rings.size(); ++r) process_ring(r);
   }
   auto append = [](FeatureCloud& to, const FeatureCloud& from) {
     to.points.insert(to.points.end(), from.points.begin(), from.points.end());

@@ -1,5 +1,7 @@
 #include "saloam/odometry/semantic_odometry.hpp"
 
+#include <time.h>
+
 #include <algorithm>
 #include <chrono>
 #include <thread>
@@ -29,6 +31,12 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
+double thread_cpu_ms() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
+}
+
 }  // namespace
 
 SemanticOdometry::SemanticOdometry(OdometryConfig config)
@@ -52,22 +60,27 @@ Pose SemanticOdometry::register_frame(const LabelledCloud& cloud, double timesta
 }
 
 Pose SemanticOdometry::process(const LabelledCloud& cloud, double timestamp) {
-  FrameTimings timing;
-  auto lap = [start = Clock::now()]() mutable {
+  FrameTimings timing, cpu;
+  // Stage times, wall-clock and CPU: each lap returns the wall time since the
+  // last and stores the CPU time since the last in `*cpu_stage`.
+  auto lap = [start = Clock::now(), cpu_start = thread_cpu_ms()](double* cpu_stage) mutable {
     const double ms = ms_since(start);
+    const double cpu_now = thread_cpu_ms();
+    *cpu_stage = cpu_now - cpu_start;
     start = Clock::now();
+    cpu_start = cpu_now;
     return ms;
   };
   ScanFeatures measured = extract_frame_features(cloud);
-  timing.features_ms = lap();
+  timing.features_ms = lap(&cpu.features_ms);
   const MotionPrediction prediction = predict_motion(timestamp);
   ScanFeatures features = downsample_and_deskew(measured, prediction);
-  timing.deskew_downsample_ms = lap();
+  timing.deskew_downsample_ms = lap(&cpu.deskew_downsample_ms);
   const Pose sweep_pose = align(features, measured, prediction);
-  timing.registration_ms = lap();
+  timing.registration_ms = lap(&cpu.registration_ms);
   update_map(features, sweep_pose);
-  timing.map_update_ms = lap();
-  return record_frame(std::move(features), sweep_pose, timestamp, timing);
+  timing.map_update_ms = lap(&cpu.map_update_ms);
+  return record_frame(std::move(features), sweep_pose, timestamp, timing, cpu);
 }
 
 ScanFeatures SemanticOdometry::extract_frame_features(const LabelledCloud& cloud) const {
@@ -189,13 +202,14 @@ void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& swee
 }
 
 Pose SemanticOdometry::record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp,
-                                    const FrameTimings& timing) {
+                                    const FrameTimings& timing, const FrameTimings& cpu_timing) {
   const std::size_t k = sweep_poses_.size();
   const double period = k >= 1 && timestamp - timestamps_[k - 1] > 1e-6 ? timestamp - timestamps_[k - 1]
                                                                          : config_.features.sweep_duration;
   sweep_poses_.push_back(sweep_pose);
   timestamps_.push_back(timestamp);
   timings_.push_back(timing);
+  cpu_timings_.push_back(cpu_timing);
 
   // Reported pose at `pose_time_in_sweep`: P_k = C * M_k * exp(-a * xi_k) with
   // M_k the mid-sweep pose, xi_k its frame motion and a = (mid - t_pose) / period.

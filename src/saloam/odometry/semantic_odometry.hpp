@@ -21,7 +21,8 @@
 
 namespace saloam {
 
-/// Wall-clock time of each stage of one frame [ms].
+/// Time of each stage of one frame [ms]: wall-clock, or CPU time of the
+/// calling thread (the stage's cost when the odometry runs on one thread).
 struct FrameTimings {
   double features_ms = 0.0;
   double deskew_downsample_ms = 0.0;
@@ -56,6 +57,8 @@ class SemanticOdometry {
   [[nodiscard]] const std::vector<Pose>& poses() const { return poses_; }
   [[nodiscard]] const std::vector<double>& timestamps() const { return timestamps_; }
   [[nodiscard]] const std::vector<FrameTimings>& timings() const { return timings_; }
+  /// Thread CPU time per stage (with more than one thread, the workers' time is not counted).
+  [[nodiscard]] const std::vector<FrameTimings>& cpu_timings() const { return cpu_timings_; }
   [[nodiscard]] const FrameStats& last_frame_stats() const { return last_stats_; }
   [[nodiscard]] const SemanticLocalMap& local_map() const { return map_; }
   /// Features of the last frame (downsampled, de-skewed, classes grouped as
@@ -86,7 +89,8 @@ class SemanticOdometry {
   Pose align(ScanFeatures& features, ScanFeatures& measured, const MotionPrediction& prediction);
   void update_map(const ScanFeatures& features, const Pose& sweep_pose);
   /// Stores the frame and returns its pose at the pose instant.
-  Pose record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp, const FrameTimings& timing);
+  Pose record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp, const FrameTimings& timing,
+                    const FrameTimings& cpu_timing);
 
   OdometryConfig config_;
   RegistrationSettings settings_;
@@ -98,6 +102,7 @@ class SemanticOdometry {
   Pose world_from_first_sweep_ = Pose::Identity();
   std::vector<double> timestamps_;
   std::vector<FrameTimings> timings_;
+  std::vector<FrameTimings> cpu_timings_;
   FrameStats last_stats_;
   ScanFeatures last_features_;
   std::optional<ScanFeatures> revised_first_;
