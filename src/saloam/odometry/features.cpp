@@ -10,6 +10,7 @@
 #include <numeric>
 #include <utility>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "saloam/core/semantic_classes.hpp"
@@ -338,13 +339,23 @@ int odometry_class(const OdometryClassTable& table, std::uint16_t raw_label) {
 int odometry_class(std::uint16_t raw_label) { return odometry_class(odometry_class_table(), raw_label); }
 
 namespace {
-std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config) {
+/// Each point's time in the sweep from its azimuth; points are independent,
+/// so with `parallel` blocks of them go to the threads (same output).
+std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config, bool parallel) {
   std::vector<float> times(cloud.size(), -1.0f);  // -1: on the sensor axis, unusable
   const SweepClock clock(config);
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f& p = cloud.points[i];
-    if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) continue;
-    times[i] = static_cast<float>(clock.time(std::atan2(p.y(), p.x())));
+  auto block = [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t i = range.begin(); i < range.end(); ++i) {
+      const Eigen::Vector3f& p = cloud.points[i];
+      if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) continue;
+      times[i] = static_cast<float>(clock.time(std::atan2(p.y(), p.x())));
+    }
+  };
+  const tbb::blocked_range<std::size_t> all(0, cloud.size(), 4096);
+  if (parallel) {
+    tbb::parallel_for(all, block);
+  } else {
+    block(all);
   }
   return times;
 }
@@ -453,7 +464,7 @@ std::vector<std::vector<std::uint32_t>> rings_from_storage(const std::vector<flo
 
 std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
                                                               const FeatureConfig& config, int expected_rings) {
-  return rings_from_storage(point_sweep_times(cloud, config), config, expected_rings);
+  return rings_from_storage(point_sweep_times(cloud, config, false), config, expected_rings);
 }
 
 namespace {
@@ -495,7 +506,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // Rings (point indices in azimuth order) from the point order when the scan
   // is stored ring by ring (exact even for scans whose points were moved by
   // motion compensation), else from the elevation angle.
-  const std::vector<float> times = point_sweep_times(cloud, config);
+  const std::vector<float> times = point_sweep_times(cloud, config, parallel);
   std::vector<std::vector<std::uint32_t>> rings;
   if (config.ring_from_point_order) rings = rings_from_storage(times, config, config.num_beams);
   if (rings.empty()) rings = rings_from_elevation(cloud, times, config);
