@@ -333,20 +333,17 @@ class World::GroundMarch {
   // gets in the tile. Over flat streets and open land that skips every tile
   // up to the one where the ray comes down.
   double first_contact() const {
-    const World& w = world_;
-    const double tile = World::kRiseTile * w.options_.ground_cell;
-    const Eigen::Vector3d p = o_ + t_ * d_;
-    const double ux = (p.x() - w.origin_.x()) / tile, uy = (p.y() - w.origin_.y()) / tile;
-    int tx = static_cast<int>(std::floor(ux)), ty = static_cast<int>(std::floor(uy));
+    const TilePosition here = tile_here();
+    const double tile = tile_size();
+    int tx = here.x, ty = here.y;
     // Ranges at which the ray leaves the current tile column / row (2D DDA).
     const double dt_x = std::abs(d_.x()) > 1e-12 ? tile / std::abs(d_.x()) : kInf;
     const double dt_y = std::abs(d_.y()) > 1e-12 ? tile / std::abs(d_.y()) : kInf;
-    double next_x = t_ + (d_.x() >= 0 ? tx + 1 - ux : ux - tx) * dt_x;
-    double next_y = t_ + (d_.y() >= 0 ? ty + 1 - uy : uy - ty) * dt_y;
+    double next_x = t_ + (d_.x() >= 0 ? tx + 1 - here.ux : here.ux - tx) * dt_x;
+    double next_y = t_ + (d_.y() >= 0 ? ty + 1 - here.uy : here.uy - ty) * dt_y;
     double t = t_;
-    while (t < max_t_ && tx >= 0 && ty >= 0 && tx < w.rise_nx_ && ty < w.rise_ny_) {
-      const double top = w.ground_top_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(w.rise_nx_) +
-                                       static_cast<std::size_t>(tx)];
+    while (t < max_t_ && in_tiles(tx, ty)) {
+      const double top = world_.ground_top_[tile_index(tx, ty)];
       const double exit = std::min({next_x, next_y, max_t_});
       const double lowest = o_.z() + (d_.z() < 0.0 ? exit : t) * d_.z();  // the ray's lowest point in the tile
       if (lowest <= top) {
@@ -371,21 +368,35 @@ class World::GroundMarch {
   // sloping ground then reach it, or leave it, in a few long steps.
   double clear_step(double f) const {
     if (f <= World::kGroundStep) return 0.0;
-    const World& w = world_;
-    const double tile = World::kRiseTile * w.options_.ground_cell;
-    const Eigen::Vector3d p = o_ + t_ * d_;
-    const double ux = (p.x() - w.origin_.x()) / tile, uy = (p.y() - w.origin_.y()) / tile;
-    const int tx = static_cast<int>(std::floor(ux)), ty = static_cast<int>(std::floor(uy));
-    if (tx < 0 || ty < 0 || tx >= w.rise_nx_ || ty >= w.rise_ny_) return 0.0;
-    const double rise = w.ground_rise_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(w.rise_nx_) +
-                                       static_cast<std::size_t>(tx)];
+    const TilePosition here = tile_here();
+    const double tile = tile_size();
+    const int tx = here.x, ty = here.y;
+    if (!in_tiles(tx, ty)) return 0.0;
+    const double rise = world_.ground_rise_[tile_index(tx, ty)];
     // Distance along the ray to the tile's edge.
     double exit = max_t_;
-    if (std::abs(d_.x()) > 1e-12) exit = std::min(exit, ((d_.x() > 0 ? tx + 1 - ux : ux - tx) * tile) / std::abs(d_.x()));
-    if (std::abs(d_.y()) > 1e-12) exit = std::min(exit, ((d_.y() > 0 ? ty + 1 - uy : uy - ty) * tile) / std::abs(d_.y()));
+    if (std::abs(d_.x()) > 1e-12) exit = std::min(exit, ((d_.x() > 0 ? tx + 1 - here.ux : here.ux - tx) * tile) / std::abs(d_.x()));
+    if (std::abs(d_.y()) > 1e-12) exit = std::min(exit, ((d_.y() > 0 ? ty + 1 - here.uy : here.uy - ty) * tile) / std::abs(d_.y()));
     const double closing = rise * d_xy_ - d_.z();
     const double clear = closing > 0.0 ? 0.9 * (f - World::kGroundStep) / closing : max_t_;
     return std::min(clear, exit);
+  }
+  // The rise tiles (World::ground_rise_, World::ground_top_): the ray's
+  // point at t_ in tile units and the tile it lies in.
+  struct TilePosition {
+    double ux, uy;
+    int x, y;
+  };
+  double tile_size() const { return World::kRiseTile * world_.options_.ground_cell; }
+  TilePosition tile_here() const {
+    const double tile = tile_size();
+    const Eigen::Vector3d p = o_ + t_ * d_;
+    const double ux = (p.x() - world_.origin_.x()) / tile, uy = (p.y() - world_.origin_.y()) / tile;
+    return {ux, uy, static_cast<int>(std::floor(ux)), static_cast<int>(std::floor(uy))};
+  }
+  bool in_tiles(int x, int y) const { return x >= 0 && y >= 0 && x < world_.rise_nx_ && y < world_.rise_ny_; }
+  std::size_t tile_index(int x, int y) const {
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(world_.rise_nx_) + static_cast<std::size_t>(x);
   }
   // Illinois variant of regula falsi on [t_prev (above), t (below)].
   double refine(double f_below) const {
