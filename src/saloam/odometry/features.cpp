@@ -10,10 +10,9 @@
 #include <numeric>
 #include <utility>
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/odometry/parallel.hpp"
 
 namespace saloam {
 
@@ -344,19 +343,11 @@ namespace {
 std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config, bool parallel) {
   std::vector<float> times(cloud.size(), -1.0f);  // -1: on the sensor axis, unusable
   const SweepClock clock(config);
-  auto block = [&](const tbb::blocked_range<std::size_t>& range) {
-    for (std::size_t i = range.begin(); i < range.end(); ++i) {
-      const Eigen::Vector3f& p = cloud.points[i];
-      if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) continue;
-      times[i] = static_cast<float>(clock.time(std::atan2(p.y(), p.x())));
-    }
-  };
-  const tbb::blocked_range<std::size_t> all(0, cloud.size(), 4096);
-  if (parallel) {
-    tbb::parallel_for(all, block);
-  } else {
-    block(all);
-  }
+  for_each_index(cloud.size(), parallel, 4096, [&](std::size_t i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (std::abs(p.x()) + std::abs(p.y()) < 1e-3f) return;
+    times[i] = static_cast<float>(clock.time(std::atan2(p.y(), p.x())));
+  });
   return times;
 }
 
@@ -551,11 +542,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
     emit(selection.edges, per_ring[r].edges);
     emit(selection.planars, per_ring[r].planars);
   };
-  if (parallel) {
-    tbb::parallel_for(std::size_t{0}, rings.size(), process_ring);
-  } else {
-    for (std::size_t r = 0; r < rings.size(); ++r) process_ring(r);
-  }
+  for_each_index(rings.size(), parallel, 1, process_ring);
   auto append = [](FeatureCloud& to, const FeatureCloud& from) {
     to.points.insert(to.points.end(), from.points.begin(), from.points.end());
     to.classes.insert(to.classes.end(), from.classes.begin(), from.classes.end());

@@ -4,9 +4,9 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
-#include <tbb/parallel_for.h>
 
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/odometry/parallel.hpp"
 
 namespace saloam {
 
@@ -44,17 +44,6 @@ struct PlaneMatch {
   bool valid = false;
   bool rejected_by_constraint = false;
 };
-
-template <class Body>
-void for_each_index(std::size_t n, bool parallel, Body&& body) {
-  if (parallel && n > 256) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 128), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t i = r.begin(); i != r.end(); ++i) body(i);
-    });
-  } else {
-    for (std::size_t i = 0; i < n; ++i) body(i);
-  }
-}
 
 // Gathers the k nearest neighbours of q among the map points of class c;
 // false unless all k lie within the correspondence distance.
@@ -107,7 +96,7 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
                std::vector<PlaneMatch>& plane_matches, RegistrationResult& result) {
   const int ne = std::min(settings.edge_neighbours, kMaxNeighbours);
   const int np = std::min(settings.planar_neighbours, kMaxNeighbours);
-  for_each_index(edges.size(), settings.parallel, [&](std::size_t i) {
+  for_each_index(edges.size(), settings.parallel, 128, [&](std::size_t i) {
     std::array<Eigen::Vector3d, kMaxNeighbours> nb;
     EdgeMatch m;
     const Eigen::Vector3d q = T * edges.points[i];
@@ -119,7 +108,7 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
     }
     edge_matches[i] = m;
   });
-  for_each_index(planars.size(), settings.parallel, [&](std::size_t i) {
+  for_each_index(planars.size(), settings.parallel, 128, [&](std::size_t i) {
     std::array<Eigen::Vector3d, kMaxNeighbours> nb;
     PlaneMatch m;
     const Eigen::Vector3d q = T * planars.points[i];
