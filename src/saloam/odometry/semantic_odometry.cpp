@@ -24,6 +24,13 @@ constexpr double kRedeskewRotation = 0.1 * M_PI / 180;  // [rad per frame]
 // every loop against frame 0 would inherit the error. It gets rounds until
 // the pose settles.
 constexpr int kBootstrapOuterIterations = 10;
+// Before that, a coarse registration against frame 0 alone searches
+// correspondences this far [m] (a frame's travel at 30 m/s): along a street
+// lined with hedges and parked cars, standing still fits the walls as well as
+// the true motion does, and only the few features across the street's
+// direction (poles, corners, car ends) tell them apart, up to a frame's
+// travel away.
+constexpr double kBootstrapSearchRadius = 3.0;
 constexpr double kBootstrapSettledTranslation = 0.01;           // [m]
 constexpr double kBootstrapSettledRotation = 0.1 * M_PI / 180;  // [rad]
 
@@ -173,9 +180,18 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
     last_stats_.association_rounds += result.associations;
     return result;
   };
+  Pose start = prediction.pose;
+  if (k == 1 && bootstrap_map_) {
+    RegistrationSettings coarse = settings;
+    coarse.max_correspondence_distance = kBootstrapSearchRadius;
+    const RegistrationResult result = register_scan(features, *bootstrap_map_, prediction.pose, coarse, refresh);
+    last_stats_.association_rounds += result.associations;
+    if (result.ok) start = result.pose;
+  }
+  if (k >= 1) bootstrap_map_.reset();
   Pose pose = prediction.pose;
   if (!map_.empty()) {
-    last_stats_.registration = register_from(prediction.pose);
+    last_stats_.registration = register_from(start);
     pose = last_stats_.registration.pose;
     if (deskewing && k == 1 && last_stats_.registration.ok) {
       // Bootstrap: de-skew the first two frames with the motion just
@@ -197,6 +213,10 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
 
 void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& sweep_pose) {
   map_.add_frame(transformed(features.edges, sweep_pose), transformed(features.planars, sweep_pose));
+  if (sweep_poses_.empty()) {  // frame 0, for the second frame's coarse registration
+    bootstrap_map_.emplace(config_.local_map_frames, voxel_sizes_, kBootstrapSearchRadius, map_voxel_point(config_));
+    bootstrap_map_->add_frame(transformed(features.edges, sweep_pose), transformed(features.planars, sweep_pose));
+  }
   last_stats_.map_edge_points = map_.num_edge_points();
   last_stats_.map_planar_points = map_.num_planar_points();
 }

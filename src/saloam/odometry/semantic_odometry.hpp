@@ -107,6 +107,8 @@ class SemanticOdometry {
   ScanFeatures last_features_;
   std::optional<ScanFeatures> revised_first_;
   ScanFeatures first_raw_;  ///< first frame's features before de-skewing (bootstrap)
+  /// Frame 0 with a wide search radius, for the second frame's coarse registration (bootstrap).
+  std::optional<SemanticLocalMap> bootstrap_map_;
 };
 
 }  // namespace saloam
