@@ -58,8 +58,9 @@ TEST(SimulateCli, Kitti08StartHasNoEmptyScans) {
   const SequenceReader reader(seq);
   ASSERT_EQ(reader.size(), 8u);
   for (std::size_t i = 0; i < reader.size(); ++i) {
-    // 16 x 600 rays; a street scene returns most of them.
-    EXPECT_GT(reader.load_scan(i).size(), 4000u) << "frame " << i;
+    // 16 x 600 rays; a street scene returns most of them, 08's steep start
+    // with a car parked alongside about a third (see kitti_ground_test.cpp).
+    EXPECT_GT(reader.load_scan(i).size(), 2400u) << "frame " << i;
   }
 }
 

@@ -155,6 +155,9 @@ class World {
     float road_right = 2;  ///< road extent right of the path
     float road_left = 5;   ///< road extent left of the path (oncoming lane)
     float parking = 0;   ///< parking width beyond the road
+    /// Width of the strip along each road edge, inside road_left/right and
+    /// labelled road, where cars park at the curb (0 = none).
+    float curb_parking = 0;
     float sidewalk = 3;  ///< sidewalk width (0 = rural, no curb)
     std::uint8_t verge = 0;  ///< 0 terrain, 1 paved (sidewalk), 2 other-ground
     [[nodiscard]] double road(int side) const { return side > 0 ? road_left : road_right; }

@@ -18,6 +18,27 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+// Open country (no sidewalks, few buildings) where the rural noise exceeds
+// this: KITTI's sequences are mostly town and suburb.
+constexpr double kRuralNoise = 0.78;
+
+// Streets with cars parked along the curbs (where the parking noise exceeds
+// this), the strip they take on each side [m] and the share of its length
+// they fill.
+constexpr double kCurbParkingNoise = 0.6;
+constexpr float kCurbParkingWidth = 2.0f;
+constexpr double kCurbParkedShare = 0.75;
+
+// Hedges and fences along a street stand this far behind the sidewalk [m],
+// and may come this close to it [m] where the sidewalk widens along them
+// (other objects keep 0.1 m clear); a fence is checked and marked as this
+// half-width [m] around its line.
+constexpr double kLineGap = 0.12;
+// Objects stand at least this far off a road without sidewalk [m].
+constexpr double kRoadsideMargin = 0.5;
+constexpr double kLineClearance = 0.0;
+constexpr double kFenceCheckHalfWidth = 0.3;
+
 enum Salt : std::uint64_t {
   kSaltRoad = 101, kSaltParking, kSaltLot, kSaltSidewalk, kSaltVerge, kSaltRural, kSaltBump, kSaltBump2,
   kSaltBuildings, kSaltFences, kSaltTrees, kSaltPoles, kSaltCars, kSaltAgents, kSaltStructures, kSaltVerges
@@ -166,21 +187,28 @@ class WorldBuilder {
       for (int ix = 0; ix < w_.nx_; ++ix) {
         const Eigen::Vector2d c = center(ix, iy);
         World::Zone z;
-        const bool rural = noise_at(hash_combine(seed_, kSaltRural), c.x(), c.y(), 260.0) > 0.7;
+        const bool rural = noise_at(hash_combine(seed_, kSaltRural), c.x(), c.y(), 260.0) > kRuralNoise;
         // Right-hand traffic: the path runs in the right lane; the oncoming
-        // lane (3.2 m further left) and, on avenues, one more lane lie left.
-        // KITTI's towns are mostly two-lane streets: avenues are rare.
-        z.road_right = static_cast<float>(1.75 + 0.55 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
-        const bool avenue = noise_at(hash_combine(seed_, kSaltRoad + 1000), c.x(), c.y(), 300.0) > 0.84;
-        z.road_left = z.road_right + 3.2f + (avenue ? 3.3f : 0.0f);
+        // lane (2.8 m further left) and, on avenues, one more lane lie left.
+        // KITTI's towns are mostly narrow two-lane streets: avenues are rare.
+        z.road_right = static_cast<float>(1.5 + 0.4 * noise_at(hash_combine(seed_, kSaltRoad), c.x(), c.y(), 140.0));
+        const bool avenue = noise_at(hash_combine(seed_, kSaltRoad + 1000), c.x(), c.y(), 300.0) > 0.9;
+        z.road_left = z.road_right + 2.8f + (avenue ? 3.3f : 0.0f);
         const double park = noise_at(hash_combine(seed_, kSaltParking), c.x(), c.y(), 55.0);
         const double lot = noise_at(hash_combine(seed_, kSaltLot), c.x(), c.y(), 70.0);
         z.parking = 0.0f;
         // Parking lanes and lots are rare in SemanticKITTI (1.5 % of all
         // points, against 4 % for cars: most of its parked cars stand in
         // driveways, yards and on the road's edge).
-        if (!rural && park > 0.735) z.parking = 2.3f;
+        if (!rural && park > 0.75) z.parking = 2.3f;
         if (!rural && lot > 0.985) z.parking = 12.0f;
+        // Elsewhere in town most streets have cars parked on the road along
+        // both curbs (no marked lane: SemanticKITTI labels the ground road).
+        if (!rural && z.parking == 0 && park > kCurbParkingNoise) {
+          z.curb_parking = kCurbParkingWidth;
+          z.road_right += z.curb_parking;
+          z.road_left += z.curb_parking;
+        }
         z.sidewalk = rural ? 0.0f
                            : static_cast<float>(1.4 + 1.2 * noise_at(hash_combine(seed_, kSaltSidewalk), c.x(), c.y(), 90.0));
         const double verge = noise_at(hash_combine(seed_, kSaltVerge), c.x(), c.y(), 45.0);
@@ -253,7 +281,7 @@ class WorldBuilder {
       Eigen::Vector2d dir;
       w_.path_point(s, pos, dir);
       // Not on open land, and one junction per place even where the path passes twice.
-      if (noise_at(hash_combine(seed_, kSaltRural), pos.x(), pos.y(), 260.0) > 0.7) continue;
+      if (noise_at(hash_combine(seed_, kSaltRural), pos.x(), pos.y(), 260.0) > kRuralNoise) continue;
       if (!far_from(junctions, pos.head<2>(), 50.0)) continue;
       // Only on straight stretches: a side street off a bend would run askew.
       Eigen::Vector3d before, after;
@@ -339,15 +367,32 @@ class WorldBuilder {
       if (!inside_grid(p)) return false;
       const World::Zone z = w_.zone_at(p.x(), p.y());
       // Off the street: a margin from the road even where there is no sidewalk.
-      const double limit = road_only ? clearance : std::max(z.parking + z.sidewalk + clearance, 0.5);
+      const double limit = road_only ? clearance : std::max(z.parking + z.sidewalk + clearance, kRoadsideMargin);
       return w_.road_margin(p.x(), p.y()) >= limit && occupied_[w_.cell_index(p.x(), p.y())] == 0;
     });
   }
   void mark_rect(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy) {
+    if (run_marks_) {
+      run_marks_->push_back({c, axis, hx, hy});
+      return;
+    }
     for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
       if (inside_grid(p)) occupied_[w_.cell_index(p.x(), p.y())] = 1;
       return true;
     });
+  }
+
+  /// Places the pieces of one run (hedge, fence) with `place`, marking their
+  /// ground only once all are placed: the pieces of a run meet end to end,
+  /// and each would otherwise find its neighbour's marked cells (the raster
+  /// is coarser than the gap between them) and leave the run in dashes.
+  template <class F>
+  void as_one_run(F&& place) {
+    std::vector<MarkedRect> marks;
+    run_marks_ = &marks;
+    place();
+    run_marks_ = nullptr;
+    for (const MarkedRect& m : marks) mark_rect(m.c, m.axis, m.hx, m.hy);
   }
   /// Square of half side r clear of the road by `clearance` (objects ignored).
   bool clear_of_road(const Eigen::Vector2d& c, double r, double clearance) const {
@@ -418,7 +463,7 @@ class WorldBuilder {
         const double height = pick < 0.12 ? rng.uniform(5, 8) : (pick < 0.75 ? rng.uniform(8, 16) : rng.uniform(16, 25));
         // Front gardens, or (in the older blocks) the facade at the back of the
         // sidewalk: no strip of grass left between them.
-        const double setback = rng.chance(0.65) ? rng.uniform(3.5, 12) : rng.uniform(0.15, 0.6);
+        const double setback = rng.chance(0.65) ? rng.uniform(3.5, 12) : rng.uniform(0.25, 0.45);
         const double yaw = rng.uniform(-0.035, 0.035);
         const double edge = street_edge(probe, side);
         for (int attempt = 0; attempt < 2; ++attempt, length *= 0.55) {
@@ -428,15 +473,14 @@ class WorldBuilder {
           if (!rect_free(c, axis, 0.5 * length + 0.1, 0.5 * depth + 0.1, 0.1, false)) continue;
           add_building(c, axis, 0.5 * length, 0.5 * depth, height, rng);
           mark_rect(c, axis, 0.5 * length + 0.8, 0.5 * depth + 0.8);
-          // Front yard: hedge or fence along the property line, sometimes a tree.
-          // (0.75 m in: the widest hedge still clears the sidewalk by 0.1 m.)
-          const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * (edge + 0.85);
+          // Front yard: hedge or fence along the property line at the back of the sidewalk.
+          const Eigen::Vector2d yard = p + 0.5 * length * axis + side * mleft * edge;
           if (setback > 2.0) property_line(yard, axis, side * mleft, 0.5 * length, rng);
           // Garden: bushes and trees between the property line and the house
           // (front gardens in KITTI's towns are densely planted).
           // (Each bush wholly between the property line, 1.6 m in, and the
           // house, 0.8 m clear of it.)
-          for (int k = 0; setback > 3.0 && k < static_cast<int>(length * setback / 6.0); ++k) {
+          for (int k = 0; setback > 3.0 && k < static_cast<int>(length * setback / 3.0); ++k) {
             const double r = std::min(rng.uniform(0.8, 2.6), 0.5 * (setback - 2.4));
             const double near = edge + 1.6 + r, far = edge + setback - 0.8 - r;
             if (r < 0.4 || far < near) continue;
@@ -447,7 +491,7 @@ class WorldBuilder {
           }
           // A car in the driveway of some front gardens (most of KITTI's parked
           // cars are off the parking lanes, which hold 1.5 % of its points).
-          if (setback > 6.5 && rng.chance(0.45)) {
+          if (setback > 5.5 && rng.chance(0.7)) {
             const Eigen::Vector2d d = p + rng.uniform(0.15, 0.85) * length * axis + side * mleft * (edge + 1.7 + 2.5);
             const double car_length = rng.uniform(3.9, 4.9);
             if (rect_free(d, mleft, 0.5 * car_length + 0.15, 1.05, 0.5, false)) {
@@ -525,18 +569,22 @@ class WorldBuilder {
     return g;
   }
 
-  /// Along a property line: a hedge, or a fence with shrubs or a hedge
-  /// behind it (`away` points from the street into the plot).
-  void property_line(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, const Eigen::Vector2d& away,
+  /// Along a property line that starts at `front` (the back of the
+  /// sidewalk; `away` points from the street into the plot): a hedge, or a
+  /// fence with shrubs or a hedge behind it, each as close to the sidewalk
+  /// as the clearance check allows (kLineGap).
+  void property_line(const Eigen::Vector2d& front, const Eigen::Vector2d& axis, const Eigen::Vector2d& away,
                      double half_length, Rng& rng) {
     const double pick = rng.uniform();
     if (pick < 0.08) return;
     if (pick < 0.58) {
       // Privacy hedges, mostly above the sensor's 1.73 m: the lawn behind them
       // is out of sight of every beam pointing down.
-      add_hedge(c, axis, half_length, rng.uniform(0.35, 0.7), rng.uniform(1.5, 2.6), rng);
+      const double half_w = rng.uniform(0.35, 0.7);
+      add_hedge(front + away * (kLineGap + half_w), axis, half_length, half_w, rng.uniform(1.5, 2.6), rng);
     } else {
-      add_fence(c, axis, half_length, rng.uniform(1.0, 1.9), 0.5, rng);
+      const Eigen::Vector2d c = front + away * (kLineGap + kFenceCheckHalfWidth);
+      add_fence(c, axis, half_length, rng.uniform(1.0, 1.9), 0.2, rng);
       if (rng.chance(0.75)) planting_behind(c, axis, away, half_length, rng);
     }
   }
@@ -549,10 +597,12 @@ class WorldBuilder {
     const int pieces = std::max(1, static_cast<int>(std::ceil(2.0 * half_length / 5.0)));
     const double half_piece = half_length / pieces;
     int placed = 0;
-    for (int k = 0; k < pieces; ++k) {
-      const Eigen::Vector2d pc = c + (-half_length + (2 * k + 1) * half_piece) * axis;
-      placed += place_piece(pc, half_piece) ? 1 : 0;
-    }
+    as_one_run([&] {
+      for (int k = 0; k < pieces; ++k) {
+        const Eigen::Vector2d pc = c + (-half_length + (2 * k + 1) * half_piece) * axis;
+        placed += place_piece(pc, half_piece) ? 1 : 0;
+      }
+    });
     return placed;
   }
 
@@ -565,7 +615,7 @@ class WorldBuilder {
 
   bool add_hedge_piece(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, double half_width,
                        double height, Rng& rng) {
-    if (!rect_free(c, axis, half_length, half_width, 0.1, false)) return false;
+    if (!rect_free(c, axis, half_length, half_width, kLineClearance, false)) return false;
     const double g = ground(c);
     Primitive h = box(cls::kVegetation, c, axis, half_length, half_width, g - 0.1, g + height, rng.uniform(0.38, 0.5));
     h.mean_free_path = 0.3f;
@@ -574,23 +624,38 @@ class WorldBuilder {
     return true;
   }
 
-  /// Fence: boards, railings, or chain-link the beam partly passes.
+  /// What a fence is made of: boards or railings, or chain-link the beam partly passes.
+  struct FenceStyle {
+    bool chain_link = false;
+    double height = 1.5, remission = 0.3;
+  };
+  static FenceStyle fence_style(double height, double chain_link, Rng& rng) {
+    FenceStyle f;
+    f.chain_link = rng.chance(chain_link);
+    f.height = height;
+    f.remission = rng.uniform(0.2, 0.5);
+    return f;
+  }
+
   bool add_fence(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, double height,
                  double chain_link, Rng& rng) {
-    const bool chain = rng.chance(chain_link);
-    const double remission = rng.uniform(0.2, 0.5);
+    const FenceStyle style = fence_style(height, chain_link, rng);
     return in_pieces(c, axis, half_length, [&](const Eigen::Vector2d& pc, double half) {
-             if (!rect_free(pc, axis, half, 0.3, 0.1, false)) return false;
-             const double g = ground(pc);
-             Primitive f = box(cls::kFence, pc, axis, half, 0.04, g, g + height, remission);
-             if (chain) {
-               f.half_y = 0.2f;
-               f.mean_free_path = 1.0f;
-             }
-             w_.primitives_.push_back(f);
-             mark_rect(pc, axis, half, 0.3);
-             return true;
+             return add_fence_piece(pc, axis, half, style);
            }) > 0;
+  }
+
+  bool add_fence_piece(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double half_length, const FenceStyle& style) {
+    if (!rect_free(c, axis, half_length, kFenceCheckHalfWidth, kLineClearance, false)) return false;
+    const double g = ground(c);
+    Primitive f = box(cls::kFence, c, axis, half_length, 0.04, g, g + style.height, style.remission);
+    if (style.chain_link) {
+      f.half_y = 0.2f;
+      f.mean_free_path = 1.0f;
+    }
+    w_.primitives_.push_back(f);
+    mark_rect(c, axis, half_length, kFenceCheckHalfWidth);
+    return true;
   }
 
   /// Shrubs or a hedge just behind a fence, taller than it now and then.
@@ -615,24 +680,47 @@ class WorldBuilder {
   void place_boundaries() {
     for (int side = -1; side <= 1; side += 2) {
       Rng rng(hash3(seed_, kSaltFences, static_cast<std::uint64_t>(side + 5)));
-      walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
+      walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double s) -> double {
         const Eigen::Vector2d left(-dir.y(), dir.x());
         const Eigen::Vector2d probe = p + side * left * 7.0;
-        const double edge = street_edge(probe, side);
         const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
         const double length = rng.uniform(6, 30);
         const double pick = rng.uniform();
-        if (pick < (rural ? 0.1 : 0.04)) return length;  // open
+        if (pick < (rural ? 0.03 : 0.04)) return length;  // open
         // Country roads: wide belts of shrubs along the field edges.
         const double half_w = rural ? rng.uniform(0.6, 1.8) : rng.uniform(0.35, 0.8);
-        // Street side of the hedge or fence at least 0.15 m behind the sidewalk.
-        const double off = edge + 0.15 + half_w + rng.uniform(0.0, rural ? 0.6 : 0.3);
-        const Eigen::Vector2d c = p + 0.5 * length * dir + side * left * off;
-        if (pick < (rural ? 0.6 : 0.5)) {
-          if (!add_hedge(c, dir, 0.5 * length, half_w, rng.uniform(1.4, rural ? 4.0 : 2.8), rng)) return 2.0;
-        } else {
-          if (!add_fence(c, dir, 0.5 * length, rng.uniform(1.0, 2.2), 0.3, rng)) return 2.0;
-          if (rng.chance(rural ? 0.6 : 0.85)) planting_behind(c, dir, side * left, 0.5 * length, rng);
+        // Street side of the hedge or fence just behind the sidewalk, or
+        // behind a country road's shoulder (rect_free keeps objects
+        // kRoadsideMargin off a road without sidewalk).
+        const double gap = rural ? kRoadsideMargin + 0.02 + rng.uniform(0.0, 0.4) : kLineGap + rng.uniform(0.0, 0.15);
+        const bool hedge = pick < (rural ? 0.85 : 0.5);
+        const double hedge_height = rng.uniform(1.4, rural ? 4.0 : 2.8);
+        const FenceStyle fence = fence_style(rng.uniform(1.0, 2.2), 0.3, rng);
+        const bool planted = !hedge && rng.chance(rural ? 0.6 : 0.85);
+        // Piece by piece along the path, so that the run follows bends and
+        // the sidewalk's changing width.
+        const int pieces = std::max(1, static_cast<int>(std::ceil(length / 5.0)));
+        const double half = 0.5 * length / pieces;
+        struct Piece {
+          Eigen::Vector2d c, dir, away;
+        };
+        std::vector<Piece> placed;
+        as_one_run([&] {
+          for (int k = 0; k < pieces; ++k) {
+            Eigen::Vector3d pos;
+            Eigen::Vector2d d;
+            w_.path_point(s + (2 * k + 1) * half, pos, d);
+            const Eigen::Vector2d l(-d.y(), d.x());
+            const double edge = street_edge(pos.head<2>() + side * l * 7.0, side);
+            const Eigen::Vector2d c = pos.head<2>() + side * l * (edge + gap + (hedge ? half_w : kFenceCheckHalfWidth));
+            if (hedge ? add_hedge_piece(c, d, half, half_w, hedge_height, rng) : add_fence_piece(c, d, half, fence)) {
+              placed.push_back({c, d, side * l});
+            }
+          }
+        });
+        if (placed.empty()) return 2.0;
+        if (planted) {
+          for (const Piece& piece : placed) planting_behind(piece.c, piece.dir, piece.away, half, rng);
         }
         return length + (rng.chance(0.75) ? 0.0 : rng.uniform(1, 4));
       });
@@ -650,11 +738,14 @@ class WorldBuilder {
       walk(rng.uniform(0, 3), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
         const Eigen::Vector2d left(-dir.y(), dir.x());
         const double half_length = rng.uniform(0.8, 1.6);
-        if (rng.chance(0.16)) return 2 * half_length + rng.uniform(1.0, 4.0);
+        if (rng.chance(0.1)) return 2 * half_length + rng.uniform(1.0, 4.0);
         const double half_w = rng.uniform(0.4, 1.2);
-        const double edge = street_edge(p + side * left * 7.0, side);
-        const Eigen::Vector2d c = p + half_length * dir + side * left * (edge + 0.2 + half_w);
-        if (!rect_free(c, dir, half_length, half_w, 0.1, false)) return 1.0;
+        const Eigen::Vector2d probe = p + side * left * 7.0;
+        const double edge = street_edge(probe, side);
+        const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
+        const double gap = rural ? kRoadsideMargin + 0.02 : kLineGap;
+        const Eigen::Vector2d c = p + half_length * dir + side * left * (edge + gap + half_w);
+        if (!rect_free(c, dir, half_length, half_w, kLineClearance, false)) return 0.5;
         const double g = ground(c);
         const double height = 0.5 + 1.3 * noise_at(hash_combine(seed_, kSaltVerges), c.x(), c.y(), 12.0) + rng.uniform(0.0, 0.3);
         Primitive bed = box(cls::kVegetation, c, dir, half_length, half_w, g - 0.1, g + height, rng.uniform(0.35, 0.5));
@@ -733,7 +824,7 @@ class WorldBuilder {
     walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
       const bool rural_here = w_.zone_at(p.x(), p.y()).sidewalk == 0;
-      for (int k = 0; k < (rural_here ? 60 : 40); ++k) {
+      for (int k = 0; k < (rural_here ? 90 : 70); ++k) {
         const int side = rng.chance(0.5) ? -1 : 1;
         const Eigen::Vector2d c = p + side * left * rng.uniform(5, 60) + dir * rng.uniform(-5, 5);
         if (!inside_grid(c)) continue;
@@ -846,7 +937,7 @@ class WorldBuilder {
       walk(rng.uniform(0, 5), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
         const Eigen::Vector2d left(-dir.y(), dir.x());
         const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
-        if (z.parking <= 0) return 3.0;
+        if (z.parking <= 0 && z.curb_parking <= 0) return 3.0;
         const double pick = rng.uniform();
         std::uint16_t label = cls::kCar;
         double length = rng.uniform(3.9, 4.9), width = rng.uniform(1.7, 1.9), height = rng.uniform(1.4, 1.65);
@@ -862,9 +953,10 @@ class WorldBuilder {
           height = rng.uniform(2.1, 2.7);
         }
         const bool lot = z.parking > 5;
+        const bool curb = z.parking <= 0;
         if (lot && label == cls::kTruck) label = cls::kCar, length = 4.5, width = 1.8, height = 1.5;
         // Streets with a parking lane are nearly fully parked in KITTI's towns.
-        const bool present = rng.chance(lot ? 0.8 : 0.92);
+        const bool present = rng.chance(lot ? 0.8 : (curb ? kCurbParkedShare : 0.92));
         double advance = lot ? 2.8 : length + rng.uniform(0.5, 1.4);
         if (!present) return advance;
         std::vector<Eigen::Vector2d> spots;
@@ -873,12 +965,15 @@ class WorldBuilder {
           axis = left;
           spots.push_back(p + side * left * (z.road(side) + 3.2));
           if (rng.chance(0.8)) spots.push_back(p + side * left * (z.road(side) + z.parking - 3.2));
+        } else if (curb) {
+          spots.push_back(p + side * left * (z.road(side) - 0.5 * z.curb_parking));
         } else {
           spots.push_back(p + side * left * (z.road(side) + 0.5 * z.parking + 0.1));
         }
         for (const auto& c : spots) {
           const double hx = 0.5 * length + 0.15, hy = 0.5 * width + 0.1;
-          if (!rect_free(c, axis, hx, hy, 0.15, true)) continue;
+          // Off the road, or (at the curb) within the parking strip.
+          if (!rect_free(c, axis, hx, curb ? 0.5 * width : hy, curb ? -z.curb_parking - 0.05 : 0.15, true)) continue;
           add_vehicle(c, axis * (rng.chance(0.5) ? 1.0 : -1.0), label, length, width, height, rng, total_time);
           mark_rect(c, axis, hx, hy);
         }
@@ -931,7 +1026,7 @@ class WorldBuilder {
       a.t_ref = t;
       a.s_ref = w_.ego_arc_length(t);
       a.speed = -rng.uniform(7, 13);
-      a.lateral = rng.uniform(3.1, 3.4);
+      a.lateral = rng.uniform(2.9, 3.2);  // the oncoming lane, clear of cars parked at its curb
       a.t_begin = t - 15;
       a.t_end = t + 15;
       vehicle_dims(a, rng);
@@ -1037,6 +1132,11 @@ class WorldBuilder {
   World& w_;
   std::uint64_t seed_;
   std::vector<std::uint8_t> occupied_;
+  struct MarkedRect {
+    Eigen::Vector2d c, axis;
+    double hx, hy;
+  };
+  std::vector<MarkedRect>* run_marks_ = nullptr;  ///< marks held back while a run is placed (as_one_run)
   PointSet poles_, trees_;
   std::uint16_t next_instance_ = 1;
 };
