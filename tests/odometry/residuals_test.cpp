@@ -2,6 +2,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include "saloam/core/lie.hpp"
 #include "saloam/core/semantic_classes.hpp"
@@ -192,6 +193,35 @@ TEST(Registration, ConvergesAsWellFarFromTheOrigin) {
     EXPECT_LT(rotation_angle(err), 5e-4) << "distance " << distance;
     EXPECT_LT(result.iterations, settings.max_iterations * settings.outer_iterations)
         << "ran out of iterations at distance " << distance;
+  }
+}
+
+// The pose and the fit are bit-identical serial and over any number of
+// threads: the association writes per feature, and the normal equations and
+// the fit are summed in blocks fixed by the number of residuals.
+TEST(Registration, SameResultWithAnyNumberOfThreads) {
+  std::mt19937 rng(7);
+  const ScanFeatures f = scene(rng);
+  const SemanticLocalMap map = map_of(f.edges, f.planars);
+  Vector6d xi;
+  xi << 0.3, -0.2, 0.04, 0.01, -0.008, 0.04;
+  const ScanFeatures scan = seen_from(f, se3_exp(xi));
+  auto settings = RegistrationSettings::from_config(OdometryConfig{});
+  settings.parallel = false;
+  const auto serial = register_scan(scan.edges, scan.planars, map, Pose::Identity(), settings);
+  ASSERT_TRUE(serial.ok);
+  ASSERT_GT(scan.edges.size() + scan.planars.size(), 4000u);  // several blocks of residuals
+  settings.parallel = true;
+  for (const int threads : {1, 2}) {
+    tbb::task_arena arena(threads);
+    const auto parallel =
+        arena.execute([&] { return register_scan(scan.edges, scan.planars, map, Pose::Identity(), settings); });
+    EXPECT_TRUE(parallel.pose.matrix() == serial.pose.matrix()) << threads << " threads";
+    EXPECT_TRUE(parallel.hessian == serial.hessian) << threads << " threads";
+    EXPECT_EQ(parallel.loss, serial.loss) << threads << " threads";
+    EXPECT_EQ(parallel.inlier_residual_sum, serial.inlier_residual_sum) << threads << " threads";
+    EXPECT_EQ(parallel.inliers, serial.inliers) << threads << " threads";
+    EXPECT_EQ(parallel.iterations, serial.iterations) << threads << " threads";
   }
 }
 

@@ -58,35 +58,72 @@ double huber_weight(double r, double k) {
   return a <= k ? 1.0 : k / a;
 }
 
+// The residuals of a scan form one index space, the edges [0, edges) then the
+// planar points; sums over it go in blocks of this many residuals
+// (sum_in_blocks), so they are the same with any number of threads.
+constexpr std::size_t kResidualBlock = 512;
+
+// Calls on_edge(e) or on_planar(p) for residual i of that index space when
+// its feature is matched.
+template <class OnEdge, class OnPlanar>
+void visit_matched(std::size_t i, const std::vector<EdgeMatch>& edge_matches,
+                   const std::vector<PlaneMatch>& plane_matches, OnEdge&& on_edge, OnPlanar&& on_planar) {
+  if (i < edge_matches.size()) {
+    if (edge_matches[i].valid) on_edge(i);
+  } else if (plane_matches[i - edge_matches.size()].valid) {
+    on_planar(i - edge_matches.size());
+  }
+}
+
+// The fit's sums over the matched features (RegistrationResult's fields).
+struct FitSums {
+  double loss = 0;
+  int inliers = 0;
+  double inlier_residual_sum = 0;
+  Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+
+  FitSums& operator+=(const FitSums& o) {
+    loss += o.loss;
+    inliers += o.inliers;
+    inlier_residual_sum += o.inlier_residual_sum;
+    hessian += o.hessian;
+    return *this;
+  }
+};
+
 // Loss, inliers and Hessian of the matched features at pose T (no new association).
 void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
                   const std::vector<PlaneMatch>& plane_matches, const Pose& T, const RegistrationSettings& settings,
                   RegistrationResult& result) {
-  result.loss = 0;
-  result.inliers = 0;
-  result.inlier_residual_sum = 0;
-  result.hessian.setZero();
   const double k = settings.robust_kernel_scale;
-  auto add = [&](double distance, double class_weight, const auto& J) {
-    result.loss += class_weight * distance;
-    if (distance < settings.inlier_distance) {
-      ++result.inliers;
-      result.inlier_residual_sum += distance;
-    }
-    result.hessian.noalias() += class_weight * huber_weight(distance, k) * J.transpose() * J;
+  const auto term = [&](std::size_t i, FitSums& sum) {
+    auto add = [&](double distance, double class_weight, const auto& J) {
+      sum.loss += class_weight * distance;
+      if (distance < settings.inlier_distance) {
+        ++sum.inliers;
+        sum.inlier_residual_sum += distance;
+      }
+      sum.hessian.noalias() += class_weight * huber_weight(distance, k) * J.transpose() * J;
+    };
+    visit_matched(
+        i, edge_matches, plane_matches,
+        [&](std::size_t e) {
+          Eigen::Matrix<double, 3, 6> J;
+          const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
+          add(r.norm(), settings.class_weight[edges.classes[e]], J);
+        },
+        [&](std::size_t p) {
+          Eigen::Matrix<double, 1, 6> J;
+          const double r = point_to_plane_residual(T, planars.points[p], plane_matches[p].plane, &J);
+          add(std::abs(r), settings.class_weight[planars.classes[p]], J);
+        });
   };
-  for (std::size_t i = 0; i < edges.size(); ++i) {
-    if (!edge_matches[i].valid) continue;
-    Eigen::Matrix<double, 3, 6> J;
-    const Eigen::Vector3d r = point_to_line_residual(T, edges.points[i], edge_matches[i].line, &J);
-    add(r.norm(), settings.class_weight[edges.classes[i]], J);
-  }
-  for (std::size_t i = 0; i < planars.size(); ++i) {
-    if (!plane_matches[i].valid) continue;
-    Eigen::Matrix<double, 1, 6> J;
-    const double r = point_to_plane_residual(T, planars.points[i], plane_matches[i].plane, &J);
-    add(std::abs(r), settings.class_weight[planars.classes[i]], J);
-  }
+  const FitSums sums =
+      sum_in_blocks(edges.size() + planars.size(), settings.parallel, kResidualBlock, FitSums{}, term);
+  result.loss = sums.loss;
+  result.inliers = sums.inliers;
+  result.inlier_residual_sum = sums.inlier_residual_sum;
+  result.hessian = sums.hessian;
 }
 
 // Matches every feature at pose T to a line or plane fitted to its nearest
@@ -136,31 +173,53 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
   }
 }
 
+// Gauss-Newton's normal equations H delta = -g: H = sum of w J^T J and
+// g = sum of w J^T r over the matched features, w = class weight * Huber.
+struct NormalEquations {
+  Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
+  Vector6d g = Vector6d::Zero();
+
+  NormalEquations& operator+=(const NormalEquations& o) {
+    H += o.H;
+    g += o.g;
+    return *this;
+  }
+};
+
+// The normal equations at pose T over the given correspondences.
+NormalEquations normal_equations(const FeatureCloud& edges, const FeatureCloud& planars,
+                                 const std::vector<EdgeMatch>& edge_matches,
+                                 const std::vector<PlaneMatch>& plane_matches, const Pose& T,
+                                 const RegistrationSettings& settings) {
+  const double k = settings.robust_kernel_scale;
+  const auto term = [&](std::size_t i, NormalEquations& sum) {
+    visit_matched(
+        i, edge_matches, plane_matches,
+        [&](std::size_t e) {
+          Eigen::Matrix<double, 3, 6> J;
+          const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
+          const double w = settings.class_weight[edges.classes[e]] * huber_weight(r.norm(), k);
+          sum.H.noalias() += w * J.transpose() * J;
+          sum.g.noalias() += w * J.transpose() * r;
+        },
+        [&](std::size_t p) {
+          Eigen::Matrix<double, 1, 6> J;
+          const double r = point_to_plane_residual(T, planars.points[p], plane_matches[p].plane, &J);
+          const double w = settings.class_weight[planars.classes[p]] * huber_weight(r, k);
+          sum.H.noalias() += w * J.transpose() * J;
+          sum.g.noalias() += (w * r) * J.transpose();
+        });
+  };
+  return sum_in_blocks(edges.size() + planars.size(), settings.parallel, kResidualBlock, NormalEquations{}, term);
+}
+
 // Gauss-Newton over the given correspondences from T; false when a step is
 // not finite (T is then the last finite pose).
 bool solve(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
            const std::vector<PlaneMatch>& plane_matches, const RegistrationSettings& settings, Pose& T,
            RegistrationResult& result) {
-  const double k = settings.robust_kernel_scale;
   for (int it = 0; it < settings.max_iterations; ++it) {
-    Eigen::Matrix<double, 6, 6> H = Eigen::Matrix<double, 6, 6>::Zero();
-    Vector6d g = Vector6d::Zero();
-    for (std::size_t i = 0; i < edges.size(); ++i) {
-      if (!edge_matches[i].valid) continue;
-      Eigen::Matrix<double, 3, 6> J;
-      const Eigen::Vector3d r = point_to_line_residual(T, edges.points[i], edge_matches[i].line, &J);
-      const double w = settings.class_weight[edges.classes[i]] * huber_weight(r.norm(), k);
-      H.noalias() += w * J.transpose() * J;
-      g.noalias() += w * J.transpose() * r;
-    }
-    for (std::size_t i = 0; i < planars.size(); ++i) {
-      if (!plane_matches[i].valid) continue;
-      Eigen::Matrix<double, 1, 6> J;
-      const double r = point_to_plane_residual(T, planars.points[i], plane_matches[i].plane, &J);
-      const double w = settings.class_weight[planars.classes[i]] * huber_weight(r, k);
-      H.noalias() += w * J.transpose() * J;
-      g.noalias() += (w * r) * J.transpose();
-    }
+    auto [H, g] = normal_equations(edges, planars, edge_matches, plane_matches, T, settings);
     // Small Levenberg-Marquardt damping keeps weakly constrained directions stable.
     H.diagonal().array() += 1e-6 * H.diagonal().maxCoeff() + 1e-9;
     const Vector6d delta = -H.ldlt().solve(g);

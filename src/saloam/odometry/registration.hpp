@@ -31,7 +31,7 @@ struct RegistrationSettings {
   double plane_normal_tolerance = 0.05;  ///< plane constraint: tolerance on |n . z|
   std::array<double, kNumClassIndices> class_weight{};          ///< w^l
   std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
-  bool parallel = false;           ///< associate with TBB (inside the caller's task arena)
+  bool parallel = false;  ///< associate and sum the normal equations with TBB (inside the caller's task arena); same result
   /// [m] a final correspondence closer than this counts as an inlier (RegistrationResult::inliers).
   double inlier_distance = 0.2;
 
