@@ -675,6 +675,36 @@ class WorldBuilder {
     }
   }
 
+  /// One piece of a run along the street: centre, direction along the
+  /// street, direction away from it, half its length.
+  struct RunPiece {
+    Eigen::Vector2d c, axis, away;
+    double half_length;
+  };
+
+  /// A run of `length` [m] from arc length s along one side of the street,
+  /// `offset` [m] behind the back of the sidewalk, in pieces of at most 5 m
+  /// that each follow the path (bends, the sidewalk's changing width); place
+  /// returns whether a piece went in (as_one_run). Returns the pieces placed.
+  template <class F>
+  std::vector<RunPiece> along_street(double s, int side, double length, double offset, F&& place) {
+    const int pieces = std::max(1, static_cast<int>(std::ceil(length / 5.0)));
+    const double half = 0.5 * length / pieces;
+    std::vector<RunPiece> placed;
+    as_one_run([&] {
+      for (int k = 0; k < pieces; ++k) {
+        Eigen::Vector3d pos;
+        Eigen::Vector2d dir;
+        w_.path_point(s + (2 * k + 1) * half, pos, dir);
+        const Eigen::Vector2d away = side * Eigen::Vector2d(-dir.y(), dir.x());
+        const double edge = street_edge(pos.head<2>() + away * 7.0, side);
+        const RunPiece piece{pos.head<2>() + away * (edge + offset), dir, away, half};
+        if (place(piece)) placed.push_back(piece);
+      }
+    });
+    return placed;
+  }
+
   // Hedges and fences along the back of the sidewalk wherever no building
   // stands there: streets in KITTI are lined with them.
   void place_boundaries() {
@@ -697,30 +727,14 @@ class WorldBuilder {
         const double hedge_height = rng.uniform(1.4, rural ? 4.0 : 2.8);
         const FenceStyle fence = fence_style(rng.uniform(1.0, 2.2), 0.3, rng);
         const bool planted = !hedge && rng.chance(rural ? 0.6 : 0.85);
-        // Piece by piece along the path, so that the run follows bends and
-        // the sidewalk's changing width.
-        const int pieces = std::max(1, static_cast<int>(std::ceil(length / 5.0)));
-        const double half = 0.5 * length / pieces;
-        struct Piece {
-          Eigen::Vector2d c, dir, away;
-        };
-        std::vector<Piece> placed;
-        as_one_run([&] {
-          for (int k = 0; k < pieces; ++k) {
-            Eigen::Vector3d pos;
-            Eigen::Vector2d d;
-            w_.path_point(s + (2 * k + 1) * half, pos, d);
-            const Eigen::Vector2d l(-d.y(), d.x());
-            const double edge = street_edge(pos.head<2>() + side * l * 7.0, side);
-            const Eigen::Vector2d c = pos.head<2>() + side * l * (edge + gap + (hedge ? half_w : kFenceCheckHalfWidth));
-            if (hedge ? add_hedge_piece(c, d, half, half_w, hedge_height, rng) : add_fence_piece(c, d, half, fence)) {
-              placed.push_back({c, d, side * l});
-            }
-          }
+        const double depth = hedge ? half_w : kFenceCheckHalfWidth;
+        const std::vector<RunPiece> placed = along_street(s, side, length, gap + depth, [&](const RunPiece& piece) {
+          return hedge ? add_hedge_piece(piece.c, piece.axis, piece.half_length, half_w, hedge_height, rng)
+                       : add_fence_piece(piece.c, piece.axis, piece.half_length, fence);
         });
         if (placed.empty()) return 2.0;
         if (planted) {
-          for (const Piece& piece : placed) planting_behind(piece.c, piece.dir, piece.away, half, rng);
+          for (const RunPiece& piece : placed) planting_behind(piece.c, piece.axis, piece.away, piece.half_length, rng);
         }
         return length + (rng.chance(0.75) ? 0.0 : rng.uniform(1, 4));
       });
