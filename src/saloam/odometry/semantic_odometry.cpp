@@ -180,14 +180,7 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
     last_stats_.association_rounds += result.associations;
     return result;
   };
-  Pose start = prediction.pose;
-  if (k == 1 && bootstrap_map_) {
-    RegistrationSettings coarse = settings;
-    coarse.max_correspondence_distance = kBootstrapSearchRadius;
-    const RegistrationResult result = register_scan(features, *bootstrap_map_, prediction.pose, coarse, refresh);
-    last_stats_.association_rounds += result.associations;
-    if (result.ok) start = result.pose;
-  }
+  const Pose start = k == 1 ? coarse_start(features, prediction.pose, settings, refresh) : prediction.pose;
   if (k >= 1) bootstrap_map_.reset();
   Pose pose = prediction.pose;
   if (!map_.empty()) {
@@ -209,6 +202,19 @@ Pose SemanticOdometry::align(ScanFeatures& features, ScanFeatures& measured, con
   if (deskewing && k == 0) first_raw_ = std::move(measured);
   if (k >= 1) first_raw_ = ScanFeatures{};
   return orthonormalized(pose);
+}
+
+// The second frame's registration against frame 0 alone, searched up to
+// kBootstrapSearchRadius: its pose, or `initial` when it finds too few
+// correspondences.
+Pose SemanticOdometry::coarse_start(ScanFeatures& features, const Pose& initial, const RegistrationSettings& settings,
+                                    const FeatureRefresh& refresh) {
+  if (!bootstrap_map_) return initial;
+  RegistrationSettings coarse = settings;
+  coarse.max_correspondence_distance = kBootstrapSearchRadius;
+  const RegistrationResult result = register_scan(features, *bootstrap_map_, initial, coarse, refresh);
+  last_stats_.association_rounds += result.associations;
+  return result.ok ? result.pose : initial;
 }
 
 void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& sweep_pose) {

@@ -87,6 +87,9 @@ class SemanticOdometry {
   /// Registers `features` to the local map; de-skews them again from
   /// `measured` as the estimate moves. Returns the mid-sweep pose.
   Pose align(ScanFeatures& features, ScanFeatures& measured, const MotionPrediction& prediction);
+  /// The second frame's coarse registration against frame 0 (bootstrap): where its fine one starts.
+  Pose coarse_start(ScanFeatures& features, const Pose& initial, const RegistrationSettings& settings,
+                    const FeatureRefresh& refresh);
   void update_map(const ScanFeatures& features, const Pose& sweep_pose);
   /// Stores the frame and returns its pose at the pose instant.
   Pose record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp, const FrameTimings& timing,
