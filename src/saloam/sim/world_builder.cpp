@@ -29,13 +29,13 @@ constexpr double kCurbParkingNoise = 0.6;
 constexpr float kCurbParkingWidth = 2.0f;
 constexpr double kCurbParkedShare = 0.75;
 
+// Objects stand at least this far off a road without sidewalk [m].
+constexpr double kRoadsideMargin = 0.5;
 // Hedges and fences along a street stand this far behind the sidewalk [m],
 // and may come this close to it [m] where the sidewalk widens along them
 // (other objects keep 0.1 m clear); a fence is checked and marked as this
 // half-width [m] around its line.
 constexpr double kLineGap = 0.12;
-// Objects stand at least this far off a road without sidewalk [m].
-constexpr double kRoadsideMargin = 0.5;
 constexpr double kLineClearance = 0.0;
 constexpr double kFenceCheckHalfWidth = 0.3;
 
@@ -333,6 +333,11 @@ class WorldBuilder {
   }
 
   // ------------------------------------------------------------ placement helpers
+
+  /// How far behind the street's edge (street_edge) a hedge, fence or bed
+  /// along it starts at the nearest: just behind the sidewalk, or beyond a
+  /// country road's margin (rect_free).
+  static double line_gap(bool rural) { return rural ? kRoadsideMargin + 0.02 : kLineGap; }
 
   /// Lateral distance from the path to the back of the sidewalk on one side.
   [[nodiscard]] double street_edge(const Eigen::Vector2d& p, int side) const {
@@ -722,7 +727,7 @@ class WorldBuilder {
         // Street side of the hedge or fence just behind the sidewalk, or
         // behind a country road's shoulder (rect_free keeps objects
         // kRoadsideMargin off a road without sidewalk).
-        const double gap = rural ? kRoadsideMargin + 0.02 + rng.uniform(0.0, 0.4) : kLineGap + rng.uniform(0.0, 0.15);
+        const double gap = line_gap(rural) + rng.uniform(0.0, rural ? 0.4 : 0.15);
         const bool hedge = pick < (rural ? 0.85 : 0.5);
         const double hedge_height = rng.uniform(1.4, rural ? 4.0 : 2.8);
         const FenceStyle fence = fence_style(rng.uniform(1.0, 2.2), 0.3, rng);
@@ -757,7 +762,7 @@ class WorldBuilder {
         const Eigen::Vector2d probe = p + side * left * 7.0;
         const double edge = street_edge(probe, side);
         const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
-        const double gap = rural ? kRoadsideMargin + 0.02 : kLineGap;
+        const double gap = line_gap(rural);
         const Eigen::Vector2d c = p + half_length * dir + side * left * (edge + gap + half_w);
         if (!rect_free(c, dir, half_length, half_w, kLineClearance, false)) return 0.5;
         const double g = ground(c);
