@@ -218,10 +218,12 @@ Pose SemanticOdometry::coarse_start(ScanFeatures& features, const Pose& initial,
 }
 
 void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& sweep_pose) {
-  map_.add_frame(transformed(features.edges, sweep_pose), transformed(features.planars, sweep_pose));
+  const FeatureCloud edges = transformed(features.edges, sweep_pose);
+  const FeatureCloud planars = transformed(features.planars, sweep_pose);
+  map_.add_frame(edges, planars);
   if (sweep_poses_.empty()) {  // frame 0, for the second frame's coarse registration
     bootstrap_map_.emplace(config_.local_map_frames, voxel_sizes_, kBootstrapSearchRadius, map_voxel_point(config_));
-    bootstrap_map_->add_frame(transformed(features.edges, sweep_pose), transformed(features.planars, sweep_pose));
+    bootstrap_map_->add_frame(edges, planars);
   }
   last_stats_.map_edge_points = map_.num_edge_points();
   last_stats_.map_planar_points = map_.num_planar_points();
