@@ -178,9 +178,9 @@ struct LoopClosureConfig {
   /// transfer poorly to simulated scans.
   std::string detector = "scancontext";
   /// sigma: odometry drift rate of Eq. 3 (search radius per metre travelled).
-  /// Table I's 0.05 suits an odometry drifting ~1 %; this one drifts ~0.1 %
-  /// (docs/odometry.md), and 0.05 let a look-alike street 91 m away through
-  /// as a loop (docs/loop_closure.md). config/paper.yaml keeps 0.05.
+  /// Table I's 0.05 budgets for ~1 % drift; this odometry drifts ~0.1 %, and
+  /// a wider radius only admits look-alike places (docs/loop_closure.md).
+  /// config/paper.yaml keeps 0.05.
   double sigma = 0.01;
   double delta_min = 15.0;    ///< delta_min [m]: smallest search radius of Eq. 3
   double delta_max = 100.0;   ///< delta_max [m]: largest search radius of Eq. 3
