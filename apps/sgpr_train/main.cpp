@@ -37,6 +37,7 @@ struct SgprTrainArgs {
   int threads = 1;
   std::size_t pairs_per_epoch = 4000;
   double hard_fraction = 0.5;
+  std::uint32_t positive_min_gap = 0;
   double dropout = 0.1;
   double jitter = 0.1;
   bool no_cache = false;
@@ -102,6 +103,7 @@ int run_sgpr_train(const SgprTrainArgs& args) {
   options.optimizer.weight_decay = args.weight_decay;
   options.pairs_per_epoch = args.pairs_per_epoch;
   options.hard_fraction = args.hard_fraction;
+  options.pairs.positive_min_gap = args.positive_min_gap;
   options.augment.node_dropout = args.dropout;
   options.augment.jitter_sigma = args.jitter;
   options.augment.jitter_clip = 3.0 * args.jitter;
@@ -167,6 +169,9 @@ std::function<int()> add_sgpr_train_options(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--hard-fraction", args->hard_fraction, "Share of the negatives mined from the current model")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--positive-min-gap", args->positive_min_gap,
+                 "Positives at least this many frames apart in their sequence (0: all pairs within 3 m, as SGPR)")
       ->capture_default_str();
   app.add_option("--node-dropout", args->dropout, "Augmentation: probability of dropping each node")
       ->check(CLI::Range(0.0, 0.9))

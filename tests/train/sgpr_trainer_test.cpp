@@ -131,6 +131,26 @@ TEST(SgprTrainingData, PairsFollowTheDistanceThresholds) {
     EXPECT_GT((street.positions[j] - street.positions[0]).norm(), 20.0);
 }
 
+TEST(SgprTrainingData, MinimumGapKeepsOnlyRevisitsAsPositives) {
+  // The street is driven out and back: neighbouring frames and the return
+  // pass both give positives; a gap of 20 frames keeps revisits only.
+  const GraphSequence street = testing::synthetic_street(4, 60.0);
+  const auto all = positive_pairs(std::span(&street, 1), PairRecipe{});
+  PairRecipe revisits;
+  revisits.positive_min_gap = 20;
+  const auto far = positive_pairs(std::span(&street, 1), revisits);
+  ASSERT_FALSE(far.empty());
+  EXPECT_LT(far.size(), all.size());
+  std::size_t near_in_all = 0;
+  for (const auto& p : all) near_in_all += p.second - p.first < 20;
+  EXPECT_GT(near_in_all, 0U);
+  for (const auto& p : far) {
+    EXPECT_GE(p.second - p.first, 20U);
+    EXPECT_LE((street.positions[p.first] - street.positions[p.second]).norm(), 3.0);
+  }
+  EXPECT_EQ(far.size(), all.size() - near_in_all);
+}
+
 TEST(SgprTrainingData, AugmentationIsARigidMotionWithoutNoise) {
   const GraphSequence street = testing::synthetic_street(4, 60.0);
   const SemanticGraph& g = street.graphs[5];

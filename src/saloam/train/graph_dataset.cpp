@@ -309,7 +309,7 @@ std::vector<TrainingPair> positive_pairs(std::span<const GraphSequence> sequence
   for (std::uint32_t s = 0; s < sequences.size(); ++s) {
     const auto& p = sequences[s].positions;
     for (std::uint32_t i = 0; i < p.size(); ++i)
-      for (std::uint32_t j = i + 1; j < p.size(); ++j)
+      for (std::uint32_t j = i + std::max<std::uint32_t>(recipe.positive_min_gap, 1); j < p.size(); ++j)
         if ((p[i] - p[j]).squaredNorm() <= limit) pairs.push_back({s, i, j, true});
   }
   return pairs;

@@ -81,6 +81,12 @@ struct TrainingPair {
 struct PairRecipe {
   double positive_distance = 3.0;   ///< [m] SGPR: positives within 3 m
   double negative_distance = 20.0;  ///< [m] negatives beyond 20 m
+  /// Positives are at least this many frames apart in their sequence (SGPR:
+  /// 0, every pair). Pairs closer in the sequence are mostly scans taken
+  /// while the car stood or crept (near copies of one scan); a gap like the
+  /// evaluation's recent-frame exclusion keeps only revisits, the pairs a
+  /// loop detector has to find.
+  std::uint32_t positive_min_gap = 0;
 };
 
 /// Every positive pair (i < j) of every sequence.

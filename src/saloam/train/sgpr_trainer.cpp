@@ -137,6 +137,7 @@ nlohmann::json options_json(const SgprTrainOptions& o) {
           {"hard_pool", o.hard_pool},
           {"positive_distance", o.pairs.positive_distance},
           {"negative_distance", o.pairs.negative_distance},
+          {"positive_min_gap", o.pairs.positive_min_gap},
           {"validation_exclude_recent", o.validation.exclude_recent},
           {"augment",
            {{"max_rotation", o.augment.max_rotation},
@@ -362,9 +363,9 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
   if (options.batch < 1) throw ConfigError("--batch must be at least 1");
   const auto positives = positive_pairs(train, options.pairs);
   if (positives.empty())
-    throw ConfigError(fmt::format("the training data have no positive pair (two scans within {} m): add revisits or a "
-                                  "smaller frame step",
-                                  options.pairs.positive_distance));
+    throw ConfigError(fmt::format("the training data have no positive pair (two scans within {} m, at least {} frames "
+                                  "apart): add revisits, or a smaller frame step or --positive-min-gap",
+                                  options.pairs.positive_distance, options.pairs.positive_min_gap));
   set_training_threads(options.threads);
   create_folder(options.out);
   const nlohmann::json options_key = options_json(options);
