@@ -235,6 +235,7 @@ int run_place_eval(const PlaceEvalArgs& args) {
   info["positive_distance"] = args.protocol.positive_distance;
   info["negative_distance"] = args.protocol.negative_distance;
   info["exclude_recent"] = args.protocol.exclude_recent;
+  info["negative_share"] = args.protocol.negative_share;
   info["describe_ms_per_frame"] =
       n > skipped.size() ? 1000.0 * describe_seconds.load() / static_cast<double>(n - skipped.size()) : 0.0;
   info["describe_wall_s"] = describe_wall;
@@ -283,6 +284,12 @@ const CommandRegistration kRegistration{Command{
           ->capture_default_str();
       app.add_option("--exclude", args->protocol.exclude_recent, "most recent frames not compared with a query")
           ->check(non_negative_integer())
+          ->capture_default_str();
+      app.add_option("--negative-share", args->protocol.negative_share,
+                     "share of the negative pairs evaluated, the same pairs in every run (SGPR's pair lists: 0.005 "
+                     "with --exclude 0)")
+          ->check(CLI::Range(0.0, 1.0).description("(0, 1]"))
+          ->check([](const std::string& v) { return std::stod(v) > 0 ? std::string() : "must be more than 0"; })
           ->capture_default_str();
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
       app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");

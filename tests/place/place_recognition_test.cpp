@@ -95,5 +95,30 @@ TEST(PlacePairs, ProtocolDistancesAndExclusion) {
   EXPECT_FALSE(pairs.empty());
 }
 
+TEST(PlacePairs, NegativeShareKeepsEveryPositiveAndAFixedSubsetOfNegatives) {
+  std::vector<Eigen::Vector3d> positions;
+  for (int i = 0; i < 400; ++i) positions.emplace_back(i, 0, 0);
+  for (int i = 0; i < 20; ++i) positions.emplace_back(i, 1.0, 0);  // a second pass over the first 20 m
+  PlaceEvalConfig all;
+  PlaceEvalConfig sampled = all;
+  sampled.negative_share = 0.05;
+  const auto full = place_pairs(positions, all);
+  const auto part = place_pairs(positions, sampled);
+  std::size_t full_pos = 0, full_neg = 0, part_pos = 0, part_neg = 0;
+  for (const auto& p : full) (p.positive ? full_pos : full_neg) += 1;
+  for (const auto& p : part) (p.positive ? part_pos : part_neg) += 1;
+  EXPECT_EQ(part_pos, full_pos);
+  EXPECT_GT(full_pos, 0U);
+  const double share = static_cast<double>(part_neg) / static_cast<double>(full_neg);
+  EXPECT_NEAR(share, 0.05, 0.005) << part_neg << " of " << full_neg;
+  // The same pairs every time, and a subset of the full list.
+  const auto again = place_pairs(positions, sampled);
+  ASSERT_EQ(again.size(), part.size());
+  for (std::size_t k = 0; k < part.size(); ++k) {
+    EXPECT_EQ(again[k].query, part[k].query);
+    EXPECT_EQ(again[k].candidate, part[k].candidate);
+  }
+}
+
 }  // namespace
 }  // namespace saloam

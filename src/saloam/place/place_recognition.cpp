@@ -2,10 +2,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numeric>
 #include <stdexcept>
 
 namespace saloam {
+
+namespace {
+// A number in [0, 1) fixed by the pair (i, j) (SplitMix64's finaliser).
+double pair_draw(std::size_t i, std::size_t j) {
+  std::uint64_t z = (static_cast<std::uint64_t>(i) << 32) ^ static_cast<std::uint64_t>(j);
+  z += 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) * 0x1.0p-53;
+}
+}  // namespace
 
 std::vector<PlacePair> place_pairs(std::span<const Eigen::Vector3d> positions, const PlaceEvalConfig& config) {
   std::vector<PlacePair> pairs;
@@ -16,7 +29,7 @@ std::vector<PlacePair> place_pairs(std::span<const Eigen::Vector3d> positions, c
       const double d_sq = (positions[i] - positions[j]).squaredNorm();
       if (d_sq <= pos_sq)
         pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), true});
-      else if (d_sq > neg_sq)
+      else if (d_sq > neg_sq && (config.negative_share >= 1.0 || pair_draw(i, j) < config.negative_share))
         pairs.push_back({static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j), false});
     }
   }

@@ -18,6 +18,11 @@ struct PlaceEvalConfig {
   double positive_distance = 3.0;   ///< [m] pairs closer than this are matches
   double negative_distance = 20.0;  ///< [m] pairs farther than this are non-matches
   std::size_t exclude_recent = 50;  ///< frames just before the query that are not compared
+  /// Share of the negative pairs kept, drawn per pair by a fixed hash of its
+  /// frame indices (the same pairs in every run). 1 = all pairs. SGPR's own
+  /// pair lists keep 0.5 % of the negatives, and every pair within 3 m
+  /// however close in time (exclude_recent 0): an easier protocol.
+  double negative_share = 1.0;
 };
 
 /// One evaluated pair: query frame, earlier candidate frame, truth.
@@ -28,8 +33,9 @@ struct PlacePair {
 };
 
 /// All pairs (i, j) with j < i - exclude_recent whose distance is within
-/// positive_distance (positive) or beyond negative_distance (negative),
-/// ordered by query then candidate. Distances are between the positions given.
+/// positive_distance (positive) or beyond negative_distance (negative; a
+/// `negative_share` of them), ordered by query then candidate. Distances are
+/// between the positions given.
 std::vector<PlacePair> place_pairs(std::span<const Eigen::Vector3d> positions, const PlaceEvalConfig& config = {});
 
 struct PrPoint {
