@@ -222,7 +222,41 @@ TEST(Registration, SameResultWithAnyNumberOfThreads) {
     EXPECT_EQ(parallel.inlier_residual_sum, serial.inlier_residual_sum) << threads << " threads";
     EXPECT_EQ(parallel.inliers, serial.inliers) << threads << " threads";
     EXPECT_EQ(parallel.iterations, serial.iterations) << threads << " threads";
+    EXPECT_EQ(parallel.class_squared_residuals, serial.class_squared_residuals) << threads << " threads";
+    EXPECT_EQ(parallel.class_dof, serial.class_dof) << threads << " threads";
   }
+}
+
+TEST(Registration, PerClassResidualsMeasureEachClassNoise) {
+  // The walls measured with 3 cm of noise along their normals, the road
+  // exactly: the fit's per-class variances tell them apart.
+  std::mt19937 rng(11);
+  const ScanFeatures f = scene(rng);
+  const SemanticLocalMap map = map_of(f.edges, f.planars);
+  ScanFeatures scan = seen_from(f, Pose::Identity());
+  const auto road = static_cast<ClassIndex>(to_learning_class(cls::kRoad));
+  const auto building = static_cast<ClassIndex>(to_learning_class(cls::kBuilding));
+  std::normal_distribution<double> noise(0.0, 0.03);
+  for (std::size_t i = 0; i < scan.planars.size(); ++i) {
+    if (scan.planars.classes[i] != building) continue;
+    Eigen::Vector3d& p = scan.planars.points[i];
+    if (std::abs(p.x() - 12.0) < 1e-9) p.x() += noise(rng);  // the wall at x = 12
+    else p.y() += noise(rng);                                 // the walls at y = -9 and 14
+  }
+  const auto result =
+      register_scan(scan.edges, scan.planars, map, Pose::Identity(), RegistrationSettings::from_config(OdometryConfig{}));
+  ASSERT_TRUE(result.ok);
+  ASSERT_GT(result.class_dof[building], 500);
+  ASSERT_GT(result.class_dof[road], 200);
+  const double wall_sigma = std::sqrt(result.class_squared_residuals[building] / result.class_dof[building]);
+  const double road_sigma = std::sqrt(result.class_squared_residuals[road] / result.class_dof[road]);
+  // The map's planes are fitted to the noise-free walls; the residual is the
+  // added noise (a little less: the fit leans towards the noisy points).
+  EXPECT_NEAR(wall_sigma, 0.03, 0.008);
+  EXPECT_LT(road_sigma, 0.005);
+  // Edges give two degrees of freedom per residual, planes one.
+  const auto pole = static_cast<ClassIndex>(to_learning_class(cls::kPole));
+  EXPECT_EQ(result.class_dof[pole], 2.0 * result.edge_matches);
 }
 
 TEST(Registration, PlaneConstraintRejectsMislabelledPlanes) {

@@ -143,6 +143,10 @@ struct OdometryConfig {
   ClassValueMap class_voxel_size{{"default", 0.4}, {"pole", 0.1}, {"trunk", 0.1}, {"traffic-sign", 0.1}};
   /// w^l of Eq. 2: per-class residual weights (equal by default).
   ClassValueMap class_weight{{"default", 1.0}};
+  /// With semantics, scale each class's w^l by the pooled residual variance
+  /// over the class's own (inverse-variance weighting, estimated from the
+  /// last frames' fits): the paper's "automatic way for weights setting".
+  bool adaptive_class_weights = false;
   int threads = 1;               ///< worker threads for association (0 = all cores)
 };
 
@@ -301,6 +305,7 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("voxel_size", c.voxel_size, "[m] voxel size (label-agnostic)", Above{0});
   v("class_voxel_size", c.class_voxel_size, "[m] per-class voxel size", Above{0});
   v("class_weight", c.class_weight, "w^l: per-class residual weight", AtLeast{0});
+  v("adaptive_class_weights", c.adaptive_class_weights, "scale w^l by inverse residual variance per class");
   v("threads", c.threads, "threads (0 = all cores)", AtLeast{0});
 }
 

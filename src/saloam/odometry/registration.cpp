@@ -81,12 +81,18 @@ struct FitSums {
   int inliers = 0;
   double inlier_residual_sum = 0;
   Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  std::array<double, kNumClassIndices> class_squared_residuals{};
+  std::array<double, kNumClassIndices> class_dof{};
 
   FitSums& operator+=(const FitSums& o) {
     loss += o.loss;
     inliers += o.inliers;
     inlier_residual_sum += o.inlier_residual_sum;
     hessian += o.hessian;
+    for (int c = 0; c < kNumClassIndices; ++c) {
+      class_squared_residuals[c] += o.class_squared_residuals[c];
+      class_dof[c] += o.class_dof[c];
+    }
     return *this;
   }
 };
@@ -96,26 +102,31 @@ void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const 
                   const std::vector<PlaneMatch>& plane_matches, const Pose& T, const RegistrationSettings& settings,
                   RegistrationResult& result) {
   const double k = settings.robust_kernel_scale;
+  const double clip = kResidualClip * k;
   const auto term = [&](std::size_t i, FitSums& sum) {
-    auto add = [&](double distance, double class_weight, const auto& J) {
+    auto add = [&](double distance, ClassIndex c, double dof, const auto& J) {
+      const double class_weight = settings.class_weight[c];
       sum.loss += class_weight * distance;
       if (distance < settings.inlier_distance) {
         ++sum.inliers;
         sum.inlier_residual_sum += distance;
       }
       sum.hessian.noalias() += class_weight * huber_weight(distance, k) * J.transpose() * J;
+      const double clipped = std::min(distance, clip);
+      sum.class_squared_residuals[c] += clipped * clipped;
+      sum.class_dof[c] += dof;
     };
     visit_matched(
         i, edge_matches, plane_matches,
         [&](std::size_t e) {
           Eigen::Matrix<double, 3, 6> J;
           const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
-          add(r.norm(), settings.class_weight[edges.classes[e]], J);
+          add(r.norm(), edges.classes[e], 2.0, J);
         },
         [&](std::size_t p) {
           Eigen::Matrix<double, 1, 6> J;
           const double r = point_to_plane_residual(T, planars.points[p], plane_matches[p].plane, &J);
-          add(std::abs(r), settings.class_weight[planars.classes[p]], J);
+          add(std::abs(r), planars.classes[p], 1.0, J);
         });
   };
   const FitSums sums =
@@ -124,6 +135,8 @@ void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const 
   result.inliers = sums.inliers;
   result.inlier_residual_sum = sums.inlier_residual_sum;
   result.hessian = sums.hessian;
+  result.class_squared_residuals = sums.class_squared_residuals;
+  result.class_dof = sums.class_dof;
 }
 
 // Matches every feature at pose T to a line or plane fitted to its nearest

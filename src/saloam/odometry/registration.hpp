@@ -39,6 +39,10 @@ struct RegistrationSettings {
   static RegistrationSettings from_config(const OdometryConfig& config);
 };
 
+/// Residuals beyond this many robust kernel scales count as this many in
+/// RegistrationResult's per-class residual sums (outliers bounded).
+inline constexpr double kResidualClip = 3.0;
+
 struct RegistrationResult {
   Pose pose = Pose::Identity();
   int edge_matches = 0;
@@ -59,6 +63,12 @@ struct RegistrationResult {
   /// T * exp([rho; phi]) (sensor frame, translation first): the information
   /// of the pose up to the residuals' noise scale.
   Eigen::Matrix<double, 6, 6> hessian = Eigen::Matrix<double, 6, 6>::Zero();
+  /// Per matched class: sum of squared residuals, each clipped at
+  /// kResidualClip * robust_kernel_scale [m^2], and their degrees of freedom
+  /// (2 per point-to-line, 1 per point-to-plane residual): a class's residual
+  /// variance is the ratio.
+  std::array<double, kNumClassIndices> class_squared_residuals{};
+  std::array<double, kNumClassIndices> class_dof{};
 
   [[nodiscard]] int correspondences() const { return edge_matches + planar_matches; }
   [[nodiscard]] double mean_inlier_residual() const { return inliers > 0 ? inlier_residual_sum / inliers : 0.0; }

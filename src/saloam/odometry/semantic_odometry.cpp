@@ -31,6 +31,13 @@ constexpr int kBootstrapOuterIterations = 10;
 // direction (poles, corners, car ends) tell them apart, up to a frame's
 // travel away.
 constexpr double kBootstrapSearchRadius = 3.0;
+// Adaptive class weights: each frame's residual sums are added to the
+// running ones after scaling those by kResidualMemory (about ten frames of
+// memory); a class needs kMinClassDof degrees of freedom before its weight
+// moves, and the variance ratio is bounded to [1 / kMaxWeightRatio, kMaxWeightRatio].
+constexpr double kResidualMemory = 0.9;
+constexpr double kMinClassDof = 50;
+constexpr double kMaxWeightRatio = 4.0;
 constexpr double kBootstrapSettledTranslation = 0.01;           // [m]
 constexpr double kBootstrapSettledRotation = 0.1 * M_PI / 180;  // [rad]
 
@@ -51,6 +58,7 @@ SemanticOdometry::SemanticOdometry(OdometryConfig config)
       settings_(RegistrationSettings::from_config(config_)),
       voxel_sizes_(class_voxel_sizes(config_)),
       map_(SemanticLocalMap::from_config(config_)) {
+  configured_weights_ = settings_.class_weight;
   if (config_.threads != 1) {
     const int threads = config_.threads > 0 ? config_.threads
                                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -84,6 +92,7 @@ Pose SemanticOdometry::process(const LabelledCloud& cloud, double timestamp) {
   ScanFeatures features = downsample_and_deskew(measured, prediction);
   timing.deskew_downsample_ms = lap(&cpu.deskew_downsample_ms);
   const Pose sweep_pose = align(features, measured, prediction);
+  if (config_.adaptive_class_weights && config_.use_semantics) update_class_weights(last_stats_.registration);
   timing.registration_ms = lap(&cpu.registration_ms);
   update_map(features, sweep_pose);
   timing.map_update_ms = lap(&cpu.map_update_ms);
@@ -227,6 +236,26 @@ void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& swee
   }
   last_stats_.map_edge_points = map_.num_edge_points();
   last_stats_.map_planar_points = map_.num_planar_points();
+}
+
+void SemanticOdometry::update_class_weights(const RegistrationResult& fit) {
+  if (!fit.ok) return;
+  double squared = 0, dof = 0;
+  for (int c = 0; c < kNumClassIndices; ++c) {
+    class_squared_residuals_[c] = kResidualMemory * class_squared_residuals_[c] + fit.class_squared_residuals[c];
+    class_dof_[c] = kResidualMemory * class_dof_[c] + fit.class_dof[c];
+    squared += class_squared_residuals_[c];
+    dof += class_dof_[c];
+  }
+  if (dof <= 0 || squared <= 0) return;
+  const double pooled = squared / dof;
+  for (int c = 0; c < kNumClassIndices; ++c) {
+    double ratio = 1.0;
+    if (class_dof_[c] >= kMinClassDof && class_squared_residuals_[c] > 0) {
+      ratio = std::clamp(pooled / (class_squared_residuals_[c] / class_dof_[c]), 1.0 / kMaxWeightRatio, kMaxWeightRatio);
+    }
+    settings_.class_weight[c] = configured_weights_[c] * ratio;
+  }
 }
 
 Pose SemanticOdometry::record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp,

@@ -70,6 +70,10 @@ class SemanticOdometry {
   /// second frame, in frame 0's sensor frame at its pose instant.
   [[nodiscard]] const std::optional<ScanFeatures>& revised_first_features() const { return revised_first_; }
   [[nodiscard]] const OdometryConfig& config() const { return config_; }
+  /// w^l used for the next frame, per class index (matched class groups:
+  /// the group's index): the configured weights, scaled when
+  /// adaptive_class_weights is on.
+  [[nodiscard]] const std::array<double, kNumClassIndices>& class_weights() const { return settings_.class_weight; }
 
  private:
   /// Constant-velocity prediction of the next mid-sweep pose.
@@ -91,12 +95,18 @@ class SemanticOdometry {
   Pose coarse_start(ScanFeatures& features, const Pose& initial, const RegistrationSettings& settings,
                     const FeatureRefresh& refresh);
   void update_map(const ScanFeatures& features, const Pose& sweep_pose);
+  /// Adaptive class weights: folds the frame's per-class residuals into the
+  /// running variances and sets settings_.class_weight from them.
+  void update_class_weights(const RegistrationResult& fit);
   /// Stores the frame and returns its pose at the pose instant.
   Pose record_frame(ScanFeatures features, const Pose& sweep_pose, double timestamp, const FrameTimings& timing,
                     const FrameTimings& cpu_timing);
 
   OdometryConfig config_;
   RegistrationSettings settings_;
+  std::array<double, kNumClassIndices> configured_weights_{};  ///< w^l from the config
+  /// Exponentially averaged per-class squared residuals and their degrees of freedom.
+  std::array<double, kNumClassIndices> class_squared_residuals_{}, class_dof_{};
   ClassVoxelSizes voxel_sizes_;
   SemanticLocalMap map_;
   std::unique_ptr<tbb::task_arena> arena_;
