@@ -11,8 +11,10 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <type_traits>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -71,7 +73,36 @@ std::vector<GraphSequence> build_sequences(const std::vector<GraphSourceSpec>& s
   return sequences;
 }
 
-int run_sgpr_train(const SgprTrainArgs& args) {
+/// For --resume: the options of the run in `dir` (its checkpoint's) wherever
+/// the command line does not give them, so that `--resume DIR --epochs N`
+/// continues a run whatever options it was started with.
+SgprTrainArgs with_run_options(SgprTrainArgs args, const CLI::App& app, const fs::path& dir) {
+  const fs::path file = dir / "checkpoint" / "state.json";
+  std::ifstream in(file);
+  if (!in) return args;  // train_sgpr reports the missing checkpoint
+  const nlohmann::json state = nlohmann::json::parse(in, nullptr, false);
+  if (state.is_discarded() || !state.contains("options")) throw InputError(file, "not a checkpoint state");
+  const nlohmann::json& o = state["options"];
+  const auto take = [&](const char* option, const char* key, auto& value, const nlohmann::json& from) {
+    if (app.count(option) == 0 && from.contains(key)) value = from[key].get<std::decay_t<decltype(value)>>();
+  };
+  take("--batch", "batch", args.batch, o);
+  take("--seed", "seed", args.seed, o);
+  take("--threads", "threads", args.threads, o);
+  take("--lr", "learning_rate", args.lr, o);
+  take("--weight-decay", "weight_decay", args.weight_decay, o);
+  take("--pairs-per-epoch", "pairs_per_epoch", args.pairs_per_epoch, o);
+  take("--hard-fraction", "hard_fraction", args.hard_fraction, o);
+  take("--positive-min-gap", "positive_min_gap", args.positive_min_gap, o);
+  if (o.contains("augment")) {
+    take("--node-dropout", "node_dropout", args.dropout, o["augment"]);
+    take("--jitter", "jitter_sigma", args.jitter, o["augment"]);
+  }
+  return args;
+}
+
+int run_sgpr_train(const SgprTrainArgs& given, const CLI::App& app) {
+  const SgprTrainArgs args = given.resume.empty() ? given : with_run_options(given, app, given.resume);
   SgprTrainOptions options;
   if (!args.resume.empty()) {
     if (!args.out.empty() && fs::path(args.out) != fs::path(args.resume))
@@ -120,7 +151,8 @@ int run_sgpr_train(const SgprTrainArgs& args) {
   info["training_graphs"] = 0;
   for (const auto& s : train) info["training_graphs"] = info["training_graphs"].get<std::size_t>() + s.graphs.size();
   std::cout << fmt::format("sgpr-train: {} from {}, {} epochs, batch {}, lr {:g}, seed {}, {} thread(s)\n",
-                           options.resume ? "resuming" : "training", options.init.empty() ? "scratch" : options.init.string(),
+                           options.resume ? "resuming" : "training",
+                           options.resume ? options.out.string() : options.init.empty() ? "scratch" : options.init.string(),
                            options.epochs, options.batch, options.optimizer.learning_rate, options.seed, options.threads);
   double best = 0;
   const auto result = train_sgpr(train, validation, options, info, [&](const EpochRecord& r) {
@@ -180,7 +212,7 @@ std::function<int()> add_sgpr_train_options(CLI::App& app) {
       ->check(CLI::Range(0.0, 10.0))
       ->capture_default_str();
   app.add_flag("--no-cache", args->no_cache, "Rebuild the graphs instead of reusing OUT/graphs/");
-  return [args] { return run_sgpr_train(*args); };
+  return [args, &app] { return run_sgpr_train(*args, app); };
 }
 
 }  // namespace

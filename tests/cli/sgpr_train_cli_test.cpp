@@ -48,6 +48,11 @@ TEST(SgprTrainCli, TrainsOnASimulatedRecipeAndResumes) {
       << output;
   EXPECT_NE(output.find("epoch   2/2: loss"), std::string::npos) << output;
   EXPECT_EQ(output.find("epoch   1/2"), std::string::npos) << output;
+  // Options left out take the run's own; options that differ are refused.
+  ASSERT_EQ(run_command(quoted(cli_path()) + " -q sgpr-train --epochs 3 --resume " + quoted(out), &output), 0) << output;
+  EXPECT_NE(output.find("epoch   3/3: loss"), std::string::npos) << output;
+  EXPECT_NE(run_command(quoted(cli_path()) + " -q sgpr-train --epochs 4 --batch 8 --resume " + quoted(out), &output), 0);
+  EXPECT_NE(output.find("options differ"), std::string::npos) << output;
 }
 
 TEST(SgprTrainCli, BadRecipeNamesTheFile) {

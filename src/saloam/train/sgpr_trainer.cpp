@@ -334,6 +334,7 @@ ResumedRun resume_run(const fs::path& out, const nlohmann::json& options, const 
   nlohmann::json before = state["options"], now = options;
   before.erase("init");
   now.erase("init");
+  if (!before.contains("positive_min_gap")) before["positive_min_gap"] = 0;  // runs from before the option
   if (before != now)
     throw ConfigError(fmt::format("--resume: the options differ from those of the run in {} ({} there, {} now); resume "
                                   "with the same options (only --epochs may change)",
