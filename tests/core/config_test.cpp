@@ -74,6 +74,7 @@ TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
   expected.odometry.local_map_frames = 20;
   expected.odometry.local_map_point = "newest";
   expected.odometry.match_class_groups = false;
+  expected.odometry.adaptive_class_weights = false;
   expected.odometry.features.ground_edge_alpha = 0.1;
   expected.loop.acceptance = "loss";
   expected.loop.sigma = 0.05;
