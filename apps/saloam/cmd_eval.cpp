@@ -1,6 +1,7 @@
 // `saloam eval`: accuracy of an estimated trajectory against ground truth
 // (KITTI relative error, ATE, RPE) as Markdown, optionally JSON and a plot.
 
+#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
@@ -51,7 +52,21 @@ void make_frames_consistent(const EvalOptions& options, Trajectory& gt, Trajecto
   tum.poses = lidar_to_camera_poses(tum.poses, read_velo_to_cam(options.calib_file));
 }
 
+/// A simulated sequence whose trajectory's heights do not fit one ground has
+/// poses_sensor.txt beside poses.txt: where the scans were really taken. An
+/// odometry drifts from those, so scoring it against poses.txt adds the
+/// trajectory's own height errors to its error.
+void warn_if_scans_were_taken_elsewhere(const std::filesystem::path& gt_file) {
+  if (gt_file.filename() != "poses.txt") return;
+  const auto sensor = gt_file.parent_path() / "poses_sensor.txt";
+  if (!std::filesystem::is_regular_file(sensor)) return;
+  spdlog::warn("{} has {} beside it: the simulator took this sequence's scans there (it rode the sensor on the ground "
+               "where the trajectory's heights do not fit one); score an odometry against --gt {}",
+               gt_file.string(), sensor.filename().string(), sensor.string());
+}
+
 int run_eval(const EvalOptions& options) {
+  warn_if_scans_were_taken_elsewhere(options.gt_file);
   TrajectoryFormat gt_format{}, est_format{};
   Trajectory gt = read_trajectory(options.gt_file, &gt_format);
   Trajectory est = read_trajectory(options.est_file, &est_format);

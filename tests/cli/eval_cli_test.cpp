@@ -1,5 +1,6 @@
 // End-to-end: `saloam eval` on the real KITTI 00 estimates and on bad files.
 
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -77,6 +78,24 @@ TEST(EvalCli, Sim3AlignmentAndShorterEstimate) {
   EXPECT_EQ(j.at("alignment"), "sim3");
   EXPECT_GT(j.at("ate").at("scale").get<double>(), 0.9);
   EXPECT_LT(j.at("ate").at("scale").get<double>(), 1.1);
+}
+
+// A simulated sequence with poses_sensor.txt beside poses.txt: scoring
+// against poses.txt works but says which file holds the scans' poses.
+TEST(EvalCli, PointsToTheSensorPosesOfASimulatedSequence) {
+  TempDir dir;
+  std::ofstream gt(dir / "poses.txt");
+  for (int i = 0; i < 30; ++i) gt << "1 0 0 0 0 1 0 0 0 0 1 " << i << "\n";
+  gt.close();
+  std::filesystem::copy_file(dir / "poses.txt", dir / "est.txt");
+  const std::string command =
+      quoted(cli_path()) + " eval --gt " + quoted(dir / "poses.txt") + " --est " + quoted(dir / "est.txt");
+  std::string output;
+  ASSERT_EQ(run_command(command, &output), 0) << output;
+  EXPECT_EQ(output.find("poses_sensor.txt"), std::string::npos) << output;
+  std::filesystem::copy_file(dir / "poses.txt", dir / "poses_sensor.txt");
+  ASSERT_EQ(run_command(command, &output), 0) << output;
+  EXPECT_NE(output.find("score an odometry against --gt"), std::string::npos) << output;
 }
 
 TEST(EvalCli, MalformedPoseFileNamesFileAndLine) {
