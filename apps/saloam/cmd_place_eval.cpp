@@ -288,8 +288,8 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--negative-share", args->protocol.negative_share,
                      "share of the negative pairs evaluated, the same pairs in every run (SGPR's pair lists: 0.005 "
                      "with --exclude 0)")
-          ->check(CLI::Range(0.0, 1.0).description("(0, 1]"))
-          ->check([](const std::string& v) { return std::stod(v) > 0 ? std::string() : "must be more than 0"; })
+          ->check(positive_number())
+          ->check(CLI::Range(0.0, 1.0))
           ->capture_default_str();
       app.add_flag("--no-instances", args->no_instances, "Ignore instance ids when building graphs");
       app.add_flag("--save-graphs", args->save_graphs, "Also write every frame's graph to OUT/graphs/");

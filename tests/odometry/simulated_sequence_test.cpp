@@ -15,6 +15,11 @@
 namespace saloam {
 namespace {
 
+// Feeds every scan of the sequence to the odometry.
+void register_all(SemanticOdometry& odometry, const SequenceReader& reader) {
+  for (std::size_t i = 0; i < reader.size(); ++i) odometry.register_frame(reader.load_scan(i), reader.times()[i]);
+}
+
 struct Drift {
   double final_error;    // [m]
   double path_length;    // [m]
@@ -29,7 +34,7 @@ Drift run(const std::filesystem::path& dir, bool semantics, bool deskew) {
   options.ignore_labels = !semantics;
   const SequenceReader reader(dir, options);
   SemanticOdometry odometry(config);
-  for (std::size_t i = 0; i < reader.size(); ++i) odometry.register_frame(reader.load_scan(i), reader.times()[i]);
+  register_all(odometry, reader);
   const auto gt = reader.lidar_poses();
   Drift d{0, 0, 0};
   for (std::size_t i = 1; i < gt.size(); ++i) {
@@ -78,7 +83,7 @@ TEST(SimulatedSequence, FastStandingStartAlongAHedgedStreet) {
   ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 20u);
   const SequenceReader reader(dir.path());
   SemanticOdometry odometry{OdometryConfig{}};
-  for (std::size_t i = 0; i < reader.size(); ++i) odometry.register_frame(reader.load_scan(i), reader.times()[i]);
+  register_all(odometry, reader);
   const auto gt = reader.lidar_poses();
   for (std::size_t i = 1; i < gt.size(); ++i) {
     const Pose truth = gt[i - 1].inverse() * gt[i];
@@ -105,7 +110,7 @@ TEST(SimulatedSequence, AdaptiveClassWeightsFollowTheResidualNoise) {
   OdometryConfig config;
   config.adaptive_class_weights = true;
   SemanticOdometry odometry(config);
-  for (std::size_t i = 0; i < reader.size(); ++i) odometry.register_frame(reader.load_scan(i), reader.times()[i]);
+  register_all(odometry, reader);
   const auto group = [](std::uint16_t raw) { return class_group(static_cast<ClassIndex>(to_learning_class(raw))); };
   const auto& w = odometry.class_weights();
   EXPECT_LT(w[group(cls::kVegetation)], w[group(cls::kRoad)]);

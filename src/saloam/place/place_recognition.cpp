@@ -6,17 +6,14 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "saloam/core/hash.hpp"
+
 namespace saloam {
 
 namespace {
-// A number in [0, 1) fixed by the pair (i, j) (SplitMix64's finaliser).
+// A number in [0, 1) fixed by the pair (i, j).
 double pair_draw(std::size_t i, std::size_t j) {
-  std::uint64_t z = (static_cast<std::uint64_t>(i) << 32) ^ static_cast<std::uint64_t>(j);
-  z += 0x9e3779b97f4a7c15ULL;
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  z ^= z >> 31;
-  return static_cast<double>(z >> 11) * 0x1.0p-53;
+  return hash_to_unit(mix64((static_cast<std::uint64_t>(i) << 32) ^ static_cast<std::uint64_t>(j)));
 }
 }  // namespace
 

@@ -6,35 +6,18 @@
 #include <cmath>
 #include <cstdint>
 
+#include "saloam/core/hash.hpp"
+
 namespace saloam {
-
-/// SplitMix64 finaliser: a good 64-bit mixing function.
-constexpr std::uint64_t mix64(std::uint64_t x) {
-  x += 0x9E3779B97F4A7C15ull;
-  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
-  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
-  return x ^ (x >> 31);
-}
-
-/// Hash of several integers (order matters).
-constexpr std::uint64_t hash_combine(std::uint64_t a, std::uint64_t b) { return mix64(a ^ mix64(b + 0x632BE59BD9B4E019ull)); }
-constexpr std::uint64_t hash3(std::uint64_t a, std::uint64_t b, std::uint64_t c) {
-  return hash_combine(hash_combine(a, b), c);
-}
-
-/// Uniform double in [0, 1) from a hash.
-inline double hash_to_unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
 
 /// xoshiro-like generator built on SplitMix64 (period 2^64, plenty here).
 class Rng {
  public:
   explicit Rng(std::uint64_t seed) : state_(mix64(seed)) {}
   std::uint64_t next() {
+    const std::uint64_t z = mix64(state_);  // mixes state_ + the SplitMix64 increment
     state_ += 0x9E3779B97F4A7C15ull;
-    std::uint64_t z = state_;
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
+    return z;
   }
   /// Uniform in [0, 1).
   double uniform() { return hash_to_unit(next()); }
