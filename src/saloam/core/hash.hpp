@@ -21,6 +21,14 @@ constexpr std::uint64_t hash3(std::uint64_t a, std::uint64_t b, std::uint64_t c)
   return hash_combine(hash_combine(a, b), c);
 }
 
+/// Cheap finaliser for hash-table keys: folds the high bits into the low
+/// ones, which open-addressing tables index their buckets by.
+constexpr std::uint64_t fold_to_low_bits(std::uint64_t h) {
+  h ^= h >> 29;
+  h *= 0xbf58476d1ce4e5b9ull;
+  return h ^ (h >> 32);
+}
+
 /// Uniform double in [0, 1) from a hash.
 inline double hash_to_unit(std::uint64_t h) { return static_cast<double>(h >> 11) * 0x1.0p-53; }
 

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <tsl/robin_map.h>
 
+#include "saloam/core/hash.hpp"
 #include "saloam/core/types.hpp"
 
 namespace saloam {
@@ -52,10 +53,7 @@ class SemanticMap {
       std::uint64_t h = static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.x())) * 73856093u ^
                         static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.y())) * 19349669u ^
                         static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.z())) * 83492791u;
-      h ^= h >> 29;
-      h *= 0xbf58476d1ce4e5b9ull;
-      h ^= h >> 32;
-      return static_cast<std::size_t>(h);
+      return static_cast<std::size_t>(fold_to_low_bits(h));
     }
   };
 

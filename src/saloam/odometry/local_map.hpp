@@ -20,6 +20,7 @@
 #include <tsl/robin_map.h>
 
 #include "saloam/core/config.hpp"
+#include "saloam/core/hash.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/odometry/features.hpp"
 
@@ -52,10 +53,7 @@ struct VoxelKeyHash {
                       static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.y)) * 19349669u ^
                       static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.z)) * 83492791u ^
                       static_cast<std::uint64_t>(static_cast<std::uint32_t>(k.c)) * 2654435761u;
-    h ^= h >> 29;
-    h *= 0xbf58476d1ce4e5b9ull;
-    h ^= h >> 32;
-    return static_cast<std::size_t>(h);
+    return static_cast<std::size_t>(fold_to_low_bits(h));
   }
 };
 /// The cell of edge `cell_size` that contains p, for class c.

@@ -9,6 +9,7 @@
 
 #include <nanoflann.hpp>
 
+#include "saloam/core/hash.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -80,10 +81,7 @@ class CellTable {
 
  private:
   [[nodiscard]] std::size_t hash(std::uint64_t key) const {
-    key ^= key >> 29;
-    key *= 0xbf58476d1ce4e5b9ULL;
-    key ^= key >> 32;
-    return static_cast<std::size_t>(key) & mask_;
+    return static_cast<std::size_t>(fold_to_low_bits(key)) & mask_;
   }
   std::vector<std::uint64_t> keys_;
   std::vector<std::uint32_t> values_;
