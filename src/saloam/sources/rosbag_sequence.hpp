@@ -1,0 +1,91 @@
+#pragma once
+// A ROS 1 bag (format 2.0) as a ScanSequence: the sensor_msgs/PointCloud2
+// messages of one topic, in the bag's time order. Read through Debian's
+// rosbag_storage (librosbag-storage-dev: chunks, bz2/lz4 compression,
+// indexes, connections), with each message's bytes parsed and checked by
+// io/pointcloud2.hpp. Times are the messages' header stamps (seconds since
+// the epoch); opening the bag reads every message of the topic once for them.
+// Scans are in the message's frame (header.frame_id, said in facts()); a bag
+// has no reference poses and no calibration: it runs in the LiDAR frame.
+//
+// Built only when rosbag_storage is found (rosbag_available()); otherwise
+// opening a bag is an InputError saying so.
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "saloam/sources/scan_sequence.hpp"
+
+namespace saloam {
+
+/// True when this build reads and writes ROS 1 bags.
+[[nodiscard]] bool rosbag_available();
+
+/// The "#ROSBAG V2.0\n" magic at the start of a bag.
+inline constexpr std::string_view kRosbagMagic = "#ROSBAG V2.0\n";
+
+struct BagTopic {
+  std::string topic;
+  std::string type;  ///< "sensor_msgs/PointCloud2"
+  std::size_t messages = 0;
+};
+
+/// The topics of a bag with their types and message counts, by topic name.
+/// InputError naming the bag when it is not a readable ROS 1 bag.
+std::vector<BagTopic> list_bag_topics(const std::filesystem::path& bag);
+
+class RosbagSequence final : public ScanSequence {
+ public:
+  /// Opens `bag` and picks `options.topic`, or the only PointCloud2 topic.
+  /// InputError naming the bag when it is unreadable, when the topic is not
+  /// a PointCloud2 topic of the bag or there is none, or when there are
+  /// several and none was named (the message lists them).
+  RosbagSequence(std::filesystem::path bag, const ScanSequenceOptions& options);
+  ~RosbagSequence() override;
+  RosbagSequence(const RosbagSequence&) = delete;
+  RosbagSequence& operator=(const RosbagSequence&) = delete;
+
+  [[nodiscard]] ScanFormat format() const override { return ScanFormat::kRosbag; }
+  [[nodiscard]] const std::filesystem::path& path() const override { return bag_; }
+  [[nodiscard]] std::string name() const override;
+  [[nodiscard]] std::size_t size() const override;
+  [[nodiscard]] const std::vector<double>& times() const override;
+  LabelledCloud scan(std::size_t i) override;
+  [[nodiscard]] ScanSequenceFacts facts() const override;
+
+  [[nodiscard]] const std::string& topic() const;
+  [[nodiscard]] std::string fields() const override;
+
+ private:
+  struct Impl;
+  std::filesystem::path bag_;
+  std::unique_ptr<Impl> impl_;
+};
+
+enum class BagCompression { kNone, kBz2, kLz4 };
+
+/// Writes PointCloud2 messages on one topic into a new bag (an existing file
+/// is replaced). The bag is complete when the writer is closed or destroyed.
+class PointCloud2BagWriter {
+ public:
+  PointCloud2BagWriter(const std::filesystem::path& bag, std::string topic, std::string frame_id,
+                       BagCompression compression = BagCompression::kNone);
+  ~PointCloud2BagWriter();
+  PointCloud2BagWriter(const PointCloud2BagWriter&) = delete;
+  PointCloud2BagWriter& operator=(const PointCloud2BagWriter&) = delete;
+
+  /// `stamp` [s since the epoch, >= 0] is the header stamp and the record
+  /// time (at least 1 ns, a bag's earliest); `topic` another topic than the
+  /// writer's, when given.
+  void write(const LabelledCloud& cloud, double stamp, const std::string& topic = {});
+  void close();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace saloam

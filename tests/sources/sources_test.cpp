@@ -1,0 +1,299 @@
+// Scan sequences in every layout: format detection, opening, and the round
+// trips of the issue's Done-when (a simulated sequence written in each
+// format reads back with the SemanticKITTI source's clouds, times and poses).
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/io/calibration.hpp"
+#include "saloam/io/pcd.hpp"
+#include "saloam/io/sequence.hpp"
+#include "saloam/io/trajectory_io.hpp"
+#include "saloam/sim/simulator.hpp"
+#include "saloam/sources/kitti_raw_drive.hpp"
+#include "saloam/sources/point_cloud_folder.hpp"
+#include "saloam/sources/rosbag_sequence.hpp"
+#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/sources/sequence_summary.hpp"
+#include "saloam/sources/sequence_writer.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::input_error_of;
+
+/// A short simulated SemanticKITTI sequence (16 beams, coarse azimuth: cheap).
+const fs::path& simulated_sequence() {
+  static testing::TempDir dir("saloam_sources_sim");
+  static const bool written = [] {
+    SimulationOptions options;
+    options.preset = "straight";
+    options.end_frame = 4;
+    options.beams = 16;
+    options.azimuth_steps = 600;
+    options.show_progress = false;
+    simulate_sequence(options, dir / "seq");
+    return true;
+  }();
+  (void)written;
+  static const fs::path seq = dir / "seq";
+  return seq;
+}
+
+/// Wraps a sequence and gives every scan rings and per-point times, as a
+/// real driver's clouds have.
+class WithPointFields final : public ScanSequence {
+ public:
+  explicit WithPointFields(ScanSequence& inner) : inner_(inner) {}
+  [[nodiscard]] ScanFormat format() const override { return inner_.format(); }
+  [[nodiscard]] const fs::path& path() const override { return inner_.path(); }
+  [[nodiscard]] std::size_t size() const override { return inner_.size(); }
+  [[nodiscard]] const std::vector<double>& times() const override { return inner_.times(); }
+  [[nodiscard]] bool has_labels() const override { return inner_.has_labels(); }
+  LabelledCloud scan(std::size_t i) override {
+    LabelledCloud c = inner_.scan(i);
+    c.ring.resize(c.size());
+    c.time.resize(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) {
+      c.ring[k] = static_cast<std::uint16_t>(k % 16);
+      c.time[k] = 0.1f * static_cast<float>(k) / static_cast<float>(c.size());
+    }
+    return c;
+  }
+  [[nodiscard]] std::optional<Pose> velo_to_cam() const override { return inner_.velo_to_cam(); }
+  [[nodiscard]] std::optional<std::vector<Pose>> reference_poses() const override { return inner_.reference_poses(); }
+
+ private:
+  ScanSequence& inner_;
+};
+
+SequenceWriteOptions layout(ScanFormat format) {
+  SequenceWriteOptions o;
+  o.format = format;
+  return o;
+}
+
+ScanSequenceOptions on_topic(const std::string& topic) {
+  ScanSequenceOptions o;
+  o.topic = topic;
+  return o;
+}
+
+void expect_same_scans(ScanSequence& a, ScanSequence& b, bool fields) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const LabelledCloud ca = a.scan(i), cb = b.scan(i);
+    ASSERT_EQ(ca.size(), cb.size()) << i;
+    for (std::size_t k = 0; k < ca.size(); ++k) {
+      ASSERT_EQ(ca.points[k], cb.points[k]) << i << " " << k;
+      ASSERT_EQ(ca.remission[k], cb.remission[k]) << i << " " << k;
+    }
+    if (fields) {
+      ASSERT_TRUE(cb.has_rings() && cb.has_times()) << i;
+      EXPECT_EQ(ca.ring, cb.ring);
+      EXPECT_EQ(ca.time, cb.time);
+    }
+  }
+}
+
+void expect_same_times(const ScanSequence& a, const ScanSequence& b, double tolerance) {
+  ASSERT_EQ(a.times().size(), b.times().size());
+  for (std::size_t i = 0; i < a.times().size(); ++i) EXPECT_NEAR(a.times()[i], b.times()[i], tolerance) << i;
+}
+
+/// Reference poses of both in the LiDAR frame agree within `tolerance` [m, and rad-ish].
+void expect_same_lidar_poses(const ScanSequence& a, const ScanSequence& b, double tolerance) {
+  const auto lidar = [](const ScanSequence& s) {
+    auto poses = *s.reference_poses();
+    return s.velo_to_cam() ? camera_to_lidar_poses(poses, *s.velo_to_cam()) : poses;
+  };
+  ASSERT_TRUE(a.reference_poses() && b.reference_poses());
+  const auto pa = lidar(a), pb = lidar(b);
+  ASSERT_EQ(pa.size(), pb.size());
+  for (std::size_t i = 0; i < pa.size(); ++i) {
+    EXPECT_LT((pa[i].matrix() - pb[i].matrix()).norm(), tolerance) << i;
+  }
+}
+
+TEST(Sources, FormatNames) {
+  EXPECT_EQ(format_name(ScanFormat::kKittiRaw), "kitti-raw");
+  EXPECT_EQ(scan_format_from_name("rosbag"), ScanFormat::kRosbag);
+  EXPECT_FALSE(scan_format_from_name("las").has_value());
+  EXPECT_EQ(scan_format_names().size(), 6u);
+}
+
+TEST(Sources, SemanticKittiFolderIsDetectedAndRead) {
+  const auto seq = open_scan_sequence(simulated_sequence());
+  EXPECT_EQ(seq->format(), ScanFormat::kSemanticKitti);
+  EXPECT_EQ(seq->size(), 4u);
+  EXPECT_TRUE(seq->has_labels());
+  EXPECT_TRUE(seq->velo_to_cam().has_value());
+  EXPECT_EQ(seq->reference_poses()->size(), 4u);
+  EXPECT_GT(seq->scan(0).size(), 1000u);
+}
+
+TEST(Sources, DetectionSaysWhatItLookedFor) {
+  testing::TempDir dir;
+  fs::create_directories(dir / "empty");
+  EXPECT_NE(input_error_of([&] { detect_scan_format(dir / "empty"); }).find("no scans found: expected velodyne/*.bin (SemanticKITTI)"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { detect_scan_format(dir / "nothing"); }).find("nothing: not found"), std::string::npos);
+  std::ofstream(dir / "empty" / "a.pcd") << "x";
+  std::ofstream(dir / "empty" / "b.ply") << "x";
+  EXPECT_NE(input_error_of([&] { detect_scan_format(dir / "empty"); }).find("both .pcd and .ply files"), std::string::npos);
+  std::ofstream(dir / "notes.txt") << "x";
+  EXPECT_NE(input_error_of([&] { detect_scan_format(dir / "notes.txt"); }).find("not a scan source"), std::string::npos);
+  std::ofstream(dir / "x.bag") << "#ROSBAG V1.2\n";
+  EXPECT_EQ(detect_scan_format(dir / "x.bag"), ScanFormat::kRosbag);
+  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "x.bag"); }).find("not a ROS 1 bag of format 2.0"), std::string::npos);
+}
+
+TEST(Sources, EveryPcdEncodingRoundTrips) {
+  auto source = open_scan_sequence(simulated_sequence());
+  WithPointFields with_fields(*source);
+  testing::TempDir dir;
+  for (const auto encoding : {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
+    if (encoding == PcdEncoding::kBinaryCompressed && !pcd_compression_available()) continue;
+    SCOPED_TRACE(static_cast<int>(encoding));
+    const fs::path out = dir / fmt::format("pcd{}", static_cast<int>(encoding));
+    write_scan_sequence(with_fields, out, [&] { auto o = layout(ScanFormat::kPcd); o.pcd = encoding; return o; }());
+    auto back = open_scan_sequence(out);
+    EXPECT_EQ(back->format(), ScanFormat::kPcd);
+    EXPECT_TRUE(back->has_labels());  // labels/ beside the scans
+    expect_same_scans(with_fields, *back, true);
+    expect_same_times(*source, *back, 1e-9);
+    expect_same_lidar_poses(*source, *back, 1e-6);
+    EXPECT_EQ(back->scan(1).label, source->scan(1).label);
+  }
+}
+
+TEST(Sources, EveryPlyEncodingRoundTrips) {
+  auto source = open_scan_sequence(simulated_sequence());
+  WithPointFields with_fields(*source);
+  testing::TempDir dir;
+  for (const auto encoding : {PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian, PlyEncoding::kBinaryBigEndian}) {
+    SCOPED_TRACE(static_cast<int>(encoding));
+    const fs::path out = dir / fmt::format("ply{}", static_cast<int>(encoding));
+    write_scan_sequence(with_fields, out, [&] { auto o = layout(ScanFormat::kPly); o.ply = encoding; return o; }());
+    auto back = open_scan_sequence(out);
+    EXPECT_EQ(back->format(), ScanFormat::kPly);
+    expect_same_scans(with_fields, *back, true);
+    expect_same_times(*source, *back, 1e-9);
+    expect_same_lidar_poses(*source, *back, 1e-6);
+  }
+}
+
+TEST(Sources, KittiRawRoundTripsWithOxtsPoses) {
+  auto source = open_scan_sequence(simulated_sequence());
+  testing::TempDir dir;
+  write_scan_sequence(*source, dir / "drive", layout(ScanFormat::kKittiRaw));
+  EXPECT_TRUE(fs::exists(dir / "drive/velodyne_points/data/0000000003.bin"));
+  EXPECT_TRUE(fs::exists(dir / "drive/oxts/data/0000000003.txt"));
+  auto back = open_scan_sequence(dir / "drive");
+  EXPECT_EQ(back->format(), ScanFormat::kKittiRaw);
+  EXPECT_FALSE(back->velo_to_cam().has_value());
+  expect_same_scans(*source, *back, false);
+  expect_same_times(*source, *back, 1e-6);
+  expect_same_lidar_poses(*source, *back, 1e-5);
+  const auto facts = back->facts().notes;
+  EXPECT_NE(facts.back().find("in the LiDAR frame via"), std::string::npos);
+}
+
+TEST(Sources, KittiRawWithoutOxtsOrTimestamps) {
+  testing::TempDir dir;
+  auto source = open_scan_sequence(simulated_sequence());
+  write_scan_sequence(*source, dir / "drive", layout(ScanFormat::kKittiRaw));
+  fs::remove_all(dir / "drive/oxts/data/0000000002.txt");
+  auto fewer = open_scan_sequence(dir / "drive");
+  EXPECT_FALSE(fewer->reference_poses().has_value());
+  EXPECT_NE(fewer->facts().notes.back().find("reference: none: "), std::string::npos);
+  fs::remove_all(dir / "drive/velodyne_points/timestamps.txt");
+  EXPECT_DOUBLE_EQ(open_scan_sequence(dir / "drive")->times()[3], 0.3);
+  fs::remove(dir / "drive/velodyne_points/data/0000000002.bin");
+  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "drive"); }).find("frame 3 follows 1: a scan is missing"), std::string::npos);
+}
+
+TEST(Sources, BagRoundTripsAndPicksItsTopic) {
+  if (!rosbag_available()) GTEST_SKIP() << "built without rosbag_storage";
+  auto source = open_scan_sequence(simulated_sequence());
+  WithPointFields with_fields(*source);
+  testing::TempDir dir;
+  write_scan_sequence(with_fields, dir / "a.bag", layout(ScanFormat::kRosbag));
+  auto back = open_scan_sequence(dir / "a.bag");
+  EXPECT_EQ(back->format(), ScanFormat::kRosbag);
+  expect_same_scans(with_fields, *back, true);
+  expect_same_times(*source, *back, 1e-8);
+  EXPECT_NE(back->name().find("(topic /points)"), std::string::npos);
+  const auto topics = list_bag_topics(dir / "a.bag");
+  ASSERT_EQ(topics.size(), 1u);
+  EXPECT_EQ(topics[0].messages, 4u);
+  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "a.bag", on_topic("/lidar")); }).find("no topic '/lidar'; the bag holds:\n  /points (sensor_msgs/PointCloud2, 4 messages)"), std::string::npos);
+}
+
+TEST(Sources, BagWithTwoCloudTopicsNeedsOne) {
+  if (!rosbag_available()) GTEST_SKIP() << "built without rosbag_storage";
+  testing::TempDir dir;
+  LabelledCloud cloud;
+  cloud.push_back({1, 2, 3}, 0.5f);
+  {
+    PointCloud2BagWriter writer(dir / "two.bag", "/front", "front");
+    writer.write(cloud, 10.0);
+    writer.write(cloud, 10.05, "/rear");
+    writer.write(cloud, 10.1);
+  }
+  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "two.bag"); })
+                .find("2 sensor_msgs/PointCloud2 topics: pick one with --topic:\n  /front (sensor_msgs/PointCloud2, 2 messages)\n  /rear"),
+            std::string::npos);
+  EXPECT_EQ(open_scan_sequence(dir / "two.bag", on_topic("/front"))->size(), 2u);
+  std::ofstream(dir / "bad.bag") << std::string(kRosbagMagic) << "garbage after the magic";
+  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "bad.bag"); }).find("bad.bag: unreadable ROS 1 bag"), std::string::npos);
+}
+
+TEST(Sources, FolderWithoutCalibRunsInTheLidarFrame) {
+  testing::TempDir dir;
+  LabelledCloud cloud;
+  cloud.push_back({1, 2, 3}, 0.5f);
+  write_pcd(dir / "1317042145.100000.pcd", cloud, PcdEncoding::kAscii);
+  write_pcd(dir / "1317042145.200000.pcd", cloud, PcdEncoding::kBinary);
+  auto seq = open_scan_sequence(dir.path());
+  EXPECT_EQ(seq->format(), ScanFormat::kPcd);
+  EXPECT_FALSE(seq->velo_to_cam().has_value());
+  EXPECT_FALSE(seq->reference_poses().has_value());
+  EXPECT_NEAR(seq->times()[1], 1317042145.2, 1e-6);
+  const auto notes = seq->facts().notes;
+  EXPECT_NE(std::find(notes.begin(), notes.end(), "calibration: none: runs in the LiDAR frame"), notes.end());
+  EXPECT_NE(std::find(notes.begin(), notes.end(), "times: from the file names"), notes.end());
+  // One file alone is a sequence of one scan.
+  EXPECT_EQ(open_scan_sequence(dir / "1317042145.100000.pcd")->size(), 1u);
+}
+
+TEST(Sources, WriterNeverOverwritesAnInput) {
+  auto source = open_scan_sequence(simulated_sequence());
+  EXPECT_NE(input_error_of([&] { write_scan_sequence(*source, simulated_sequence(), layout(ScanFormat::kPcd)); })
+                .find("exists and is not an empty folder"),
+            std::string::npos);
+}
+
+TEST(Sources, SummaryOfASimulatedSequence) {
+  auto seq = open_scan_sequence(simulated_sequence());
+  const SequenceSummary s = summarize(*seq, 2);
+  EXPECT_EQ(s.format, "semantickitti");
+  EXPECT_EQ(s.frames, 4u);
+  EXPECT_NEAR(s.median_interval, 0.1, 1e-9);
+  EXPECT_EQ(s.scans_read, 2u);
+  EXPECT_EQ(s.fields, "x y z remission");
+  ASSERT_TRUE(s.beams.has_value());
+  EXPECT_EQ(s.beams->beams, 16u) << static_cast<int>(s.beams->method);  // the simulator's 16 lasers
+  EXPECT_TRUE(s.labels && s.calibration);
+  EXPECT_EQ(s.reference_poses, 4u);
+  WithPointFields with_fields(*seq);
+  EXPECT_EQ(estimate_beams(with_fields.scan(0)).method, BeamMethod::kRingField);
+  EXPECT_EQ(estimate_beams(with_fields.scan(0)).beams, 16u);
+}
+
+}  // namespace
+}  // namespace saloam
