@@ -3,13 +3,16 @@
 // format reads back with the SemanticKITTI source's clouds, times and poses).
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
+#include <iterator>
 
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/pcd.hpp"
+#include "saloam/io/rosbag_structure.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
 #include "saloam/sim/simulator.hpp"
@@ -201,6 +204,19 @@ TEST(Sources, KittiRawRoundTripsWithOxtsPoses) {
   expect_same_lidar_poses(*source, *back, 1e-5);
   const auto facts = back->facts().notes;
   EXPECT_NE(facts.back().find("in the LiDAR frame via"), std::string::npos);
+
+  // Sweep bounds, when the drive has them.
+  std::vector<double> start, end;
+  for (const double t : source->times()) {
+    start.push_back(kKittiRawEpoch + t - 0.05);
+    end.push_back(kKittiRawEpoch + t + 0.0495);
+  }
+  write_kitti_timestamps(dir / "drive/velodyne_points/timestamps_start.txt", start);
+  write_kitti_timestamps(dir / "drive/velodyne_points/timestamps_end.txt", end);
+  const KittiRawDrive drive(dir / "drive", {});
+  ASSERT_TRUE(drive.sweep_durations().has_value());
+  EXPECT_NEAR(drive.sweep_durations()->at(2), 0.0995, 1e-6);
+  EXPECT_NEAR(drive.first_stamp(), kKittiRawEpoch, 1e-6);
 }
 
 TEST(Sources, KittiRawWithoutOxtsOrTimestamps) {
@@ -250,7 +266,41 @@ TEST(Sources, BagWithTwoCloudTopicsNeedsOne) {
             std::string::npos);
   EXPECT_EQ(open_scan_sequence(dir / "two.bag", on_topic("/front"))->size(), 2u);
   std::ofstream(dir / "bad.bag") << std::string(kRosbagMagic) << "garbage after the magic";
-  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "bad.bag"); }).find("bad.bag: unreadable ROS 1 bag"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "bad.bag"); }).find("bad.bag: corrupt ROS bag: record at byte 13: "), std::string::npos);
+}
+
+// rosbag_storage trusts a bag's lengths: a connection record claiming a
+// 4 GB header made it allocate 4 GB (found by fuzz/rosbag_fuzz.cpp). The
+// structure check rejects such a bag before rosbag reads it.
+TEST(Sources, CorruptBagLengthsAreCaughtBeforeRosbag) {
+  if (!rosbag_available()) GTEST_SKIP() << "built without rosbag_storage";
+  testing::TempDir dir;
+  LabelledCloud cloud;
+  cloud.push_back({1, 2, 3}, 0.5f);
+  {
+    PointCloud2BagWriter writer(dir / "a.bag", "/points", "velodyne");
+    writer.write(cloud, 10.0);
+  }
+  EXPECT_NO_THROW(check_rosbag_structure(dir / "a.bag"));
+  std::string bytes;
+  {
+    std::ifstream in(dir / "a.bag", std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const auto corrupt_at = [&](std::size_t at, std::uint32_t value) {
+    std::string copy = bytes;
+    std::memcpy(copy.data() + at, &value, 4);
+    std::ofstream(dir / "b.bag", std::ios::binary) << copy;
+    return input_error_of([&] { open_scan_sequence(dir / "b.bag"); });
+  };
+  // The connection record after index_pos (the index starts with it).
+  std::uint64_t index_pos = 0;
+  const auto field = bytes.find("index_pos=");
+  ASSERT_NE(field, std::string::npos);
+  std::memcpy(&index_pos, bytes.data() + field + 10, 8);
+  EXPECT_NE(corrupt_at(index_pos, 0xFFFFFFFFu).find(fmt::format("b.bag: corrupt ROS bag: record at byte {}: header of 4294967295 bytes runs past its end", index_pos)),
+            std::string::npos);
+  EXPECT_NE(corrupt_at(field + 10, 100).find("index_pos 100 is not the start of a record"), std::string::npos);
 }
 
 TEST(Sources, FolderWithoutCalibRunsInTheLidarFrame) {

@@ -62,7 +62,10 @@ void KittiRawDrive::read_times() {
     const auto b = read_kitti_timestamps(end);
     if (a.size() >= scans_.size() && b.size() >= scans_.size()) {
       std::vector<double> durations(scans_.size());
-      for (std::size_t i = 0; i < durations.size(); ++i) durations[i] = b[i] - a[i];
+      double sum = 0.0;
+      for (std::size_t i = 0; i < durations.size(); ++i) sum += durations[i] = b[i] - a[i];
+      facts_.notes.push_back(fmt::format("sweeps: {:.4f} s on average (timestamps_start/_end.txt)",
+                                         sum / static_cast<double>(durations.size())));
       sweep_durations_ = std::move(durations);
     }
   }

@@ -9,6 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/io/pointcloud2.hpp"
+#include "saloam/io/rosbag_structure.hpp"
 
 #ifdef SALOAM_HAVE_ROSBAG
 #include <rosbag/bag.h>
@@ -91,8 +92,10 @@ bool rosbag_available() {
 namespace {
 
 /// Runs `f`, turning rosbag's exceptions into an InputError naming the bag.
+/// rosbag's own console messages are off: the error says what went wrong.
 template <class F>
 auto guarded(const fs::path& bag, F&& f) {
+  console_bridge::setLogLevel(console_bridge::CONSOLE_BRIDGE_LOG_NONE);
   try {
     return f();
   } catch (const InputError&) {
@@ -149,6 +152,7 @@ struct RosbagSequence::Impl {
 
 std::vector<BagTopic> list_bag_topics(const fs::path& bag) {
   check_magic(bag);
+  check_rosbag_structure(bag);
   return guarded(bag, [&] {
     rosbag::Bag b(bag.string(), rosbag::bagmode::Read);
     return topics_of(b);
@@ -158,6 +162,7 @@ std::vector<BagTopic> list_bag_topics(const fs::path& bag) {
 RosbagSequence::RosbagSequence(fs::path bag, const ScanSequenceOptions& options)
     : bag_(std::move(bag)), impl_(std::make_unique<Impl>()) {
   check_magic(bag_);
+  check_rosbag_structure(bag_);  // every length and position, before rosbag trusts them
   guarded(bag_, [&] {
     impl_->bag.open(bag_.string(), rosbag::bagmode::Read);
     const auto topics = topics_of(impl_->bag);

@@ -5,6 +5,9 @@
 // indexes, connections), with each message's bytes parsed and checked by
 // io/pointcloud2.hpp. Times are the messages' header stamps (seconds since
 // the epoch); opening the bag reads every message of the topic once for them.
+// Before rosbag reads a bag, io/rosbag_structure.hpp checks every record
+// length and position in it (rosbag trusts them: a corrupt length made it
+// allocate 4 GB under the fuzzer).
 // Scans are in the message's frame (header.frame_id, said in facts()); a bag
 // has no reference poses and no calibration: it runs in the LiDAR frame.
 //
