@@ -1,0 +1,81 @@
+// `saloam info PATH`: what a scan source holds before anything runs on it:
+// format, frames, rate, duration, point fields, beams, labels, calibration,
+// reference poses.
+
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "command.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/sources/rosbag_sequence.hpp"
+#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/sources/sequence_summary.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct InfoArgs {
+  std::string path;
+  std::string format = "auto";
+  std::string topic;
+  std::size_t scans = 3;
+};
+
+std::string beams_text(const SequenceSummary& s) {
+  if (!s.beams) return "unknown";
+  switch (s.beams->method) {
+    case BeamMethod::kRingField: return fmt::format("{} (ring field)", s.beams->beams);
+    case BeamMethod::kAzimuthWraps: return fmt::format("about {} (azimuth wraps: points stored laser by laser)", s.beams->beams);
+    case BeamMethod::kElevation: break;
+  }
+  return fmt::format("about {} (elevation angles; no ring field)", s.beams->beams);
+}
+
+void print_summary(const ScanSequence& seq, const SequenceSummary& s, bool format_given) {
+  std::cout << seq.name() << '\n';
+  std::cout << fmt::format("  format:      {}{}\n", s.format, format_given ? "" : " (detected)");
+  const double duration = s.last_time - s.first_time;
+  std::cout << fmt::format("  frames:      {}, {:.3f} s from {:.6f} to {:.6f} s\n", s.frames, duration, s.first_time, s.last_time);
+  if (s.median_interval > 0.0) {
+    std::cout << fmt::format("  rate:        {:.2f} Hz (median interval {:.4f} s)\n", 1.0 / s.median_interval, s.median_interval);
+  }
+  std::cout << fmt::format("  fields:      {}\n", s.fields);
+  std::cout << fmt::format("  points:      {:.0f} per scan (mean of {} scans read)\n", s.mean_points, s.scans_read);
+  std::cout << fmt::format("  beams:       {}\n", beams_text(s));
+  std::cout << fmt::format("  point times: {}\n", s.per_point_times ? fmt::format("yes, spanning {:.4f} s in the first scan", s.sweep_seconds)
+                                                                     : std::string("no (de-skew uses the sweep model)"));
+  std::cout << fmt::format("  labels:      {}\n", s.labels ? "yes" : "no");
+  std::cout << fmt::format("  reference:   {}\n", s.reference_poses ? fmt::format("{} poses", *s.reference_poses) : std::string("none"));
+  for (const auto& note : s.notes) std::cout << "  - " << note << '\n';
+}
+
+int run_info(const InfoArgs& args) {
+  const auto format = scan_format_from_name(args.format);
+  if (!format) throw InputError(args.format, "unknown --format");
+  ScanSequenceOptions options;
+  options.format = *format;
+  options.topic = args.topic;
+  auto seq = open_scan_sequence(args.path, options);
+  const SequenceSummary summary = summarize(*seq, args.scans);
+  print_summary(*seq, summary, *format != ScanFormat::kAuto);
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "info", "What a scan source holds: format, frames, rate, fields, beams, duration, calibration, reference", 15,
+    [](CLI::App& app) {
+      auto args = std::make_shared<InfoArgs>();
+      app.add_option("path", args->path,
+                     "A SemanticKITTI sequence, a KITTI raw drive, a folder of .pcd or .ply files (or one file), a ROS 1 bag")
+          ->required();
+      app.add_option("--format", args->format, "auto (default: from the path), or the format to read it as")
+          ->check(CLI::IsMember(scan_format_names()));
+      app.add_option("--topic", args->topic, "Bag topic of sensor_msgs/PointCloud2 (default: the only one)");
+      app.add_option("--scans", args->scans, "Scans to read for fields, points and beams (default 3)")
+          ->check(positive_number());
+      return [args] { return run_info(*args); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli

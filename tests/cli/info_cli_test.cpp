@@ -1,0 +1,66 @@
+// End-to-end: `saloam info` on each kind of source, and on what is not one.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "saloam/io/pcd.hpp"
+#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/sources/sequence_writer.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::cli_path;
+using testing::quoted;
+using testing::run_command;
+using testing::TempDir;
+
+std::string info(const fs::path& path, const std::string& extra = "") {
+  return quoted(cli_path()) + " info " + quoted(path) + " " + extra;
+}
+
+TEST(InfoCli, SaysWhatEachSourceHolds) {
+  TempDir dir;
+  std::string output;
+  ASSERT_EQ(run_command(quoted(cli_path()) + " simulate --out " + quoted(dir / "seq") +
+                            " --preset straight --frames 0:3 --beams 16 --azimuth-steps 600",
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(run_command(info(dir / "seq"), &output), 0) << output;
+  EXPECT_NE(output.find("format:      semantickitti (detected)"), std::string::npos) << output;
+  EXPECT_NE(output.find("frames:      3, 0.200 s"), std::string::npos) << output;
+  EXPECT_NE(output.find("rate:        10.00 Hz"), std::string::npos) << output;
+  EXPECT_NE(output.find("beams:       about 16"), std::string::npos) << output;
+  EXPECT_NE(output.find("reference:   3 poses"), std::string::npos) << output;
+  EXPECT_NE(output.find("calibration: calib.txt"), std::string::npos) << output;
+
+  auto seq = open_scan_sequence(dir / "seq");
+  SequenceWriteOptions pcd;
+  pcd.format = ScanFormat::kPcd;
+  pcd.pcd = PcdEncoding::kAscii;
+  write_scan_sequence(*seq, dir / "pcd", pcd);
+  fs::remove(dir / "pcd" / "calib.txt");
+  ASSERT_EQ(run_command(info(dir / "pcd", "--scans 1"), &output), 0) << output;
+  EXPECT_NE(output.find("format:      pcd (detected)"), std::string::npos) << output;
+  EXPECT_NE(output.find("fields:      x y z intensity"), std::string::npos) << output;
+  EXPECT_NE(output.find("calibration: none: runs in the LiDAR frame"), std::string::npos) << output;
+  EXPECT_NE(output.find("point times: no"), std::string::npos) << output;
+}
+
+TEST(InfoCli, WhatIsNotASourceIsAnErrorSayingWhy) {
+  TempDir dir;
+  fs::create_directories(dir / "empty");
+  std::string output;
+  EXPECT_EQ(run_command(info(dir / "empty"), &output), 2);
+  EXPECT_NE(output.find("empty: no scans found: expected velodyne/*.bin (SemanticKITTI)"), std::string::npos) << output;
+  EXPECT_NE(run_command(info(dir / "empty", "--format las"), &output), 0);
+  EXPECT_NE(output.find("las"), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace saloam
