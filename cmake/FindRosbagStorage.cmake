@@ -5,6 +5,12 @@
 # saloam_rosbag_storage (rosbag_storage with what its headers and symbols need:
 # roscpp_serialization, rostime, cpp_common, console_bridge, Boost headers,
 # and the ROS 2 style include folders of pluginlib and class_loader).
+option(SALOAM_ROSBAG "Read ROS 1 bags when rosbag_storage is installed (OFF: build as without it)" ON)
+if(NOT SALOAM_ROSBAG)
+  set(SALOAM_HAVE_ROSBAG OFF)
+  message(STATUS "SALOAM_ROSBAG=OFF: ROS 1 bags are left out")
+  return()
+endif()
 find_path(SALOAM_ROSBAG_INCLUDE_DIR rosbag/bag.h)
 find_path(SALOAM_PLUGINLIB_INCLUDE_DIR pluginlib/class_loader.hpp PATH_SUFFIXES pluginlib)
 find_path(SALOAM_CLASS_LOADER_INCLUDE_DIR class_loader/class_loader.hpp PATH_SUFFIXES class_loader)

@@ -153,6 +153,10 @@ TEST(Sources, DetectionSaysWhatItLookedFor) {
   std::ofstream(dir / "x.bag") << "#ROSBAG V1.2\n";
   EXPECT_EQ(detect_scan_format(dir / "x.bag"), ScanFormat::kRosbag);
   EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "x.bag"); }).find("not a ROS 1 bag of format 2.0"), std::string::npos);
+  if (!rosbag_available()) {  // a build without rosbag_storage says so
+    std::ofstream(dir / "y.bag") << kRosbagMagic;
+    EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "y.bag"); }).find("not built into this saloam"), std::string::npos);
+  }
 }
 
 TEST(Sources, EveryPcdEncodingRoundTrips) {

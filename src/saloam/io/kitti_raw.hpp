@@ -13,6 +13,10 @@
 //       "R: 9 numbers" (row-major) and "T: 3 numbers" [m]: p_velo = R p_imu + T
 //       (a "calib_time:" line is ignored)
 // The scans (velodyne_points/data/*.bin) are KITTI .bin files (scan_io.hpp).
+// No library: KITTI's raw-data devkit is MATLAB and sample C++ code, and
+// Debian packages none; convertOxtsToPose is a few lines, written out here
+// and checked against the published reference of drive 0005
+// (tests/io/kitti_raw_test.cpp).
 
 #include <cstddef>
 #include <filesystem>

@@ -150,7 +150,7 @@ PcdHeader parse_header(std::span<const std::byte> bytes, const std::filesystem::
   return header;
 }
 
-std::uint32_t load_u32(const std::byte* p) {
+[[maybe_unused]] std::uint32_t load_u32(const std::byte* p) {  // unused without liblzf
   std::uint32_t v;
   std::memcpy(&v, p, 4);
   return v;
@@ -160,6 +160,11 @@ std::uint32_t load_u32(const std::byte* p) {
 /// fields are stored one after another.
 std::vector<std::byte> decompress_fields(std::span<const std::byte> data, const PcdHeader& header,
                                          const std::filesystem::path& file) {
+#ifndef SALOAM_HAVE_LZF
+  (void)data;
+  (void)header;
+  throw InputError(file, "binary_compressed PCD is not built into this saloam (install liblzf-dev and rebuild)");
+#else
   if (data.size() < 8) throw InputError(file, "binary_compressed data shorter than its 8-byte size header");
   const std::size_t compressed = load_u32(data.data());
   const std::size_t size = load_u32(data.data() + 4);
@@ -173,7 +178,6 @@ std::vector<std::byte> decompress_fields(std::span<const std::byte> data, const 
   if (size > kMaxLzfRatio * compressed + 1024) {
     throw InputError(file, fmt::format("{} bytes cannot come from {} LZF bytes: corrupt header", size, compressed));
   }
-#ifdef SALOAM_HAVE_LZF
   std::vector<std::byte> fields(size);
   if (size > 0) {
     const unsigned got = lzf_decompress(data.data() + 8, static_cast<unsigned>(compressed), fields.data(),
@@ -189,8 +193,6 @@ std::vector<std::byte> decompress_fields(std::span<const std::byte> data, const 
     }
   }
   return records;
-#else
-  throw InputError(file, "binary_compressed PCD is not built into this saloam (install liblzf-dev and rebuild)");
 #endif
 }
 
