@@ -16,18 +16,17 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
-#include "saloam/core/frame_range.hpp"
-#include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/frame_range.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/eval/evaluation_report.hpp"
-#include "saloam/io/sequence.hpp"
-#include "saloam/odometry/semantic_odometry.hpp"
-#include "saloam/runs/frame_source.hpp"
-#include "saloam/runs/trajectory_writer.hpp"
+#include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
+#include "saloam/sim/simulated_source.hpp"
 #include "saloam/sim/simulator.hpp"
+#include "saloam/sources/open_source.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 
 namespace saloam::cli {
@@ -69,25 +68,6 @@ OdometryConfig without_semantics(OdometryConfig config) {
   config.use_semantics = false;
   return config;
 }
-
-const std::filesystem::path& created(const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
-  return folder;
-}
-
-class BaselineOdometry {
- public:
-  BaselineOdometry(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> tr)
-      : odometry_(without_semantics(config)),
-        writer_(created(out_dir) / "poses.txt", out_dir / "poses_tum.txt", tr) {}
-  void process(const LabelledCloud& scan, double t) { output_.push_back(writer_.write(t, odometry_.register_frame(scan, t))); }
-  [[nodiscard]] const std::vector<Pose>& output_poses() const { return output_; }
-
- private:
-  SemanticOdometry odometry_;
-  TrajectoryWriter writer_;
-  std::vector<Pose> output_;
-};
 
 std::uintmax_t disk_usage(const std::filesystem::path& folder) {
   std::uintmax_t bytes = 0;
@@ -140,6 +120,49 @@ void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequen
   }
 }
 
+/// The demo's frames: the simulator streaming them (it renders ahead on
+/// another thread while the SLAM runs, and writes them to `sequence_dir`
+/// only with --keep-sequence), or with --reuse the sequence kept earlier.
+struct DemoSource {
+  std::unique_ptr<SimulatedSequence> simulated;  ///< none when read from disk
+  std::unique_ptr<FrameSource> frames;           ///< declared last: destroyed first (it streams `simulated`)
+};
+
+DemoSource open_demo_source(const DemoOptions& options, const std::filesystem::path& sequence_dir, bool from_disk) {
+  DemoSource source;
+  if (from_disk) {
+    source.frames = open_source(sequence_dir, {});
+    return source;
+  }
+  std::filesystem::remove_all(sequence_dir);
+  source.simulated = std::make_unique<SimulatedSequence>(simulation_options(options));
+  const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
+  source.frames = add_stages(std::make_unique<SimulatedSource>(*source.simulated, 16, keep), {});
+  return source;
+}
+
+/// eval_baseline.{json,png}: the label-agnostic odometry against the ground truth.
+TrajectoryEvaluation evaluate_baseline(const std::filesystem::path& out, const std::vector<Pose>& ground_truth,
+                                       const std::vector<Pose>& baseline) {
+  const TrajectoryEvaluation evaluation = evaluate_trajectories(ground_truth, baseline);
+  const EvaluationLabels labels{"ground truth", "odometry_baseline/poses.txt"};
+  write_evaluation_json(out / "eval_baseline.json", evaluation, labels);
+  plot_evaluation(out / "eval_baseline.png", ground_truth, baseline, evaluation, labels);
+  return evaluation;
+}
+
+void print_outputs(const SlamRunResult& slam, double seconds, const std::filesystem::path& out) {
+  std::cout << fmt::format("\n{} frames in {:.0f} s; SLAM median {:.1f} Hz, loop closure {:.2f} ms/frame amortised; "
+                           "{:.0f} MB written to {}\n",
+                           slam.frames, seconds, 1000.0 / std::max(slam.median_frame_ms, 1e-9), slam.mean_loop_ms,
+                           static_cast<double>(disk_usage(out)) / 1e6, out.string());
+  std::cout << fmt::format("map: {}, {} (loop edges in orange)\n", (out / "slam/map.ply").string(),
+                           (out / "slam/map.png").string());
+  std::cout << fmt::format("plots: {}, {}\n", (out / "slam/trajectories.png").string(),
+                           (out / "slam/eval_slam.png").string());
+  std::cout << "trajectories: " << (out / "slam/poses.txt").string() << " (KITTI camera frame)\n";
+}
+
 int run_demo(const DemoOptions& options) {
   const auto t0 = std::chrono::steady_clock::now();
   SaloamConfig config = options.config.resolve();
@@ -151,62 +174,32 @@ int run_demo(const DemoOptions& options) {
   heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.preset, options.beams,
                       options.gt_labels ? "ground-truth" : "noisy (emulated network)",
                       from_disk ? " (reusing " + sequence_dir.string() + ")" : ""));
-  std::optional<SimulatedSequence> simulated;
-  std::optional<SimulatedSource> stream;
-  std::optional<SequenceReader> reader;
-  std::optional<SequenceFolderSource> folder;
-  FrameSource* source = nullptr;
-  if (from_disk) {
-    reader.emplace(sequence_dir);
-    source = &folder.emplace(*reader);
-  } else {
-    std::filesystem::remove_all(sequence_dir);
-    simulated.emplace(simulation_options(options));
-    // The simulator renders ahead on another thread while the SLAM runs; the
-    // scans are written to disk only with --keep-sequence.
-    const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
-    source = &stream.emplace(*simulated, 16, keep);
-  }
-  std::cout << fmt::format("{} frames; the simulator renders them {}\n", source->size(),
+  DemoSource source = open_demo_source(options, sequence_dir, from_disk);
+  const SourceInfo info = source.frames->info();
+  std::cout << fmt::format("{} frames; the simulator renders them {}\n", info.size(),
                            from_disk ? "from disk" : options.keep_sequence ? "ahead and writes them to " + sequence_dir.string()
                                                                              : "ahead, in memory");
-
-  std::optional<BaselineOdometry> baseline;
-  if (options.baseline) baseline.emplace(config.odometry, out / "odometry_baseline", source->velo_to_cam());
-  const std::size_t shown = source->size() / 2;
+  std::optional<OdometryRun> baseline;
+  if (options.baseline) {
+    create_folder(out / "odometry_baseline");
+    baseline.emplace(without_semantics(config.odometry), out / "odometry_baseline", info.velo_to_cam);
+  }
+  const std::size_t shown = info.size() / 2;
   SlamRunOptions run_options;
   run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
-    if (baseline) baseline->process(scan, t);
+    if (baseline) baseline->add(scan, t);
     if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
   };
-  const SlamRunResult slam = run_slam(*source, config, load_loop_network(config), out / "slam", run_options);
+  const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), out / "slam", run_options);
   if (slam.interrupted) return 130;
-  const std::optional<std::vector<Pose>> ground_truth = source->camera_poses();
-  source = nullptr;
-  stream.reset();  // stops the simulator's thread; finishes the kept sequence folder
+  source.frames.reset();  // stops the simulator's thread; finishes the kept sequence folder
 
   std::optional<TrajectoryEvaluation> baseline_eval;
-  if (baseline && ground_truth) {
-    const auto& gt = *ground_truth;
-    baseline_eval = evaluate_trajectories(gt, baseline->output_poses());
-    const EvaluationLabels labels{"ground truth", "odometry_baseline/poses.txt"};
-    write_evaluation_json(out / "eval_baseline.json", *baseline_eval, labels);
-    plot_evaluation(out / "eval_baseline.png", gt, baseline->output_poses(), *baseline_eval, labels);
-  }
-
+  if (baseline && info.camera_poses) baseline_eval = evaluate_baseline(out, *info.camera_poses, baseline->result().output_poses);
   heading("2/2 summary");
   print_summary(slam, baseline_eval);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  std::cout << fmt::format("\n{} frames in {:.0f} s; SLAM median {:.1f} Hz, loop closure {:.2f} ms/frame amortised; "
-                           "{:.0f} MB written to {}\n",
-                           slam.frames, seconds, 1000.0 / std::max(slam.median_frame_ms, 1e-9), slam.mean_loop_ms,
-                           static_cast<double>(disk_usage(out)) / 1e6, out.string());
-  std::cout << fmt::format("map: {}, {} (loop edges in orange)\n", (out / "slam/map.ply").string(),
-                           (out / "slam/map.png").string());
-  std::cout << fmt::format("plots: {}, {}\n", (out / "slam/trajectories.png").string(),
-                           (out / "slam/eval_slam.png").string());
-  std::cout << "trajectories: " << (out / "slam/poses.txt").string() << " (KITTI camera frame)\n";
-  write_view_page(out / "slam", simulated && !options.keep_sequence ? &*simulated : nullptr);
+  print_outputs(slam, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), out);
+  write_view_page(out / "slam", source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
   return 0;
 }
 

@@ -183,13 +183,12 @@ struct RunTruth {
 // its ground has sensor poses (poses_sensor.txt), where the scans were really
 // taken: loops are judged against them (poses.txt is wrong in height there,
 // as KITTI's).
-RunTruth run_truth(const FrameSource& source, const std::optional<Pose>& tr, std::size_t first, std::size_t frames) {
+RunTruth run_truth(const SourceInfo& source, const std::optional<Pose>& tr, std::size_t frames) {
   RunTruth truth;
-  const auto camera = source.camera_poses();
+  const auto& camera = source.camera_poses;
   if (!camera || frames == 0) return truth;
   const auto slice_of = [&](const std::vector<Pose>& all) {
-    std::vector<Pose> slice(all.begin() + static_cast<std::ptrdiff_t>(first),
-                            all.begin() + static_cast<std::ptrdiff_t>(first + frames));
+    std::vector<Pose> slice(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(frames));
     const Pose rebase = slice.front().inverse();  // world = first processed frame, as the estimates
     for (auto& p : slice) p = orthonormalized(rebase * p);
     return slice;
@@ -202,7 +201,7 @@ RunTruth run_truth(const FrameSource& source, const std::optional<Pose>& tr, std
   truth.camera = slice_of(*camera);
   if (!tr) return truth;
   truth.lidar = to_lidar(*truth.camera);
-  if (const auto sensor = source.sensor_camera_poses()) truth.sensor_lidar = to_lidar(slice_of(*sensor));
+  if (const auto& sensor = source.sensor_camera_poses) truth.sensor_lidar = to_lidar(slice_of(*sensor));
   return truth;
 }
 
@@ -218,17 +217,12 @@ nlohmann::json loop_summary_json(const LoopSummary& s) {
           {"missed_reverse_stretches", s.missed_reverse_stretches}};
 }
 
-// Where the frames came from, for `saloam view` (summary.json).
-struct RunOrigin {
-  std::optional<std::filesystem::path> sequence;  ///< the sequence folder; none for a stream
-  std::size_t first_frame = 0;
-};
-
 // Evaluates both trajectories and the loops against the ground truth (when
-// known) and writes eval_{odometry,slam}.{json,png} and summary.json.
+// known) and writes eval_{odometry,slam}.{json,png} and summary.json, with
+// where the frames came from for `saloam view` (the source's folder and first frame).
 void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunTruth& truth,
                   const std::vector<Pose>& odometry_out, const std::vector<Pose>& slam_out,
-                  const std::filesystem::path& out_dir, SlamRunResult& result, const RunOrigin& origin) {
+                  const std::filesystem::path& out_dir, SlamRunResult& result, const SourceInfo& origin) {
   nlohmann::json summary{{"first_frame", origin.first_frame},
                          {"frames", result.frames},
                          {"keyframes", result.keyframes},
@@ -262,7 +256,7 @@ void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunT
     }
     summary["loops"] = loop_summary_json(*result.loop_summary);
   }
-  if (origin.sequence) summary["sequence"] = std::filesystem::absolute(*origin.sequence).lexically_normal().string();
+  if (origin.folder) summary["sequence"] = std::filesystem::absolute(*origin.folder).lexically_normal().string();
   std::ofstream out(out_dir / "summary.json");
   if (!out) throw InputError(out_dir / "summary.json", "cannot write the run summary");
   out << summary.dump(2) << '\n';
@@ -300,66 +294,77 @@ SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
 
 }  // namespace
 
-SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
-                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
-  const std::size_t first = options.first_frame;
-  const std::size_t end = std::min(options.end_frame, source.size());
-  if (first >= end) throw ConfigError(fmt::format("empty frame range {}:{} ({} frames)", first, end, source.size()));
-  if (config.odometry.use_semantics && !source.has_labels()) {
-    spdlog::warn("{}: no labels found; running with every point in one class", source.name());
-  }
-  const std::optional<Pose> tr = output_velo_to_cam(source, options.no_calib);
-  prepare_output_folder(out_dir, source.folder());
+namespace {
 
-  // A stream cannot be read again for the map: keep what the map needs as it goes by.
-  SemanticMapOptions map_options;
-  map_options.voxel_size = config.slam.map_voxel_size;
-  const auto map_step = static_cast<std::size_t>(std::max(1, config.slam.map_frame_step));
-  std::optional<MapScanStore> map_scans;
-  if (options.write_map && !source.rereadable()) map_scans.emplace(map_options, map_step);
-
-  SlamSystem slam(config, std::move(network));
-  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
-  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
-  ProgressBar progress(end - first, "slam", options.show_progress);
+// The frame loop: every frame of `source` through the SLAM, the odometry's
+// poses written as they come, and a stream's scans kept for the map.
+double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& odometry_writer,
+                      std::optional<MapScanStore>& map_scans, const SlamRunOptions& options) {
+  const SourceInfo& info = source.info();
+  ProgressBar progress(info.size(), "slam", options.show_progress);
   const auto start = std::chrono::steady_clock::now();
-  for (std::size_t i = first; i < end && !stop_requested(); ++i) {
+  for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
     const LabelledCloud scan = source.scan(i);
-    const double t = source.times().at(i);
+    const double t = info.times.at(i);
     odometry_writer.write(t, slam.process(scan, t));
     if (options.on_scan) options.on_scan(i, scan, t);
-    if (map_scans) map_scans->offer(i - first, scan);
+    if (map_scans) map_scans->offer(i, scan);
     progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
     progress.advance();
   }
   progress.finish();
-  SlamRunResult result = summarize_run(slam, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
 
-  const std::vector<Pose> optimized = slam.optimized_poses();
+// Everything written after the frame loop: loop-closed poses, timing, loops,
+// graph map, trajectories and their evaluation.
+void write_results(const SlamSystem& slam, const std::vector<Pose>& optimized, TrajectoryWriter& slam_writer,
+                   const SaloamConfig& config, const SourceInfo& info, const std::optional<Pose>& tr,
+                   const std::filesystem::path& out_dir, SlamRunResult& result) {
   for (std::size_t i = 0; i < optimized.size(); ++i) slam_writer.write(slam.timestamps().at(i), optimized[i]);
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
-  const RunTruth truth = run_truth(source, tr, first, result.frames);
+  const RunTruth truth = run_truth(info, tr, result.frames);
   write_loops_csv(out_dir / "loops.csv", slam, truth.loop_reference());
   if (uses_sgpr(parse_place_detector(config.loop.detector))) write_graph_map(out_dir / "graph_map.json", slam);
   const std::vector<Pose> odometry_out = output_poses(slam.odometry_poses(), tr);
   const std::vector<Pose> slam_out = output_poses(optimized, tr);
   plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, truth.camera ? &*truth.camera : nullptr,
                     slam.accepted_loops());
-  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, RunOrigin{source.folder(), first});
+  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, info);
+}
+
+}  // namespace
+
+SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
+  const SourceInfo& info = source.info();
+  if (config.odometry.use_semantics && !info.has_labels) {
+    spdlog::warn("{}: no labels found; running with every point in one class", info.name);
+  }
+  const std::optional<Pose> tr = output_velo_to_cam(info);
+  prepare_output_folder(out_dir, info.folder);
+
+  // A stream cannot be read again for the map: keep what the map needs as it goes by.
+  SemanticMapOptions map_options;
+  map_options.voxel_size = config.slam.map_voxel_size;
+  const auto map_step = static_cast<std::size_t>(std::max(1, config.slam.map_frame_step));
+  std::optional<MapScanStore> map_scans;
+  if (options.write_map && !info.rereadable) map_scans.emplace(map_options, map_step);
+
+  SlamSystem slam(config, std::move(network));
+  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
+  SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options));
+  const std::vector<Pose> optimized = slam.optimized_poses();
+  write_results(slam, optimized, slam_writer, config, info, tr, out_dir, result);
 
   if (options.write_map && !result.interrupted) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)
-                                        : build_semantic_map(source, optimized, first, map_options, map_step,
+                                        : build_semantic_map(source, optimized, map_options, map_step,
                                                              options.show_progress);
     write_map_outputs(slam, map, optimized, out_dir);
   }
   return result;
-}
-
-SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
-                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
-  SequenceFolderSource source(reader);
-  return run_slam(source, config, std::move(network), out_dir, options);
 }
 
 }  // namespace saloam
