@@ -30,13 +30,6 @@ void print_frequency(const char* what, const Summary& s) {
       what, 1000.0 / s.median, s.median, 1000.0 / s.p95, s.p95, 1000.0 / s.max, s.max, s.mean);
 }
 
-std::vector<double> stage(const std::vector<FrameTimings>& timings, double FrameTimings::*member) {
-  std::vector<double> ms;
-  ms.reserve(timings.size());
-  for (const auto& t : timings) ms.push_back(t.*member);
-  return ms;
-}
-
 // With one thread the stage's CPU time is its cost, whatever else runs on the machine.
 void print_stages(const BenchResult& r, bool cpu_columns) {
   std::cout << "stage (wall)       median ms   mean ms    max ms" << (cpu_columns ? "   cpu: median ms   mean ms" : "")
@@ -45,10 +38,10 @@ void print_stages(const BenchResult& r, bool cpu_columns) {
                                      std::tuple{"deskew+downsample", &FrameTimings::deskew_downsample_ms},
                                      std::tuple{"registration", &FrameTimings::registration_ms},
                                      std::tuple{"map update", &FrameTimings::map_update_ms}}) {
-    const Summary s = summarize(stage(r.stage_wall_ms, member));
+    const Summary s = summarize(column(r.stage_wall_ms, member));
     std::cout << fmt::format("{:<18} {:>9.2f} {:>9.2f} {:>9.2f}", name, s.median, s.mean, s.max);
     if (cpu_columns) {
-      const Summary c = summarize(stage(r.stage_cpu_ms, member));
+      const Summary c = summarize(column(r.stage_cpu_ms, member));
       std::cout << fmt::format("   {:>14.2f} {:>9.2f}", c.median, c.mean);
     }
     std::cout << "\n";

@@ -7,7 +7,6 @@
 // scans reach the disk only with --keep-sequence. Evaluates both against the
 // ground truth and writes the semantic map and pictures.
 
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -20,6 +19,7 @@
 #include "saloam/core/files.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/slam_run.hpp"
@@ -164,7 +164,7 @@ void print_outputs(const SlamRunResult& slam, double seconds, const std::filesys
 }
 
 int run_demo(const DemoOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const StageTimer timer;
   SaloamConfig config = options.config.resolve();
   if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
   const std::filesystem::path out(options.out);
@@ -198,7 +198,7 @@ int run_demo(const DemoOptions& options) {
   if (baseline && info.camera_poses) baseline_eval = evaluate_baseline(out, *info.camera_poses, baseline->result().output_poses);
   heading("2/2 summary");
   print_summary(slam, baseline_eval);
-  print_outputs(slam, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), out);
+  print_outputs(slam, timer.elapsed_s(), out);
   write_view_page(out / "slam", source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
   return 0;
 }

@@ -5,6 +5,7 @@
 // change a result.
 
 #include <chrono>
+#include <functional>
 #include <vector>
 
 namespace saloam {
@@ -46,5 +47,15 @@ struct Summary {
   double median = 0, p95 = 0, mean = 0, max = 0, sum = 0;
 };
 Summary summarize(std::vector<double> values);
+
+/// One stage's times over the frames: get(row) for each per-frame row (a
+/// member pointer such as &FrameTimings::features_ms, or &FrameTimings::total_ms).
+template <class Row, class Get>
+std::vector<double> column(const std::vector<Row>& rows, Get get) {
+  std::vector<double> values;
+  values.reserve(rows.size());
+  for (const Row& row : rows) values.push_back(std::invoke(get, row));
+  return values;
+}
 
 }  // namespace saloam

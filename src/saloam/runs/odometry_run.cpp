@@ -1,8 +1,6 @@
 #include "saloam/runs/odometry_run.hpp"
 
-#include <algorithm>
 #include <fstream>
-#include <numeric>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -12,46 +10,25 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/runs/output_folder.hpp"
-#include "saloam/runs/timing_stats.hpp"
+#include "saloam/runs/timing_report.hpp"
 
 namespace saloam {
-namespace {
 
-std::vector<double> totals(const std::vector<FrameTimings>& timings) {
-  std::vector<double> total;
-  total.reserve(timings.size());
-  for (const auto& t : timings) total.push_back(t.total_ms());
-  return total;
-}
+double OdometryRunResult::median_frame_ms() const { return summarize(column(timings, &FrameTimings::total_ms)).median; }
 
-}  // namespace
-
-double OdometryRunResult::median_frame_ms() const { return median_of(totals(timings)); }
-
-double OdometryRunResult::worst_frame_ms() const {
-  const auto total = totals(timings);
-  return total.empty() ? 0.0 : *std::max_element(total.begin(), total.end());
-}
+double OdometryRunResult::worst_frame_ms() const { return summarize(column(timings, &FrameTimings::total_ms)).max; }
 
 void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings) {
-  std::vector<double> features, deskew, registration, map;
-  for (const auto& t : timings) {
-    features.push_back(t.features_ms);
-    deskew.push_back(t.deskew_downsample_ms);
-    registration.push_back(t.registration_ms);
-    map.push_back(t.map_update_ms);
-  }
-  const auto total = totals(timings);
-  const double med = median_of(total);
-  const double worst = total.empty() ? 0.0 : *std::max_element(total.begin(), total.end());
+  const std::vector<double> total = column(timings, &FrameTimings::total_ms);
+  const Summary frame = summarize(total);
   const nlohmann::json j{{"frames", total.size()},
-                         {"hz_median", med > 0 ? 1000.0 / med : 0.0},
-                         {"hz_worst_frame", worst > 0 ? 1000.0 / worst : 0.0},
+                         {"hz_median", hz(frame.median)},
+                         {"hz_worst_frame", hz(frame.max)},
                          {"stages",
-                          {{"features", stage_stats(features)},
-                           {"deskew_downsample", stage_stats(deskew)},
-                           {"registration", stage_stats(registration)},
-                           {"map_update", stage_stats(map)},
+                          {{"features", stage_stats(column(timings, &FrameTimings::features_ms))},
+                           {"deskew_downsample", stage_stats(column(timings, &FrameTimings::deskew_downsample_ms))},
+                           {"registration", stage_stats(column(timings, &FrameTimings::registration_ms))},
+                           {"map_update", stage_stats(column(timings, &FrameTimings::map_update_ms))},
                            {"total", stage_stats(total)}}},
                          {"frame_total_ms", total}};
   std::ofstream out(file);

@@ -1,11 +1,7 @@
 #include "saloam/runs/slam_run.hpp"
 
-#include <sys/resource.h>
-
 #include <algorithm>
-#include <chrono>
 #include <fstream>
-#include <numeric>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -23,19 +19,13 @@
 #include "saloam/runs/map_building.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
-#include "saloam/runs/timing_stats.hpp"
+#include "saloam/runs/timing_report.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam {
 
 namespace {
-
-double peak_rss_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
 
 std::string pose_numbers(const Pose& T) {
   double v[12];
@@ -88,34 +78,25 @@ void write_graph_map(const std::filesystem::path& file, const SlamSystem& slam) 
 }
 
 void write_timing(const std::filesystem::path& file, const SlamSystem& slam, double seconds, double rss_mib) {
-  std::vector<double> odometry, place, search, verification, optimization, loop, total;
-  for (const auto& t : slam.timings()) {
-    odometry.push_back(t.odometry_ms);
-    place.push_back(t.place_ms);
-    search.push_back(t.search_ms);
-    verification.push_back(t.verification_ms);
-    optimization.push_back(t.optimization_ms);
-    loop.push_back(t.loop_ms());
-    total.push_back(t.total_ms());
-  }
-  const double median = median_of(total);
-  const double mean = mean_of(total);
+  const auto& t = slam.timings();
+  const std::vector<double> total = column(t, &SlamFrameTimings::total_ms);
+  const Summary frame = summarize(total);
   const nlohmann::json j{
       {"frames", total.size()},
       {"keyframes", slam.keyframes().size()},
       {"optimizations", slam.optimizations()},
       {"wall_s", seconds},
-      {"hz_median", median > 0 ? 1000.0 / median : 0.0},
-      {"hz_mean", mean > 0 ? 1000.0 / mean : 0.0},
+      {"hz_median", hz(frame.median)},
+      {"hz_mean", hz(frame.mean)},
       {"peak_rss_mib", rss_mib},
       {"keyframe_store_mib", static_cast<double>(slam.keyframe_bytes()) / (1024.0 * 1024.0)},
       {"stages",
-       {{"odometry", stage_stats(odometry)},
-        {"place_descriptor", stage_stats(place)},
-        {"candidates_and_scoring", stage_stats(search)},
-        {"verification", stage_stats(verification)},
-        {"pose_graph", stage_stats(optimization)},
-        {"loop_closure_total", stage_stats(loop)},
+       {{"odometry", stage_stats(column(t, &SlamFrameTimings::odometry_ms))},
+        {"place_descriptor", stage_stats(column(t, &SlamFrameTimings::place_ms))},
+        {"candidates_and_scoring", stage_stats(column(t, &SlamFrameTimings::search_ms))},
+        {"verification", stage_stats(column(t, &SlamFrameTimings::verification_ms))},
+        {"pose_graph", stage_stats(column(t, &SlamFrameTimings::optimization_ms))},
+        {"loop_closure_total", stage_stats(column(t, &SlamFrameTimings::loop_ms))},
         {"total", stage_stats(total)}}}};
   std::ofstream out(file);
   if (!out) throw InputError(file, "cannot write timing file");
@@ -282,13 +263,8 @@ SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
   result.loops_accepted = slam.accepted_loops();
   result.loops_verified = slam.loops().size();
   result.peak_rss_mib = peak_rss_mib();
-  std::vector<double> totals, loops;
-  for (const auto& t : slam.timings()) {
-    totals.push_back(t.total_ms());
-    loops.push_back(t.loop_ms());
-  }
-  result.median_frame_ms = median_of(totals);
-  result.mean_loop_ms = mean_of(loops);
+  result.median_frame_ms = summarize(column(slam.timings(), &SlamFrameTimings::total_ms)).median;
+  result.mean_loop_ms = summarize(column(slam.timings(), &SlamFrameTimings::loop_ms)).mean;
   return result;
 }
 
@@ -302,7 +278,7 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
                       std::optional<MapScanStore>& map_scans, const SlamRunOptions& options) {
   const SourceInfo& info = source.info();
   ProgressBar progress(info.size(), "slam", options.show_progress);
-  const auto start = std::chrono::steady_clock::now();
+  const StageTimer timer;
   for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
     const LabelledCloud scan = source.scan(i);
     const double t = info.times.at(i);
@@ -313,7 +289,7 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
     progress.advance();
   }
   progress.finish();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return timer.elapsed_s();
 }
 
 // Everything written after the frame loop: loop-closed poses, timing, loops,
