@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <tuple>
 
 #include <fmt/format.h>
@@ -18,7 +19,7 @@ namespace {
 
 struct BenchOptions {
   SourceArgs source;
-  int threads = 1;
+  std::optional<int> threads;  ///< --threads; else the config's odometry.threads
   bool no_semantics = false;
   ConfigOptions config;
 };
@@ -50,7 +51,8 @@ void print_stages(const BenchResult& r, bool cpu_columns) {
 
 int run_bench_command(BenchOptions options) {
   SaloamConfig config = options.config.resolve();
-  config.odometry.threads = options.threads;
+  if (options.threads) config.odometry.threads = *options.threads;
+  const int threads = config.odometry.threads;
   if (options.no_semantics) config.odometry.use_semantics = false;
   options.source.no_calib = true;  // the bench writes no poses: calib.txt is not needed
   const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics);
@@ -58,14 +60,14 @@ int run_bench_command(BenchOptions options) {
   if (r.frames == 0) return 130;
 
   std::cout << fmt::format("saloam bench: {} frames of {} ({:.0f} points/scan), threads {}, semantics {}\n", r.frames,
-                           options.source.path, r.points_per_scan, options.threads, r.semantics ? "on" : "off");
+                           options.source.path, r.points_per_scan, threads, r.semantics ? "on" : "off");
   print_frequency("frequency:", summarize(r.frame_wall_ms));
   // CPU time of this thread: on a shared machine wall time includes waiting
   // for a core; with --threads 1 the thread's CPU time is the cost of the frame.
-  if (options.threads == 1) print_frequency("cpu time: ", summarize(r.frame_cpu_ms));
+  if (threads == 1) print_frequency("cpu time: ", summarize(r.frame_cpu_ms));
   double load[3] = {0, 0, 0};
   if (getloadavg(load, 3) > 0) std::cout << fmt::format("load average {:.2f} (wall time suffers above the core count)\n", load[0]);
-  print_stages(r, options.threads == 1);
+  print_stages(r, threads == 1);
   std::cout << fmt::format("per frame (mean): {:.0f} edge + {:.0f} planar features, local map {:.0f} edge + {:.0f} "
                            "planar points, {:.2f} association rounds\n",
                            r.edge_features, r.planar_features, r.map_edge_points, r.map_planar_points,
@@ -79,8 +81,8 @@ const CommandRegistration kRegistration{Command{
     [](CLI::App& app) {
       auto options = std::make_shared<BenchOptions>();
       options->source.add_to(app, "Sequence folder (velodyne/ ...)");
-      app.add_option("--threads", options->threads, "Worker threads (1 = single core, 0 = all)")
-          ->capture_default_str();
+      app.add_option("--threads", options->threads,
+                     "Worker threads (1 = single core, 0 = all); default: odometry.threads of the configuration");
       app.add_flag("--no-semantics", options->no_semantics, "Label-agnostic baseline");
       options->config.add_to(app);
       return [options] { return run_bench_command(*options); };

@@ -32,12 +32,18 @@
 namespace saloam::cli {
 namespace {
 
+/// The demo's route (it revisits places both ways); the other simulation
+/// defaults are SimulationOptions'.
+SimulationOptions demo_route() {
+  SimulationOptions sim;
+  sim.preset = "figure-eight";
+  return sim;
+}
+
 struct DemoOptions {
   std::string out = "demo_output";
-  std::string preset = "figure-eight";
+  SimulationOptions sim = demo_route();  ///< --preset, --beams, --seed
   std::string frames;
-  int beams = 64;
-  std::uint64_t seed = 1;
   bool gt_labels = false;
   bool keep_sequence = false;
   bool reuse = false;
@@ -48,10 +54,7 @@ struct DemoOptions {
 void heading(const std::string& text) { std::cout << "\n== " << text << " ==\n" << std::flush; }
 
 SimulationOptions simulation_options(const DemoOptions& options) {
-  SimulationOptions sim;
-  sim.preset = options.preset;
-  sim.beams = options.beams;
-  sim.seed = options.seed;
+  SimulationOptions sim = options.sim;
   sim.labels = options.gt_labels ? LabelMode::kGroundTruth : LabelMode::kNoisy;
   sim.show_progress = false;
   if (!options.frames.empty()) {
@@ -171,7 +174,8 @@ int run_demo(const DemoOptions& options) {
   const std::filesystem::path sequence_dir = out / "sequence";
   const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
 
-  heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.preset, options.beams,
+  heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.sim.preset,
+                      options.sim.beams,
                       options.gt_labels ? "ground-truth" : "noisy (emulated network)",
                       from_disk ? " (reusing " + sequence_dir.string() + ")" : ""));
   DemoSource source = open_demo_source(options, sequence_dir, from_disk);
@@ -208,10 +212,10 @@ const CommandRegistration kRegistration{Command{
     [](CLI::App& app) {
       auto options = std::make_shared<DemoOptions>();
       app.add_option("--out", options->out, "Output folder (default demo_output)");
-      app.add_option("--preset", options->preset, "Simulated route: figure-eight (default), urban-loop, straight");
+      app.add_option("--preset", options->sim.preset, "Simulated route: figure-eight (default), urban-loop, straight");
       app.add_option("--frames", options->frames, "Only frames A:B of the route (quicker runs)");
-      app.add_option("--beams", options->beams, "LiDAR beams: 64, 32 or 16")->check(CLI::IsMember({64, 32, 16}));
-      app.add_option("--seed", options->seed, "Simulation seed");
+      app.add_option("--beams", options->sim.beams, "LiDAR beams: 64, 32 or 16")->check(CLI::IsMember({64, 32, 16}));
+      app.add_option("--seed", options->sim.seed, "Simulation seed");
       app.add_flag("--gt-labels", options->gt_labels, "Use ground-truth labels instead of emulated network output");
       app.add_flag("--keep-sequence", options->keep_sequence,
                    "Also write the simulated sequence to OUT/sequence (about 2.4 MB per 64-beam scan)");

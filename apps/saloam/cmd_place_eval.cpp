@@ -50,7 +50,7 @@ void print_result(const PlaceEvalArgs& args, const PlaceEvalResult& r, const std
 int run_place_eval_command(PlaceEvalArgs args) {
   PlaceEvalOptions& run = args.run;
   if (!args.graphs.empty()) run.graphs = args.graphs;
-  run.use_instances = !args.no_instances;
+  run.graph.use_instances = !args.no_instances;
   run.check();  // before the sequence is read
   const SaloamConfig config = args.config.resolve();
   const PlaceDetector detector = parse_place_detector(run.method);

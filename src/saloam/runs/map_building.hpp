@@ -17,7 +17,7 @@ namespace saloam {
 /// SemanticMap and returns its points (world frame). The source must be
 /// rereadable.
 LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& lidar_poses,
-                                 const SemanticMapOptions& options, std::size_t frame_step = 1,
+                                 const SemanticMapOptions& options, std::size_t frame_step,
                                  bool show_progress = true);
 
 /// The scans of a streamed run that go into its map, kept as it goes by:

@@ -221,7 +221,7 @@ void write_summary(const std::filesystem::path& file, const SourceInfo& info, co
                    {"negative_pairs", r.summary.negatives}};
   if (uses_sgpr(parse_place_detector(options.method))) {
     j["model"] = options.model.string();
-    j["use_instances"] = options.use_instances;
+    j["use_instances"] = options.graph.use_instances;
     j["mean_nodes"] = r.mean_nodes;
   }
   if (options.graphs) j["graphs"] = std::filesystem::absolute(*options.graphs).string();
@@ -243,9 +243,7 @@ std::vector<Eigen::Vector3d> truth_positions(const SourceInfo& info) {
 PlaceRecognizer make_recognizer(PlaceDetector detector, const SaloamConfig& config, const PlaceEvalOptions& options) {
   std::optional<SgprNetwork> network;
   if (uses_sgpr(detector)) network.emplace(SgprNetwork::load(options.model));
-  GraphBuilderConfig graph_config;
-  graph_config.use_instances = options.use_instances;
-  return PlaceRecognizer(detector, std::move(network), graph_config, ScanContextConfig{}, config.loop.ssc);
+  return PlaceRecognizer(detector, std::move(network), options.graph, ScanContextConfig{}, config.loop.ssc);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@
 #include "saloam/core/config.hpp"
 #include "saloam/io/frame_source.hpp"
 #include "saloam/place/place_recognition.hpp"
+#include "saloam/place/semantic_graph.hpp"
 
 namespace saloam {
 
@@ -27,7 +28,7 @@ struct PlaceEvalOptions {
   std::string method = "sgpr";     ///< sgpr, scancontext, hybrid or ssc (parse_place_detector)
   std::filesystem::path model;     ///< SGPR weights, for the methods that use SGPR
   PlaceEvalConfig protocol;
-  bool use_instances = true;       ///< SGPR graphs: instance ids where the scans have them
+  GraphBuilderConfig graph;        ///< how SGPR's graphs are built (use_instances: --no-instances)
   /// SGPR: read every frame's graph from here (an earlier run's graphs/)
   /// instead of building it, to compare models on the very same graphs.
   std::optional<std::filesystem::path> graphs;

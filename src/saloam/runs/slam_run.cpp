@@ -225,8 +225,7 @@ void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunT
     summary["slam"] = evaluation_to_json(*result.slam_evaluation, slam_labels, false);
   }
   if (const std::vector<Pose>* reference = truth.loop_reference()) {
-    LoopTruthOptions truth_options;
-    truth_options.exclude_recent_distance = config.loop.exclude_recent_distance;
+    const LoopTruthOptions truth_options = LoopTruthOptions::from_config(config.loop);
     result.loop_summary = summarize_loops(slam, *reference, truth_options);
     result.loop_reference = truth.sensor_lidar ? "poses_sensor.txt" : "poses.txt";
     if (truth.sensor_lidar) result.loop_summary_poses_txt = summarize_loops(slam, *truth.lidar, truth_options);
@@ -321,8 +320,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   prepare_output_folder(out_dir, info.folder);
 
   // A stream cannot be read again for the map: keep what the map needs as it goes by.
-  SemanticMapOptions map_options;
-  map_options.voxel_size = config.slam.map_voxel_size;
+  const SemanticMapOptions map_options = SemanticMapOptions::from_config(config.slam);
   const auto map_step = static_cast<std::size_t>(std::max(1, config.slam.map_frame_step));
   std::optional<MapScanStore> map_scans;
   if (options.write_map && !info.rereadable) map_scans.emplace(map_options, map_step);

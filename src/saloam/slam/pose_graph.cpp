@@ -60,6 +60,10 @@ void PoseGraph::add_edge(const PoseGraphEdge& edge) {
   edges_.push_back(edge);
 }
 
+PoseGraphOptions PoseGraphOptions::from_config(const SlamConfig& config) {
+  return {config.max_iterations, config.loop_robust_scale};
+}
+
 PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
   PoseGraphSummary summary;
   if (nodes_.size() < 2 || edges_.empty()) {

@@ -53,9 +53,8 @@ SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> ne
               config.loop.ssc),
       gate_(CandidateGate::from_config(config.loop)),
       verification_(LoopVerificationSettings::from_config(config)),
+      graph_options_(PoseGraphOptions::from_config(config.slam)),
       rng_(config.loop.seed) {
-  graph_options_.max_iterations = config.slam.max_iterations;
-  graph_options_.loop_robust_scale = config.slam.loop_robust_scale;
   switch (places_.detector()) {
     case PlaceDetector::kSgpr: score_threshold_ = config.loop.zeta; break;
     case PlaceDetector::kSsc: score_threshold_ = config.loop.ssc_zeta; break;
