@@ -9,6 +9,8 @@
 #include <fmt/ranges.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/frame_range.hpp"
+#include "saloam/sources/open_source.hpp"
 
 namespace saloam::cli {
 
@@ -90,6 +92,21 @@ std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConf
       "SGPR needs weights: pass --model FILE.sgw or --set loop.sgpr_model=FILE.sgw (the shipped model is missing "
       "from {}; set SALOAM_DATA_DIR if saloam was moved)",
       shipped.parent_path().string()));
+}
+
+void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
+  app.add_option("SEQ_DIR", path, path_help)->required();
+  app.add_option("--labels", labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+  app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
+}
+
+std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels) const {
+  SourceOptions options;
+  if (!labels.empty()) options.labels = labels;
+  options.ignore_labels = ignore_labels;
+  options.ignore_calib = no_calib;
+  options.frames = FrameRange::parse(frames);
+  return open_source(path, options);
 }
 
 void add_no_calib_flag(CLI::App& app, bool& no_calib) {

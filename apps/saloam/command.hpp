@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "saloam/core/config.hpp"
+#include "saloam/io/frame_source.hpp"
 
 namespace saloam::cli {
 
@@ -40,6 +42,20 @@ struct ConfigOptions {
   std::vector<std::string> overrides;
   void add_to(CLI::App& app);
   [[nodiscard]] SaloamConfig resolve() const;
+};
+
+/// The options that choose a run's frames, shared by the commands that run
+/// over a sequence (odom, slam, place-eval, bench): SEQ_DIR, --labels and
+/// --frames; commands where calibration matters add --no-calib
+/// (add_no_calib_flag). Call `open()` after parsing.
+struct SourceArgs {
+  std::string path;
+  std::string labels;
+  std::string frames;
+  bool no_calib = false;
+  void add_to(CLI::App& app, const std::string& path_help);
+  /// open_source() with these options; whether labels are read is the command's choice.
+  [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels) const;
 };
 
 /// The folder of the running program (from /proc/self/exe); none when it
