@@ -1,4 +1,4 @@
-// ROS 1 bags (RosbagSequence over Debian's rosbag_storage): the bytes after
+// ROS 1 bags (RosbagSource over Debian's rosbag_storage): the bytes after
 // the "#ROSBAG V2.0" magic, written to a temporary file (rosbag reads only
 // files), opened, and every scan of the picked topic read. Built only with
 // rosbag_storage.
@@ -11,7 +11,7 @@
 #include <fmt/format.h>
 
 #include "point_cloud_checks.hpp"
-#include "saloam/sources/rosbag_sequence.hpp"
+#include "saloam/sources/rosbag_source.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace saloam;
@@ -23,10 +23,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
   }
   try {
-    RosbagSequence bag(file, {});
-    SALOAM_FUZZ_CHECK(bag.size() > 0 && bag.times().size() == bag.size());
+    RosbagSource bag(file, {});
+    const auto& times = bag.info().times;
+    SALOAM_FUZZ_CHECK(bag.size() > 0 && times.size() == bag.size());
     for (std::size_t i = 0; i < bag.size(); ++i) {
-      if (i > 0) SALOAM_FUZZ_CHECK(bag.times()[i] > bag.times()[i - 1]);
+      if (i > 0) SALOAM_FUZZ_CHECK(times[i] > times[i - 1]);
       try {
         const LabelledCloud cloud = bag.scan(i);
         SALOAM_FUZZ_CHECK(!cloud.empty());

@@ -8,17 +8,13 @@
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
-#include "saloam/sources/rosbag_sequence.hpp"
-#include "saloam/sources/scan_sequence.hpp"
 #include "saloam/sources/sequence_summary.hpp"
 
 namespace saloam::cli {
 namespace {
 
 struct InfoArgs {
-  std::string path;
-  std::string format = "auto";
-  std::string topic;
+  SourceArgs source;
   std::size_t scans = 3;
 };
 
@@ -32,8 +28,8 @@ std::string beams_text(const SequenceSummary& s) {
   return fmt::format("about {} (elevation angles; no ring field)", s.beams->beams);
 }
 
-void print_summary(const ScanSequence& seq, const SequenceSummary& s, bool format_given) {
-  std::cout << seq.name() << '\n';
+void print_summary(const FrameSource& source, const SequenceSummary& s, bool format_given) {
+  std::cout << source.info().name << '\n';
   std::cout << fmt::format("  format:      {}{}\n", s.format, format_given ? "" : " (detected)");
   const double duration = s.last_time - s.first_time;
   std::cout << fmt::format("  frames:      {}, {:.3f} s from {:.6f} to {:.6f} s\n", s.frames, duration, s.first_time, s.last_time);
@@ -51,14 +47,9 @@ void print_summary(const ScanSequence& seq, const SequenceSummary& s, bool forma
 }
 
 int run_info(const InfoArgs& args) {
-  const auto format = scan_format_from_name(args.format);
-  if (!format) throw InputError(args.format, "unknown --format");
-  ScanSequenceOptions options;
-  options.format = *format;
-  options.topic = args.topic;
-  auto seq = open_scan_sequence(args.path, options);
-  const SequenceSummary summary = summarize(*seq, args.scans);
-  print_summary(*seq, summary, *format != ScanFormat::kAuto);
+  const auto source = args.source.open(false);
+  const SequenceSummary summary = summarize(*source, args.scans);
+  print_summary(*source, summary, args.source.format != "auto");
   return 0;
 }
 
@@ -66,12 +57,8 @@ const CommandRegistration kRegistration{Command{
     "info", "What a scan source holds: format, frames, rate, fields, beams, duration, calibration, reference", 15,
     [](CLI::App& app) {
       auto args = std::make_shared<InfoArgs>();
-      app.add_option("path", args->path,
-                     "A SemanticKITTI sequence, a KITTI raw drive, a folder of .pcd or .ply files (or one file), a ROS 1 bag")
-          ->required();
-      app.add_option("--format", args->format, "auto (default: from the path), or the format to read it as")
-          ->check(CLI::IsMember(scan_format_names()));
-      app.add_option("--topic", args->topic, "Bag topic of sensor_msgs/PointCloud2 (default: the only one)");
+      args->source.add_to(app, "A SemanticKITTI sequence folder");
+      add_no_calib_flag(app, args->source.no_calib);
       app.add_option("--scans", args->scans, "Scans to read for fields, points and beams (default 3)")
           ->check(positive_number());
       return [args] { return run_info(*args); };

@@ -95,24 +95,40 @@ std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConf
 }
 
 void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
-  app.add_option("SEQ_DIR", path, path_help)->required();
-  app.add_option("--labels", labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+  app.add_option("SEQ_DIR", path, path_help + "; or a KITTI raw drive, a folder of .pcd/.ply files, a ROS 1 bag")
+      ->required();
+  app.add_option("--format", format,
+                 "Layout of SEQ_DIR: auto (detected), semantickitti, kitti-raw, pcd, ply, rosbag")
+      ->check(CLI::IsMember(scan_format_names()))
+      ->capture_default_str();
+  app.add_option("--topic", topic, "ROS bag topic of sensor_msgs/PointCloud2 (default: the only one)");
+  app.add_option("--labels", labels, "Folder of .label files (named like the scans) instead of SEQ_DIR/labels");
   app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
 }
 
-std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels) const {
+namespace {
+SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
   SourceOptions options;
-  if (!labels.empty()) options.labels = labels;
+  const auto format = scan_format_from_name(args.format);
+  if (!format) throw ConfigError(fmt::format("--format {}: not one of {}", args.format, fmt::join(scan_format_names(), ", ")));
+  options.format = *format;
+  options.topic = args.topic;
+  if (!args.labels.empty()) options.labels = args.labels;
   options.ignore_labels = ignore_labels;
-  options.ignore_calib = no_calib;
-  options.frames = FrameRange::parse(frames);
-  return open_source(path, options);
+  options.ignore_calib = args.no_calib;
+  options.frames = FrameRange::parse(args.frames);
+  return options;
+}
+}  // namespace
+
+std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels) const {
+  return open_source(path, source_options(*this, ignore_labels));
 }
 
 void add_no_calib_flag(CLI::App& app, bool& no_calib) {
   app.add_flag("--no-calib", no_calib,
-               "Run without calib.txt (ignored if present): poses.txt holds LiDAR-frame poses, not KITTI's camera "
-               "frame");
+               "Ignore calib.txt: work in the LiDAR frame (pose files hold LiDAR-frame poses, poses.txt is taken as "
+               "such), as for a source without calib.txt");
 }
 
 CLI::Validator positive_number() {

@@ -44,12 +44,15 @@ struct ConfigOptions {
   [[nodiscard]] SaloamConfig resolve() const;
 };
 
-/// The options that choose a run's frames, shared by the commands that run
-/// over a sequence (odom, slam, place-eval, bench): SEQ_DIR, --labels and
-/// --frames; commands where calibration matters add --no-calib
-/// (add_no_calib_flag). Call `open()` after parsing.
+/// The options that choose a run's frames, shared by the commands that read
+/// a source (odom, slam, place-eval, bench, info): SEQ_DIR (any layout of
+/// sources/source_options.hpp), --format, --topic, --labels and --frames;
+/// commands where calibration matters add --no-calib (add_no_calib_flag).
+/// Call `open()` after parsing.
 struct SourceArgs {
   std::string path;
+  std::string format = "auto";
+  std::string topic;
   std::string labels;
   std::string frames;
   bool no_calib = false;
@@ -75,8 +78,9 @@ std::filesystem::path config_file_path(const std::string& name);
 /// loop.sgpr_model, else the model shipped in data_dir()/models/sgpr/saloam.sgw;
 /// ConfigError saying how to pass one when there is none.
 std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config);
-/// --no-calib of the runs (odom, slam): without it a missing calib.txt is an
-/// error; with it poses.txt holds LiDAR-frame poses.
+/// --no-calib of the runs (odom, slam, place-eval): calib.txt is not read even
+/// when present, and the run works in the LiDAR frame, as it does for a
+/// source without calib.txt.
 void add_no_calib_flag(CLI::App& app, bool& no_calib);
 
 /// Checks for numeric options whose messages name the value: CLI11's

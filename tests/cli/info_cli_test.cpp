@@ -6,7 +6,7 @@
 #include <string>
 
 #include "saloam/io/pcd.hpp"
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/sources/open_source.hpp"
 #include "saloam/sources/sequence_writer.hpp"
 #include "testing/test_support.hpp"
 
@@ -39,7 +39,7 @@ TEST(InfoCli, SaysWhatEachSourceHolds) {
   EXPECT_NE(output.find("reference:   3 poses"), std::string::npos) << output;
   EXPECT_NE(output.find("calibration: calib.txt"), std::string::npos) << output;
 
-  auto seq = open_scan_sequence(dir / "seq");
+  auto seq = open_reader(dir / "seq", {});
   SequenceWriteOptions pcd;
   pcd.format = ScanFormat::kPcd;
   pcd.pcd = PcdEncoding::kAscii;

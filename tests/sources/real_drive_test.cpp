@@ -8,7 +8,7 @@
 
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/pcd.hpp"
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/sources/open_source.hpp"
 #include "saloam/sources/sequence_summary.hpp"
 #include "saloam/sources/sequence_writer.hpp"
 #include "testing/test_support.hpp"
@@ -28,8 +28,8 @@ TEST(RealDrive, KittiRawAndPcdLayoutsReadLikeTheKittiFolder) {
   for (const char* name : {"poses.txt", "times.txt", "calib.txt"}) {
     fs::copy_file(testing::shared_file(std::string("data/kitti_raw_0005/") + name), kitti / name);
   }
-  auto source = open_scan_sequence(kitti);
-  ASSERT_EQ(source->format(), ScanFormat::kSemanticKitti);
+  auto source = open_reader(kitti, {});
+  ASSERT_EQ(source->info().format, "semantickitti");
   ASSERT_EQ(source->size(), 100u);
 
   write_scan_sequence(*source, dir / "drive", [] { SequenceWriteOptions o; o.format = ScanFormat::kKittiRaw; return o; }());
@@ -37,11 +37,11 @@ TEST(RealDrive, KittiRawAndPcdLayoutsReadLikeTheKittiFolder) {
   write_scan_sequence(*source, dir / "pcd", [&] { SequenceWriteOptions o; o.format = ScanFormat::kPcd; o.pcd = pcd; return o; }());
   for (const fs::path& layout : {dir / "drive", dir / "pcd"}) {
     SCOPED_TRACE(layout.string());
-    auto other = open_scan_sequence(layout);
+    auto other = open_reader(layout, {});
     ASSERT_EQ(other->size(), source->size());
-    for (std::size_t i = 0; i < source->size(); ++i) EXPECT_NEAR(other->times()[i], source->times()[i], 1e-6) << i;
-    const auto reference = *source->reference_poses();  // Tr is the identity: LiDAR frame
-    const auto poses = *other->reference_poses();
+    for (std::size_t i = 0; i < source->size(); ++i) EXPECT_NEAR(other->info().times[i], source->info().times[i], 1e-6) << i;
+    const auto reference = *source->info().camera_poses;  // Tr is the identity: LiDAR frame
+    const auto poses = *other->info().camera_poses;
     for (std::size_t i = 0; i < poses.size(); ++i) {
       ASSERT_LT((poses[i].matrix() - reference[i].matrix()).norm(), 1e-6) << i;
     }
@@ -53,7 +53,7 @@ TEST(RealDrive, KittiRawAndPcdLayoutsReadLikeTheKittiFolder) {
     }
   }
   // What `saloam info` reports for the real drive: 64 beams, 10 Hz.
-  auto drive = open_scan_sequence(dir / "drive");
+  auto drive = open_reader(dir / "drive", {});
   const SequenceSummary summary = summarize(*drive, 1);
   EXPECT_EQ(summary.format, "kitti-raw");
   EXPECT_NEAR(summary.median_interval, 0.1, 1e-6);

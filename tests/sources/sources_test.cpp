@@ -18,8 +18,8 @@
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sources/kitti_raw_drive.hpp"
 #include "saloam/sources/point_cloud_folder.hpp"
-#include "saloam/sources/rosbag_sequence.hpp"
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/sources/open_source.hpp"
+#include "saloam/sources/rosbag_source.hpp"
 #include "saloam/sources/sequence_summary.hpp"
 #include "saloam/sources/sequence_writer.hpp"
 #include "testing/test_support.hpp"
@@ -48,16 +48,12 @@ const fs::path& simulated_sequence() {
   return seq;
 }
 
-/// Wraps a sequence and gives every scan rings and per-point times, as a
+/// Wraps a source and gives every scan rings and per-point times, as a
 /// real driver's clouds have.
-class WithPointFields final : public ScanSequence {
+class WithPointFields final : public FrameSource {
  public:
-  explicit WithPointFields(ScanSequence& inner) : inner_(inner) {}
-  [[nodiscard]] ScanFormat format() const override { return inner_.format(); }
-  [[nodiscard]] const fs::path& path() const override { return inner_.path(); }
-  [[nodiscard]] std::size_t size() const override { return inner_.size(); }
-  [[nodiscard]] const std::vector<double>& times() const override { return inner_.times(); }
-  [[nodiscard]] bool has_labels() const override { return inner_.has_labels(); }
+  explicit WithPointFields(FrameSource& inner) : inner_(inner) {}
+  [[nodiscard]] const SourceInfo& info() const override { return inner_.info(); }
   LabelledCloud scan(std::size_t i) override {
     LabelledCloud c = inner_.scan(i);
     c.ring.resize(c.size());
@@ -68,12 +64,14 @@ class WithPointFields final : public ScanSequence {
     }
     return c;
   }
-  [[nodiscard]] std::optional<Pose> velo_to_cam() const override { return inner_.velo_to_cam(); }
-  [[nodiscard]] std::optional<std::vector<Pose>> reference_poses() const override { return inner_.reference_poses(); }
 
  private:
-  ScanSequence& inner_;
+  FrameSource& inner_;
 };
+
+std::unique_ptr<FrameSource> open(const fs::path& path, const SourceOptions& options = {}) {
+  return open_reader(path, options);
+}
 
 SequenceWriteOptions layout(ScanFormat format) {
   SequenceWriteOptions o;
@@ -81,13 +79,13 @@ SequenceWriteOptions layout(ScanFormat format) {
   return o;
 }
 
-ScanSequenceOptions on_topic(const std::string& topic) {
-  ScanSequenceOptions o;
+SourceOptions on_topic(const std::string& topic) {
+  SourceOptions o;
   o.topic = topic;
   return o;
 }
 
-void expect_same_scans(ScanSequence& a, ScanSequence& b, bool fields) {
+void expect_same_scans(FrameSource& a, FrameSource& b, bool fields) {
   ASSERT_EQ(a.size(), b.size());
   for (std::size_t i = 0; i < a.size(); ++i) {
     const LabelledCloud ca = a.scan(i), cb = b.scan(i);
@@ -104,18 +102,19 @@ void expect_same_scans(ScanSequence& a, ScanSequence& b, bool fields) {
   }
 }
 
-void expect_same_times(const ScanSequence& a, const ScanSequence& b, double tolerance) {
-  ASSERT_EQ(a.times().size(), b.times().size());
-  for (std::size_t i = 0; i < a.times().size(); ++i) EXPECT_NEAR(a.times()[i], b.times()[i], tolerance) << i;
+void expect_same_times(const FrameSource& a, const FrameSource& b, double tolerance) {
+  const auto &ta = a.info().times, &tb = b.info().times;
+  ASSERT_EQ(ta.size(), tb.size());
+  for (std::size_t i = 0; i < ta.size(); ++i) EXPECT_NEAR(ta[i], tb[i], tolerance) << i;
 }
 
 /// Reference poses of both in the LiDAR frame agree within `tolerance` [m, and rad-ish].
-void expect_same_lidar_poses(const ScanSequence& a, const ScanSequence& b, double tolerance) {
-  const auto lidar = [](const ScanSequence& s) {
-    auto poses = *s.reference_poses();
-    return s.velo_to_cam() ? camera_to_lidar_poses(poses, *s.velo_to_cam()) : poses;
+void expect_same_lidar_poses(const FrameSource& a, const FrameSource& b, double tolerance) {
+  const auto lidar = [](const FrameSource& s) {
+    const auto& poses = *s.info().camera_poses;
+    return s.info().velo_to_cam ? camera_to_lidar_poses(poses, *s.info().velo_to_cam) : poses;
   };
-  ASSERT_TRUE(a.reference_poses() && b.reference_poses());
+  ASSERT_TRUE(a.info().camera_poses && b.info().camera_poses);
   const auto pa = lidar(a), pb = lidar(b);
   ASSERT_EQ(pa.size(), pb.size());
   for (std::size_t i = 0; i < pa.size(); ++i) {
@@ -123,20 +122,13 @@ void expect_same_lidar_poses(const ScanSequence& a, const ScanSequence& b, doubl
   }
 }
 
-TEST(Sources, FormatNames) {
-  EXPECT_EQ(format_name(ScanFormat::kKittiRaw), "kitti-raw");
-  EXPECT_EQ(scan_format_from_name("rosbag"), ScanFormat::kRosbag);
-  EXPECT_FALSE(scan_format_from_name("las").has_value());
-  EXPECT_EQ(scan_format_names().size(), 6u);
-}
-
 TEST(Sources, SemanticKittiFolderIsDetectedAndRead) {
-  const auto seq = open_scan_sequence(simulated_sequence());
-  EXPECT_EQ(seq->format(), ScanFormat::kSemanticKitti);
+  const auto seq = open(simulated_sequence());
+  EXPECT_EQ(seq->info().format, "semantickitti");
   EXPECT_EQ(seq->size(), 4u);
-  EXPECT_TRUE(seq->has_labels());
-  EXPECT_TRUE(seq->velo_to_cam().has_value());
-  EXPECT_EQ(seq->reference_poses()->size(), 4u);
+  EXPECT_TRUE(seq->info().has_labels);
+  EXPECT_TRUE(seq->info().velo_to_cam.has_value());
+  EXPECT_EQ(seq->info().camera_poses->size(), 4u);
   EXPECT_GT(seq->scan(0).size(), 1000u);
 }
 
@@ -152,15 +144,15 @@ TEST(Sources, DetectionSaysWhatItLookedFor) {
   EXPECT_NE(input_error_of([&] { detect_scan_format(dir / "notes.txt"); }).find("not a scan source"), std::string::npos);
   std::ofstream(dir / "x.bag") << "#ROSBAG V1.2\n";
   EXPECT_EQ(detect_scan_format(dir / "x.bag"), ScanFormat::kRosbag);
-  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "x.bag"); }).find("not a ROS 1 bag of format 2.0"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { open(dir / "x.bag"); }).find("not a ROS 1 bag of format 2.0"), std::string::npos);
   if (!rosbag_available()) {  // a build without rosbag_storage says so
     std::ofstream(dir / "y.bag") << kRosbagMagic;
-    EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "y.bag"); }).find("not built into this saloam"), std::string::npos);
+    EXPECT_NE(input_error_of([&] { open(dir / "y.bag"); }).find("not built into this saloam"), std::string::npos);
   }
 }
 
 TEST(Sources, EveryPcdEncodingRoundTrips) {
-  auto source = open_scan_sequence(simulated_sequence());
+  auto source = open(simulated_sequence());
   WithPointFields with_fields(*source);
   testing::TempDir dir;
   for (const auto encoding : {PcdEncoding::kAscii, PcdEncoding::kBinary, PcdEncoding::kBinaryCompressed}) {
@@ -168,9 +160,9 @@ TEST(Sources, EveryPcdEncodingRoundTrips) {
     SCOPED_TRACE(static_cast<int>(encoding));
     const fs::path out = dir / fmt::format("pcd{}", static_cast<int>(encoding));
     write_scan_sequence(with_fields, out, [&] { auto o = layout(ScanFormat::kPcd); o.pcd = encoding; return o; }());
-    auto back = open_scan_sequence(out);
-    EXPECT_EQ(back->format(), ScanFormat::kPcd);
-    EXPECT_TRUE(back->has_labels());  // labels/ beside the scans
+    auto back = open(out);
+    EXPECT_EQ(back->info().format, "pcd");
+    EXPECT_TRUE(back->info().has_labels);  // labels/ beside the scans
     expect_same_scans(with_fields, *back, true);
     expect_same_times(*source, *back, 1e-9);
     expect_same_lidar_poses(*source, *back, 1e-6);
@@ -179,15 +171,15 @@ TEST(Sources, EveryPcdEncodingRoundTrips) {
 }
 
 TEST(Sources, EveryPlyEncodingRoundTrips) {
-  auto source = open_scan_sequence(simulated_sequence());
+  auto source = open(simulated_sequence());
   WithPointFields with_fields(*source);
   testing::TempDir dir;
   for (const auto encoding : {PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian, PlyEncoding::kBinaryBigEndian}) {
     SCOPED_TRACE(static_cast<int>(encoding));
     const fs::path out = dir / fmt::format("ply{}", static_cast<int>(encoding));
     write_scan_sequence(with_fields, out, [&] { auto o = layout(ScanFormat::kPly); o.ply = encoding; return o; }());
-    auto back = open_scan_sequence(out);
-    EXPECT_EQ(back->format(), ScanFormat::kPly);
+    auto back = open(out);
+    EXPECT_EQ(back->info().format, "ply");
     expect_same_scans(with_fields, *back, true);
     expect_same_times(*source, *back, 1e-9);
     expect_same_lidar_poses(*source, *back, 1e-6);
@@ -195,23 +187,23 @@ TEST(Sources, EveryPlyEncodingRoundTrips) {
 }
 
 TEST(Sources, KittiRawRoundTripsWithOxtsPoses) {
-  auto source = open_scan_sequence(simulated_sequence());
+  auto source = open(simulated_sequence());
   testing::TempDir dir;
   write_scan_sequence(*source, dir / "drive", layout(ScanFormat::kKittiRaw));
   EXPECT_TRUE(fs::exists(dir / "drive/velodyne_points/data/0000000003.bin"));
   EXPECT_TRUE(fs::exists(dir / "drive/oxts/data/0000000003.txt"));
-  auto back = open_scan_sequence(dir / "drive");
-  EXPECT_EQ(back->format(), ScanFormat::kKittiRaw);
-  EXPECT_FALSE(back->velo_to_cam().has_value());
+  auto back = open(dir / "drive");
+  EXPECT_EQ(back->info().format, "kitti-raw");
+  EXPECT_FALSE(back->info().velo_to_cam.has_value());
   expect_same_scans(*source, *back, false);
   expect_same_times(*source, *back, 1e-6);
   expect_same_lidar_poses(*source, *back, 1e-5);
-  const auto facts = back->facts().notes;
+  const auto facts = back->info().notes;
   EXPECT_NE(facts.back().find("in the LiDAR frame via"), std::string::npos);
 
   // Sweep bounds, when the drive has them.
   std::vector<double> start, end;
-  for (const double t : source->times()) {
+  for (const double t : source->info().times) {
     start.push_back(kKittiRawEpoch + t - 0.05);
     end.push_back(kKittiRawEpoch + t + 0.0495);
   }
@@ -225,33 +217,33 @@ TEST(Sources, KittiRawRoundTripsWithOxtsPoses) {
 
 TEST(Sources, KittiRawWithoutOxtsOrTimestamps) {
   testing::TempDir dir;
-  auto source = open_scan_sequence(simulated_sequence());
+  auto source = open(simulated_sequence());
   write_scan_sequence(*source, dir / "drive", layout(ScanFormat::kKittiRaw));
   fs::remove_all(dir / "drive/oxts/data/0000000002.txt");
-  auto fewer = open_scan_sequence(dir / "drive");
-  EXPECT_FALSE(fewer->reference_poses().has_value());
-  EXPECT_NE(fewer->facts().notes.back().find("reference: none: "), std::string::npos);
+  auto fewer = open(dir / "drive");
+  EXPECT_FALSE(fewer->info().camera_poses.has_value());
+  EXPECT_NE(fewer->info().notes.back().find("reference: none: "), std::string::npos);
   fs::remove_all(dir / "drive/velodyne_points/timestamps.txt");
-  EXPECT_DOUBLE_EQ(open_scan_sequence(dir / "drive")->times()[3], 0.3);
+  EXPECT_DOUBLE_EQ(open(dir / "drive")->info().times[3], 0.3);
   fs::remove(dir / "drive/velodyne_points/data/0000000002.bin");
-  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "drive"); }).find("frame 3 follows 1: a scan is missing"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { open(dir / "drive"); }).find("frame 3 follows 1: a scan is missing"), std::string::npos);
 }
 
 TEST(Sources, BagRoundTripsAndPicksItsTopic) {
   if (!rosbag_available()) GTEST_SKIP() << "built without rosbag_storage";
-  auto source = open_scan_sequence(simulated_sequence());
+  auto source = open(simulated_sequence());
   WithPointFields with_fields(*source);
   testing::TempDir dir;
   write_scan_sequence(with_fields, dir / "a.bag", layout(ScanFormat::kRosbag));
-  auto back = open_scan_sequence(dir / "a.bag");
-  EXPECT_EQ(back->format(), ScanFormat::kRosbag);
+  auto back = open(dir / "a.bag");
+  EXPECT_EQ(back->info().format, "rosbag");
   expect_same_scans(with_fields, *back, true);
   expect_same_times(*source, *back, 1e-8);
-  EXPECT_NE(back->name().find("(topic /points)"), std::string::npos);
+  EXPECT_NE(back->info().name.find("(topic /points)"), std::string::npos);
   const auto topics = list_bag_topics(dir / "a.bag");
   ASSERT_EQ(topics.size(), 1u);
   EXPECT_EQ(topics[0].messages, 4u);
-  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "a.bag", on_topic("/lidar")); }).find("no topic '/lidar'; the bag holds:\n  /points (sensor_msgs/PointCloud2, 4 messages)"), std::string::npos);
+  EXPECT_NE(input_error_of([&] { open(dir / "a.bag", on_topic("/lidar")); }).find("no topic '/lidar'; the bag holds:\n  /points (sensor_msgs/PointCloud2, 4 messages)"), std::string::npos);
 }
 
 TEST(Sources, BagWithTwoCloudTopicsNeedsOne) {
@@ -265,12 +257,12 @@ TEST(Sources, BagWithTwoCloudTopicsNeedsOne) {
     writer.write(cloud, 10.05, "/rear");
     writer.write(cloud, 10.1);
   }
-  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "two.bag"); })
+  EXPECT_NE(input_error_of([&] { open(dir / "two.bag"); })
                 .find("2 sensor_msgs/PointCloud2 topics: pick one with --topic:\n  /front (sensor_msgs/PointCloud2, 2 messages)\n  /rear"),
             std::string::npos);
-  EXPECT_EQ(open_scan_sequence(dir / "two.bag", on_topic("/front"))->size(), 2u);
+  EXPECT_EQ(open(dir / "two.bag", on_topic("/front"))->size(), 2u);
   std::ofstream(dir / "bad.bag") << std::string(kRosbagMagic) << "garbage after the magic";
-  EXPECT_NE(input_error_of([&] { open_scan_sequence(dir / "bad.bag"); }).find("bad.bag: corrupt ROS bag: record at byte 13: "), std::string::npos);
+  EXPECT_NE(input_error_of([&] { open(dir / "bad.bag"); }).find("bad.bag: corrupt ROS bag: record at byte 13: "), std::string::npos);
 }
 
 // rosbag_storage trusts a bag's lengths: a connection record claiming a
@@ -295,7 +287,7 @@ TEST(Sources, CorruptBagLengthsAreCaughtBeforeRosbag) {
     std::string copy = bytes;
     std::memcpy(copy.data() + at, &value, 4);
     std::ofstream(dir / "b.bag", std::ios::binary) << copy;
-    return input_error_of([&] { open_scan_sequence(dir / "b.bag"); });
+    return input_error_of([&] { open(dir / "b.bag"); });
   };
   // The connection record after index_pos (the index starts with it).
   std::uint64_t index_pos = 0;
@@ -313,27 +305,27 @@ TEST(Sources, FolderWithoutCalibRunsInTheLidarFrame) {
   cloud.push_back({1, 2, 3}, 0.5f);
   write_pcd(dir / "1317042145.100000.pcd", cloud, PcdEncoding::kAscii);
   write_pcd(dir / "1317042145.200000.pcd", cloud, PcdEncoding::kBinary);
-  auto seq = open_scan_sequence(dir.path());
-  EXPECT_EQ(seq->format(), ScanFormat::kPcd);
-  EXPECT_FALSE(seq->velo_to_cam().has_value());
-  EXPECT_FALSE(seq->reference_poses().has_value());
-  EXPECT_NEAR(seq->times()[1], 1317042145.2, 1e-6);
-  const auto notes = seq->facts().notes;
+  auto seq = open(dir.path());
+  EXPECT_EQ(seq->info().format, "pcd");
+  EXPECT_FALSE(seq->info().velo_to_cam.has_value());
+  EXPECT_FALSE(seq->info().camera_poses.has_value());
+  EXPECT_NEAR(seq->info().times[1], 1317042145.2, 1e-6);
+  const auto notes = seq->info().notes;
   EXPECT_NE(std::find(notes.begin(), notes.end(), "calibration: none: runs in the LiDAR frame"), notes.end());
   EXPECT_NE(std::find(notes.begin(), notes.end(), "times: from the file names"), notes.end());
   // One file alone is a sequence of one scan.
-  EXPECT_EQ(open_scan_sequence(dir / "1317042145.100000.pcd")->size(), 1u);
+  EXPECT_EQ(open(dir / "1317042145.100000.pcd")->size(), 1u);
 }
 
 TEST(Sources, WriterNeverOverwritesAnInput) {
-  auto source = open_scan_sequence(simulated_sequence());
+  auto source = open(simulated_sequence());
   EXPECT_NE(input_error_of([&] { write_scan_sequence(*source, simulated_sequence(), layout(ScanFormat::kPcd)); })
                 .find("exists and is not an empty folder"),
             std::string::npos);
 }
 
 TEST(Sources, SummaryOfASimulatedSequence) {
-  auto seq = open_scan_sequence(simulated_sequence());
+  auto seq = open(simulated_sequence());
   const SequenceSummary s = summarize(*seq, 2);
   EXPECT_EQ(s.format, "semantickitti");
   EXPECT_EQ(s.frames, 4u);

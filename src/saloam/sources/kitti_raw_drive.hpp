@@ -1,6 +1,6 @@
 #pragma once
 // A KITTI raw drive folder (e.g. 2011_09_26/2011_09_26_drive_0005_sync) as a
-// ScanSequence (file formats in io/kitti_raw.hpp):
+// FrameSource (file formats in io/kitti_raw.hpp):
 //   DRIVE/velodyne_points/data/NNNNNNNNNN.bin   the scans, numbered without gaps
 //   DRIVE/velodyne_points/timestamps.txt        scan times (laser facing forward);
 //                                               _start/_end: the sweeps' bounds
@@ -10,32 +10,29 @@
 // records through KITTI's convertOxtsToPose (IMU poses, Mercator scale from
 // the first latitude) expressed in the LiDAR frame with calib_imu_to_velo
 // (Q_i = T_velo<-imu P_i T_velo<-imu^-1); without that file they stay IMU
-// poses (said in facts()). oxts records are paired with scans by index, as
-// in the synchronised (_sync) drives; a drive with another number of oxts
+// poses (said in info().notes). oxts records are paired with scans by index,
+// as in the synchronised (_sync) drives; a drive with another number of oxts
 // records than scans (an unsynchronised _extract drive), or a gap in their
-// numbers, has no reference (facts() says why).
-// No Tr: a KITTI raw drive runs in the LiDAR frame.
+// numbers, has no reference (the notes say why).
+// No Tr: a KITTI raw drive runs in the LiDAR frame, and info().camera_poses
+// holds the reference in the LiDAR frame (Q_i). Labels only from
+// SourceOptions::labels (a drive has no labels folder of its own).
 
 #include <filesystem>
 #include <optional>
 #include <vector>
 
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/io/frame_source.hpp"
+#include "saloam/sources/source_options.hpp"
 
 namespace saloam {
 
-class KittiRawDrive final : public ScanSequence {
+class KittiRawDrive final : public FrameSource {
  public:
-  KittiRawDrive(std::filesystem::path drive, const ScanSequenceOptions& options);
+  KittiRawDrive(std::filesystem::path drive, const SourceOptions& options);
 
-  [[nodiscard]] ScanFormat format() const override { return ScanFormat::kKittiRaw; }
-  [[nodiscard]] const std::filesystem::path& path() const override { return drive_; }
-  [[nodiscard]] std::size_t size() const override { return scans_.size(); }
-  [[nodiscard]] const std::vector<double>& times() const override { return times_; }
-  [[nodiscard]] bool has_labels() const override { return !label_files_.empty(); }
+  [[nodiscard]] const SourceInfo& info() const override { return info_; }
   LabelledCloud scan(std::size_t i) override;
-  [[nodiscard]] std::optional<std::vector<Pose>> reference_poses() const override { return poses_; }
-  [[nodiscard]] ScanSequenceFacts facts() const override { return facts_; }
 
   /// Seconds since the epoch (the recording PC's clock) of the first scan.
   [[nodiscard]] double first_stamp() const { return first_stamp_; }
@@ -49,11 +46,9 @@ class KittiRawDrive final : public ScanSequence {
   std::filesystem::path drive_;
   std::vector<std::filesystem::path> scans_;
   std::vector<std::filesystem::path> label_files_;
-  std::vector<double> times_;
   double first_stamp_ = 0.0;
   std::optional<std::vector<double>> sweep_durations_;
-  std::optional<std::vector<Pose>> poses_;
-  ScanSequenceFacts facts_;
+  SourceInfo info_;
 };
 
 /// The folder holding calib_imu_to_velo.txt for `drive`: the drive itself or

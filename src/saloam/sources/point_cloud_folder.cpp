@@ -21,7 +21,7 @@ std::string_view extension_of(ScanFormat format) { return format == ScanFormat::
 
 }  // namespace
 
-PointCloudFolder::PointCloudFolder(fs::path path, ScanFormat format, const ScanSequenceOptions& options)
+PointCloudFolder::PointCloudFolder(fs::path path, ScanFormat format, const SourceOptions& options)
     : path_(std::move(path)), format_(format) {
   std::error_code ec;
   std::optional<std::vector<double>> name_stamps;
@@ -33,16 +33,29 @@ PointCloudFolder::PointCloudFolder(fs::path path, ScanFormat format, const ScanS
     ScanFiles listed = list_scan_files(path_, extension_of(format_));
     files_ = std::move(listed.files);
     name_stamps = std::move(listed.stamps);
+    info_.folder = folder_;
   } else {
     throw InputError(path_, "not found");
   }
+  info_.name = path_.string();
+  info_.format = std::string(format_name(format_));
   read_times(name_stamps);
-  const bool whole_folder = files_.size() > 1 || fs::is_directory(path_, ec);
-  if (whole_folder && fs::is_regular_file(folder_ / "calib.txt", ec)) {
-    velo_to_cam_ = read_velo_to_cam(folder_ / "calib.txt");
-    facts_.notes.push_back("calibration: calib.txt (Tr, velodyne to camera 0)");
+  read_calibration_and_reference(options);
+  find_labels(options);
+  info_.has_labels = !label_files_.empty();
+  info_.point_fields = decode(0).fields;
+}
+
+void PointCloudFolder::read_calibration_and_reference(const SourceOptions& options) {
+  std::error_code ec;
+  const bool whole_folder = info_.folder.has_value();
+  const bool has_calib = whole_folder && fs::is_regular_file(folder_ / "calib.txt", ec);
+  if (has_calib && !options.ignore_calib) {
+    info_.velo_to_cam = read_velo_to_cam(folder_ / "calib.txt");
+    info_.notes.push_back("calibration: calib.txt (Tr, velodyne to camera 0): poses in KITTI's camera frame");
   } else {
-    facts_.notes.push_back("calibration: none: runs in the LiDAR frame");
+    info_.notes.push_back(has_calib ? "calibration: calib.txt ignored (--no-calib): runs in the LiDAR frame"
+                                    : "calibration: none: runs in the LiDAR frame");
   }
   if (whole_folder && fs::is_regular_file(folder_ / "poses.txt", ec)) {
     auto poses = read_kitti_poses(folder_ / "poses.txt");
@@ -50,41 +63,40 @@ PointCloudFolder::PointCloudFolder(fs::path path, ScanFormat format, const ScanS
       throw InputError(folder_ / "poses.txt", fmt::format("{} poses for {} scans", poses.size(), files_.size()));
     }
     poses.resize(files_.size());
-    poses_ = std::move(poses);
-    facts_.notes.push_back(velo_to_cam_ ? "reference: poses.txt (camera frame)" : "reference: poses.txt (LiDAR frame)");
+    info_.camera_poses = std::move(poses);
+    info_.notes.push_back(info_.velo_to_cam ? "reference: poses.txt (camera frame)" : "reference: poses.txt (LiDAR frame)");
   } else {
-    facts_.notes.push_back("reference: none (no poses.txt)");
+    info_.notes.push_back("reference: none (no poses.txt)");
   }
-  find_labels(options);
 }
 
 void PointCloudFolder::read_times(const std::optional<std::vector<double>>& name_stamps) {
   std::error_code ec;
   const fs::path times_file = folder_ / "times.txt";
   if (fs::is_directory(path_, ec) && fs::is_regular_file(times_file, ec)) {
-    times_ = saloam::read_times(times_file);
-    if (times_.size() < files_.size()) {
-      throw InputError(times_file, fmt::format("{} timestamps for {} scans", times_.size(), files_.size()));
+    info_.times = saloam::read_times(times_file);
+    if (info_.times.size() < files_.size()) {
+      throw InputError(times_file, fmt::format("{} timestamps for {} scans", info_.times.size(), files_.size()));
     }
-    times_.resize(files_.size());
-    facts_.notes.push_back("times: times.txt");
+    info_.times.resize(files_.size());
+    info_.notes.push_back("times: times.txt");
   } else if (name_stamps) {
-    times_ = *name_stamps;
-    facts_.notes.push_back("times: from the file names");
+    info_.times = *name_stamps;
+    info_.notes.push_back("times: from the file names");
   } else {
-    times_.resize(files_.size());
-    for (std::size_t i = 0; i < times_.size(); ++i) times_[i] = 0.1 * static_cast<double>(i);
-    facts_.notes.push_back("times: none found (no times.txt, names are not timestamps): 0.1 s steps assumed");
+    info_.times.resize(files_.size());
+    for (std::size_t i = 0; i < info_.times.size(); ++i) info_.times[i] = 0.1 * static_cast<double>(i);
+    info_.notes.push_back("times: none found (no times.txt, names are not timestamps): 0.1 s steps assumed");
   }
-  stamps_are_absolute_ = !times_.empty() && times_.front() > kAbsoluteTimeThreshold;
+  stamps_are_absolute_ = !info_.times.empty() && info_.times.front() > kAbsoluteTimeThreshold;
 }
 
-void PointCloudFolder::find_labels(const ScanSequenceOptions& options) {
+void PointCloudFolder::find_labels(const SourceOptions& options) {
   if (options.ignore_labels) return;
   std::error_code ec;
-  const fs::path dir = options.labels_dir.value_or(folder_ / "labels");
+  const fs::path dir = options.labels.value_or(folder_ / "labels");
   if (!fs::is_directory(dir, ec)) {
-    if (options.labels_dir) throw InputError(dir, "labels folder not found");
+    if (options.labels) throw InputError(dir, "labels folder not found");
     return;
   }
   std::vector<fs::path> found;
@@ -92,7 +104,7 @@ void PointCloudFolder::find_labels(const ScanSequenceOptions& options) {
     fs::path label = dir / file.filename();
     label.replace_extension(".label");
     if (!fs::is_regular_file(label, ec)) {
-      if (found.empty() && !options.labels_dir) return;  // a labels/ folder of something else
+      if (found.empty() && !options.labels) return;  // a labels/ folder of something else
       throw InputError(label, fmt::format("missing: labels for {} of {} scans", found.size(), files_.size()));
     }
     found.push_back(label);
@@ -100,11 +112,15 @@ void PointCloudFolder::find_labels(const ScanSequenceOptions& options) {
   label_files_ = std::move(found);
 }
 
+DecodedCloud PointCloudFolder::decode(std::size_t i) const {
+  const fs::path& file = files_.at(i);
+  const std::optional<double> stamp = stamps_are_absolute_ ? std::optional<double>(info_.times[i]) : std::nullopt;
+  return format_ == ScanFormat::kPly ? read_ply_cloud(file, stamp) : read_pcd(file, stamp);
+}
+
 LabelledCloud PointCloudFolder::scan(std::size_t i) {
   const fs::path& file = files_.at(i);
-  const std::optional<double> stamp = stamps_are_absolute_ ? std::optional<double>(times_[i]) : std::nullopt;
-  DecodedCloud decoded = format_ == ScanFormat::kPly ? read_ply_cloud(file, stamp) : read_pcd(file, stamp);
-  fields_ = decoded.fields;
+  DecodedCloud decoded = decode(i);
   if (!label_files_.empty()) {
     const auto labels = read_label_file(label_files_[i]);
     if (labels.size() != decoded.points_in_file) {

@@ -69,11 +69,12 @@ BeamEstimate estimate_beams(const LabelledCloud& cloud) {
   return {elevation_clusters(cloud), BeamMethod::kElevation};
 }
 
-SequenceSummary summarize(ScanSequence& seq, std::size_t scans_to_read) {
+SequenceSummary summarize(FrameSource& source, std::size_t scans_to_read) {
+  const SourceInfo& info = source.info();
   SequenceSummary s;
-  s.format = std::string(format_name(seq.format()));
-  s.frames = seq.size();
-  const auto& t = seq.times();
+  s.format = info.format;
+  s.frames = source.size();
+  const auto& t = info.times;
   if (!t.empty()) {
     s.first_time = t.front();
     s.last_time = t.back();
@@ -84,11 +85,11 @@ SequenceSummary summarize(ScanSequence& seq, std::size_t scans_to_read) {
     std::nth_element(dt.begin(), dt.begin() + static_cast<std::ptrdiff_t>(dt.size() / 2), dt.end());
     s.median_interval = dt[dt.size() / 2];
   }
-  const std::size_t n = std::min(scans_to_read, seq.size());
+  const std::size_t n = std::min(scans_to_read, source.size());
   double points = 0.0;
   for (std::size_t k = 0; k < n; ++k) {
-    const std::size_t i = n == 1 ? 0 : k * (seq.size() - 1) / (n - 1);
-    const LabelledCloud cloud = seq.scan(i);
+    const std::size_t i = n == 1 ? 0 : k * (source.size() - 1) / (n - 1);
+    const LabelledCloud cloud = source.scan(i);
     points += static_cast<double>(cloud.size());
     if (k == 0) {
       s.beams = estimate_beams(cloud);
@@ -101,11 +102,11 @@ SequenceSummary summarize(ScanSequence& seq, std::size_t scans_to_read) {
   }
   s.scans_read = n;
   s.mean_points = n > 0 ? points / static_cast<double>(n) : 0.0;
-  s.fields = seq.fields();
-  s.labels = seq.has_labels();
-  s.calibration = seq.velo_to_cam().has_value();
-  if (const auto poses = seq.reference_poses()) s.reference_poses = poses->size();
-  s.notes = seq.facts().notes;
+  s.fields = info.point_fields;
+  s.labels = info.has_labels;
+  s.calibration = info.velo_to_cam.has_value();
+  if (info.camera_poses) s.reference_poses = info.camera_poses->size();
+  s.notes = info.notes;
   return s;
 }
 

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "saloam/core/types.hpp"
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/io/frame_source.hpp"
 
 namespace saloam {
 
@@ -49,10 +49,10 @@ struct SequenceSummary {
   bool labels = false;
   bool calibration = false;
   std::optional<std::size_t> reference_poses;
-  std::vector<std::string> notes;             ///< ScanSequence::facts()
+  std::vector<std::string> notes;             ///< SourceInfo::notes
 };
 
 /// Summarises `seq`, reading up to `scans_to_read` scans spread over it.
-SequenceSummary summarize(ScanSequence& seq, std::size_t scans_to_read = 3);
+SequenceSummary summarize(FrameSource& source, std::size_t scans_to_read = 3);
 
 }  // namespace saloam

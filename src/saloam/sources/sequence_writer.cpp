@@ -15,38 +15,39 @@ namespace fs = std::filesystem;
 namespace saloam {
 namespace {
 
-void check_new_folder(const ScanSequence& in, const fs::path& out) {
+void check_new_folder(const FrameSource& in, const fs::path& out) {
   std::error_code ec;
   if (fs::exists(out, ec)) {
     if (!fs::is_directory(out, ec) || !fs::is_empty(out, ec)) {
       throw InputError(out, "exists and is not an empty folder: write a sequence into a new folder");
     }
   }
-  if (fs::equivalent(in.path(), out, ec)) throw InputError(out, "is the input: write a sequence into a new folder");
+  if (in.info().folder && fs::equivalent(*in.info().folder, out, ec)) throw InputError(out, "is the input: write a sequence into a new folder");
   create_folder(out);
 }
 
 /// The reference poses in the LiDAR frame, when the source has them.
-std::optional<std::vector<Pose>> lidar_reference(const ScanSequence& in) {
-  auto poses = in.reference_poses();
-  if (!poses) return std::nullopt;
-  if (const auto tr = in.velo_to_cam()) return camera_to_lidar_poses(*poses, *tr);
-  return poses;
+std::optional<std::vector<Pose>> lidar_reference(const FrameSource& in) {
+  const SourceInfo& info = in.info();
+  if (!info.camera_poses) return std::nullopt;
+  if (info.velo_to_cam) return camera_to_lidar_poses(*info.camera_poses, *info.velo_to_cam);
+  return info.camera_poses;
 }
 
-void write_folder_extras(const ScanSequence& in, const fs::path& out) {
-  write_times(out / "times.txt", in.times());
-  if (const auto poses = in.reference_poses()) write_kitti_poses(out / "poses.txt", *poses);
-  if (const auto tr = in.velo_to_cam()) write_calib(out / "calib.txt", *tr);
+void write_folder_extras(const FrameSource& in, const fs::path& out) {
+  const SourceInfo& info = in.info();
+  write_times(out / "times.txt", info.times);
+  if (info.camera_poses) write_kitti_poses(out / "poses.txt", *info.camera_poses);
+  if (info.velo_to_cam) write_calib(out / "calib.txt", *info.velo_to_cam);
 }
 
-void write_semantic_kitti(ScanSequence& in, const fs::path& out) {
+void write_semantic_kitti(FrameSource& in, const fs::path& out) {
   const SequenceWriter writer(out);
   for (std::size_t i = 0; i < in.size(); ++i) writer.write_scan(i, in.scan(i));
   write_folder_extras(in, out);
 }
 
-void write_point_cloud_folder(ScanSequence& in, const fs::path& out, const SequenceWriteOptions& options) {
+void write_point_cloud_folder(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
   const bool ply = options.format == ScanFormat::kPly;
   for (std::size_t i = 0; i < in.size(); ++i) {
     const LabelledCloud cloud = in.scan(i);
@@ -61,12 +62,12 @@ void write_point_cloud_folder(ScanSequence& in, const fs::path& out, const Seque
   write_folder_extras(in, out);
 }
 
-void write_kitti_raw(ScanSequence& in, const fs::path& out) {
+void write_kitti_raw(FrameSource& in, const fs::path& out) {
   const auto lidar = lidar_reference(in);
   if (!lidar) throw InputError(out, "a KITTI raw drive needs reference poses (oxts), and the source has none");
   const fs::path data = out / "velodyne_points" / "data";
   for (std::size_t i = 0; i < in.size(); ++i) write_scan_bin(data / fmt::format("{:010d}.bin", i), in.scan(i));
-  std::vector<double> stamps = in.times();
+  std::vector<double> stamps = in.info().times;
   for (double& t : stamps) t = t < kAbsoluteTimeThreshold ? kKittiRawEpoch + t : t;
   write_kitti_timestamps(out / "velodyne_points" / "timestamps.txt", stamps);
   write_kitti_timestamps(out / "oxts" / "timestamps.txt", stamps);
@@ -79,9 +80,9 @@ void write_kitti_raw(ScanSequence& in, const fs::path& out) {
   write_imu_to_velo(out / "calib_imu_to_velo.txt", velo_imu);
 }
 
-void write_bag(ScanSequence& in, const fs::path& out, const SequenceWriteOptions& options) {
+void write_bag(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
   PointCloud2BagWriter writer(out, options.topic, options.frame_id, options.bag_compression);
-  for (std::size_t i = 0; i < in.size(); ++i) writer.write(in.scan(i), in.times()[i]);
+  for (std::size_t i = 0; i < in.size(); ++i) writer.write(in.scan(i), in.info().times[i]);
   writer.close();
 }
 
@@ -104,7 +105,7 @@ Pose kitti_imu_to_velo() {
   return orthonormalized(T);
 }
 
-void write_scan_sequence(ScanSequence& in, const fs::path& out, const SequenceWriteOptions& options) {
+void write_scan_sequence(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
   if (options.format == ScanFormat::kRosbag) {
     std::error_code ec;
     if (fs::exists(out, ec)) throw InputError(out, "exists: write a bag into a new file");

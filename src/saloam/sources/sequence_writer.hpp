@@ -1,6 +1,6 @@
 #pragma once
-// Writes a scan sequence in any layout saloam reads (scan_sequence.hpp), from
-// any ScanSequence: the simulator's SemanticKITTI output into PCD, PLY, KITTI
+// Writes a scan sequence in any layout saloam reads (source_options.hpp), from
+// any FrameSource: the simulator's SemanticKITTI output into PCD, PLY, KITTI
 // raw or a bag, a real drive into another layout. What each layout keeps:
 //   semantickitti  velodyne/*.bin, labels/ (when labelled), times.txt,
 //                  poses.txt and calib.txt (when the source has them)
@@ -20,8 +20,9 @@
 #include "saloam/io/kitti_raw.hpp"
 #include "saloam/io/pcd.hpp"
 #include "saloam/io/ply.hpp"
-#include "saloam/sources/rosbag_sequence.hpp"
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/io/frame_source.hpp"
+#include "saloam/sources/rosbag_source.hpp"
+#include "saloam/sources/source_options.hpp"
 
 namespace saloam {
 
@@ -42,10 +43,11 @@ OxtsRecord kitti_raw_origin();
 /// KITTI's 2011_09_26 calib_imu_to_velo (T_velo<-imu).
 Pose kitti_imu_to_velo();
 
-/// Writes every scan of `in` and what goes with it into `out`, which must
-/// not exist yet or be an empty folder (an input is never overwritten).
+/// Writes every scan of `in` and what goes with it (times, reference poses,
+/// Tr) into `out`, which must not exist yet or be an empty folder (an input
+/// is never overwritten).
 /// InputError naming `out` otherwise, or for a layout that cannot hold the
 /// source (kitti-raw needs reference poses; kAuto is no layout).
-void write_scan_sequence(ScanSequence& in, const std::filesystem::path& out, const SequenceWriteOptions& options);
+void write_scan_sequence(FrameSource& in, const std::filesystem::path& out, const SequenceWriteOptions& options);
 
 }  // namespace saloam

@@ -1,5 +1,5 @@
 #pragma once
-// A ROS 1 bag (format 2.0) as a ScanSequence: the sensor_msgs/PointCloud2
+// A ROS 1 bag (format 2.0) as a FrameSource: the sensor_msgs/PointCloud2
 // messages of one topic, in the bag's time order. Read through Debian's
 // rosbag_storage (librosbag-storage-dev: chunks, bz2/lz4 compression,
 // indexes, connections), with each message's bytes parsed and checked by
@@ -8,8 +8,9 @@
 // Before rosbag reads a bag, io/rosbag_structure.hpp checks every record
 // length and position in it (rosbag trusts them: a corrupt length made it
 // allocate 4 GB under the fuzzer).
-// Scans are in the message's frame (header.frame_id, said in facts()); a bag
-// has no reference poses and no calibration: it runs in the LiDAR frame.
+// Scans are in the message's frame (header.frame_id, said in info().notes); a
+// bag has no reference poses and no calibration: it runs in the LiDAR frame.
+// info().point_fields are the first message's (parsed when the bag is opened).
 //
 // Built only when rosbag_storage is found (rosbag_available()); otherwise
 // opening a bag is an InputError saying so.
@@ -20,7 +21,9 @@
 #include <string>
 #include <vector>
 
-#include "saloam/sources/scan_sequence.hpp"
+#include "saloam/io/frame_source.hpp"
+#include "saloam/io/pointcloud2.hpp"
+#include "saloam/sources/source_options.hpp"
 
 namespace saloam {
 
@@ -40,32 +43,31 @@ struct BagTopic {
 /// InputError naming the bag when it is not a readable ROS 1 bag.
 std::vector<BagTopic> list_bag_topics(const std::filesystem::path& bag);
 
-class RosbagSequence final : public ScanSequence {
+class RosbagSource final : public FrameSource {
  public:
   /// Opens `bag` and picks `options.topic`, or the only PointCloud2 topic.
   /// InputError naming the bag when it is unreadable, when the topic is not
   /// a PointCloud2 topic of the bag or there is none, or when there are
   /// several and none was named (the message lists them).
-  RosbagSequence(std::filesystem::path bag, const ScanSequenceOptions& options);
-  ~RosbagSequence() override;
-  RosbagSequence(const RosbagSequence&) = delete;
-  RosbagSequence& operator=(const RosbagSequence&) = delete;
+  RosbagSource(std::filesystem::path bag, const SourceOptions& options);
+  ~RosbagSource() override;
+  RosbagSource(const RosbagSource&) = delete;
+  RosbagSource& operator=(const RosbagSource&) = delete;
 
-  [[nodiscard]] ScanFormat format() const override { return ScanFormat::kRosbag; }
-  [[nodiscard]] const std::filesystem::path& path() const override { return bag_; }
-  [[nodiscard]] std::string name() const override;
-  [[nodiscard]] std::size_t size() const override;
-  [[nodiscard]] const std::vector<double>& times() const override;
+  /// name: the bag and its topic.
+  [[nodiscard]] const SourceInfo& info() const override { return info_; }
   LabelledCloud scan(std::size_t i) override;
-  [[nodiscard]] ScanSequenceFacts facts() const override;
 
   [[nodiscard]] const std::string& topic() const;
-  [[nodiscard]] std::string fields() const override;
 
  private:
+  /// Message i's cloud, parsed and checked by io/pointcloud2.hpp.
+  [[nodiscard]] PointCloud2Scan parse(std::size_t i) const;
+
   struct Impl;
   std::filesystem::path bag_;
   std::unique_ptr<Impl> impl_;
+  SourceInfo info_;
 };
 
 enum class BagCompression { kNone, kBz2, kLz4 };

@@ -1,4 +1,4 @@
-#include "saloam/sources/rosbag_sequence.hpp"
+#include "saloam/sources/rosbag_source.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -141,13 +141,11 @@ std::vector<BagTopic> topics_of(const rosbag::Bag& bag) {
 
 }  // namespace
 
-struct RosbagSequence::Impl {
+struct RosbagSource::Impl {
   rosbag::Bag bag;
   std::string topic;
   std::string frame_id;
   std::vector<rosbag::MessageInstance> messages;
-  std::vector<double> times;
-  std::string fields;
 };
 
 std::vector<BagTopic> list_bag_topics(const fs::path& bag) {
@@ -159,7 +157,7 @@ std::vector<BagTopic> list_bag_topics(const fs::path& bag) {
   });
 }
 
-RosbagSequence::RosbagSequence(fs::path bag, const ScanSequenceOptions& options)
+RosbagSource::RosbagSource(fs::path bag, const SourceOptions& options)
     : bag_(std::move(bag)), impl_(std::make_unique<Impl>()) {
   check_magic(bag_);
   check_rosbag_structure(bag_);  // every length and position, before rosbag trusts them
@@ -189,39 +187,33 @@ RosbagSequence::RosbagSequence(fs::path bag, const ScanSequenceOptions& options)
       const auto bytes = message_bytes(m, bag_);
       const RosHeader header =
           parse_ros_header(bytes, bag_, fmt::format("topic {}, message {}", impl_->topic, impl_->messages.size()));
-      if (!impl_->times.empty() && !(header.stamp > impl_->times.back())) {
+      if (!info_.times.empty() && !(header.stamp > info_.times.back())) {
         throw InputError(bag_, fmt::format("topic {}, message {}: header stamp {:.9f} is not after the previous {:.9f}",
-                                           impl_->topic, impl_->messages.size(), header.stamp, impl_->times.back()));
+                                           impl_->topic, impl_->messages.size(), header.stamp, info_.times.back()));
       }
       if (impl_->messages.empty()) impl_->frame_id = header.frame_id;
-      impl_->times.push_back(header.stamp);
+      info_.times.push_back(header.stamp);
       impl_->messages.push_back(m);
     }
     if (impl_->messages.empty()) throw InputError(bag_, fmt::format("topic {} has no messages", impl_->topic));
     return 0;
   });
+  info_.name = fmt::format("{} (topic {})", bag_.string(), impl_->topic);
+  info_.format = "rosbag";
+  info_.point_fields = parse(0).decoded.fields;
+  info_.notes = {fmt::format("topic: {} ({} messages), frame '{}'", impl_->topic, impl_->messages.size(), impl_->frame_id),
+                 "times: the messages' header stamps", "calibration: none: runs in the LiDAR frame",
+                 "reference: none (a bag of point clouds)"};
 }
 
-LabelledCloud RosbagSequence::scan(std::size_t i) {
+PointCloud2Scan RosbagSource::parse(std::size_t i) const {
   const auto bytes = guarded(bag_, [&] { return message_bytes(impl_->messages.at(i), bag_); });
-  PointCloud2Scan scan = parse_pointcloud2(bytes, bag_, fmt::format("topic {}, message {}", impl_->topic, i));
-  impl_->fields = scan.decoded.fields;
-  return std::move(scan.decoded.cloud);
+  return parse_pointcloud2(bytes, bag_, fmt::format("topic {}, message {}", impl_->topic, i));
 }
 
-std::size_t RosbagSequence::size() const { return impl_->messages.size(); }
-const std::vector<double>& RosbagSequence::times() const { return impl_->times; }
-const std::string& RosbagSequence::topic() const { return impl_->topic; }
-std::string RosbagSequence::fields() const { return impl_->fields; }
+LabelledCloud RosbagSource::scan(std::size_t i) { return std::move(parse(i).decoded.cloud); }
 
-ScanSequenceFacts RosbagSequence::facts() const {
-  ScanSequenceFacts f;
-  f.notes.push_back(fmt::format("topic: {} ({} messages), frame '{}'", impl_->topic, impl_->messages.size(), impl_->frame_id));
-  f.notes.push_back("times: the messages' header stamps");
-  f.notes.push_back("calibration: none: runs in the LiDAR frame");
-  f.notes.push_back("reference: none (a bag of point clouds)");
-  return f;
-}
+const std::string& RosbagSource::topic() const { return impl_->topic; }
 
 struct PointCloud2BagWriter::Impl {
   fs::path path;
@@ -272,29 +264,22 @@ void PointCloud2BagWriter::close() {
 
 #else  // without rosbag_storage
 
-struct RosbagSequence::Impl {};
+struct RosbagSource::Impl {};
 struct PointCloud2BagWriter::Impl {};
 
 std::vector<BagTopic> list_bag_topics(const fs::path& bag) {
   check_magic(bag);
   not_built(bag);
 }
-RosbagSequence::RosbagSequence(fs::path bag, const ScanSequenceOptions&) : bag_(std::move(bag)) {
+RosbagSource::RosbagSource(fs::path bag, const SourceOptions&) : bag_(std::move(bag)) {
   check_magic(bag_);
   not_built(bag_);
 }
-LabelledCloud RosbagSequence::scan(std::size_t) { not_built(bag_); }
-std::size_t RosbagSequence::size() const { return 0; }
-const std::vector<double>& RosbagSequence::times() const {
-  static const std::vector<double> none;
-  return none;
-}
-const std::string& RosbagSequence::topic() const {
+LabelledCloud RosbagSource::scan(std::size_t) { not_built(bag_); }
+const std::string& RosbagSource::topic() const {
   static const std::string none;
   return none;
 }
-std::string RosbagSequence::fields() const { return {}; }
-ScanSequenceFacts RosbagSequence::facts() const { return {}; }
 PointCloud2BagWriter::PointCloud2BagWriter(const fs::path& bag, std::string, std::string, BagCompression) { not_built(bag); }
 PointCloud2BagWriter::~PointCloud2BagWriter() = default;
 void PointCloud2BagWriter::write(const LabelledCloud&, double, const std::string&) {}
@@ -302,8 +287,6 @@ void PointCloud2BagWriter::close() {}
 
 #endif
 
-RosbagSequence::~RosbagSequence() = default;
-
-std::string RosbagSequence::name() const { return fmt::format("{} (topic {})", bag_.string(), topic()); }
+RosbagSource::~RosbagSource() = default;
 
 }  // namespace saloam
