@@ -35,6 +35,21 @@ TEST(KittiRaw, TimestampsWriteAndReadBack) {
   for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(back[i], t[i], 1e-6);
 }
 
+// Nanoseconds stay exact: times relative to a drive's first scan come back as
+// written (in seconds since the epoch a double keeps only about 0.2 us).
+TEST(KittiRaw, TimestampsAreExactNanoseconds) {
+  std::istringstream in("2011-09-26 13:02:25.000000000\n2011-09-26 13:02:25.100000000\n2011-09-26 13:02:25.1000000006\n");
+  const auto ns = parse_kitti_timestamps_ns(in, "timestamps.txt");
+  ASSERT_EQ(ns.size(), 3u);
+  EXPECT_EQ(ns[0], 1317042145 * kNanosPerSecond);
+  EXPECT_EQ(ns[1] - ns[0], 100000000);
+  EXPECT_EQ(ns[2] - ns[1], 1);  // a tenth digit rounds
+  EXPECT_EQ(nanos_to_seconds(ns[1] - ns[0]), 0.1);
+  testing::TempDir dir;
+  write_kitti_timestamps_ns(dir / "t.txt", ns);
+  EXPECT_EQ(read_kitti_timestamps_ns(dir / "t.txt"), ns);
+}
+
 TEST(KittiRaw, BadTimestampsNameTheLine) {
   const auto error_of = [](const std::string& text) {
     std::istringstream in(text);

@@ -65,24 +65,27 @@ long days_from_civil(long y, unsigned m, unsigned d) {
   return era * 146097 + static_cast<long>(doe) - 719468;
 }
 
-/// "YYYY-MM-DD hh:mm:ss[.fffffffff]" as seconds since the epoch, or nullopt.
-std::optional<double> parse_date_time(std::string_view s) {
+/// "YYYY-MM-DD hh:mm:ss[.fffffffff]" as nanoseconds since the epoch (exact:
+/// times of one drive subtract without rounding), or nullopt. A tenth
+/// fraction digit rounds the nanoseconds.
+std::optional<std::int64_t> parse_date_time(std::string_view s) {
   if (s.size() < 19 || s[4] != '-' || s[7] != '-' || s[10] != ' ' || s[13] != ':' || s[16] != ':') return std::nullopt;
   const auto year = digits_at(s, 0, 4), month = digits_at(s, 5, 2), day = digits_at(s, 8, 2);
   const auto hour = digits_at(s, 11, 2), minute = digits_at(s, 14, 2), second = digits_at(s, 17, 2);
   if (!year || !month || !day || !hour || !minute || !second) return std::nullopt;
   if (*month < 1 || *month > 12 || *day < 1 || *day > 31 || *hour > 23 || *minute > 59 || *second > 60) return std::nullopt;
-  double fraction = 0.0;
+  std::int64_t nanos = 0;
   if (s.size() > 19) {
     if (s[19] != '.' || s.size() == 20 || s.size() > 30) return std::nullopt;
-    double scale = 0.1;
-    for (std::size_t i = 20; i < s.size(); ++i, scale /= 10.0) {
+    std::int64_t scale = 100000000;
+    for (std::size_t i = 20; i < s.size(); ++i, scale /= 10) {
       if (s[i] < '0' || s[i] > '9') return std::nullopt;
-      fraction += scale * (s[i] - '0');
+      nanos += scale > 0 ? scale * (s[i] - '0') : (s[i] >= '5');  // the 10th digit rounds
     }
   }
   const long days = days_from_civil(*year, static_cast<unsigned>(*month), static_cast<unsigned>(*day));
-  return static_cast<double>(days) * 86400.0 + *hour * 3600.0 + *minute * 60.0 + *second + fraction;
+  const std::int64_t seconds = static_cast<std::int64_t>(days) * 86400 + *hour * 3600 + *minute * 60 + *second;
+  return seconds * kNanosPerSecond + nanos;
 }
 
 std::string read_all(std::istream& in, const std::filesystem::path& file) {
@@ -186,8 +189,8 @@ std::vector<OxtsRecord> poses_to_oxts(const std::vector<Pose>& imu_poses, const 
   return out;
 }
 
-std::vector<double> parse_kitti_timestamps(std::istream& in, const std::filesystem::path& file) {
-  std::vector<double> times;
+std::vector<std::int64_t> parse_kitti_timestamps_ns(std::istream& in, const std::filesystem::path& file) {
+  std::vector<std::int64_t> times;
   std::size_t previous_line = 0;
   for_each_text_line(in, file, [&](const std::string& raw, std::size_t line_no) {
     const auto words = split_words(raw);
@@ -198,11 +201,25 @@ std::vector<double> parse_kitti_timestamps(std::istream& in, const std::filesyst
       throw InputError(file, fmt::format("line {}: '{}' is not a KITTI timestamp (YYYY-MM-DD hh:mm:ss.fffffffff)", line_no,
                                          line.substr(0, 40)));
     }
-    if (!times.empty()) check_time_increases(times.back(), previous_line, *t, file, line_no);
+    if (!times.empty() && *t <= times.back()) {
+      check_time_increases(nanos_to_seconds(times.back()), previous_line, nanos_to_seconds(*t), file, line_no);
+    }
     times.push_back(*t);
     previous_line = line_no;
   });
   return times;
+}
+
+std::vector<double> parse_kitti_timestamps(std::istream& in, const std::filesystem::path& file) {
+  const auto nanos = parse_kitti_timestamps_ns(in, file);
+  std::vector<double> times(nanos.size());
+  std::transform(nanos.begin(), nanos.end(), times.begin(), nanos_to_seconds);
+  return times;
+}
+
+std::vector<std::int64_t> read_kitti_timestamps_ns(const std::filesystem::path& file) {
+  auto in = open_text_file(file, "timestamps file");
+  return parse_kitti_timestamps_ns(in, file);
 }
 
 std::vector<double> read_kitti_timestamps(const std::filesystem::path& file) {
@@ -211,15 +228,16 @@ std::vector<double> read_kitti_timestamps(const std::filesystem::path& file) {
 }
 
 void write_kitti_timestamps(const std::filesystem::path& file, const std::vector<double>& seconds) {
+  std::vector<std::int64_t> nanos(seconds.size());
+  std::transform(seconds.begin(), seconds.end(), nanos.begin(), [](double t) { return std::llround(t * 1e9); });
+  write_kitti_timestamps_ns(file, nanos);
+}
+
+void write_kitti_timestamps_ns(const std::filesystem::path& file, const std::vector<std::int64_t>& times) {
   auto out = create_text(file);
-  for (const double t : seconds) {
-    const auto whole = static_cast<long>(std::floor(t));
-    long nanos = std::lround((t - static_cast<double>(whole)) * 1e9);
-    long s = whole;
-    if (nanos >= 1000000000L) {
-      nanos -= 1000000000L;
-      ++s;
-    }
+  for (const std::int64_t t : times) {
+    const std::int64_t s = t >= 0 ? t / kNanosPerSecond : (t - kNanosPerSecond + 1) / kNanosPerSecond;
+    const long nanos = static_cast<long>(t - s * kNanosPerSecond);
     const long days = s >= 0 ? s / 86400 : (s - 86399) / 86400;
     const long in_day = s - days * 86400;
     // civil_from_days (H. Hinnant)

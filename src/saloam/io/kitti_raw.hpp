@@ -19,6 +19,7 @@
 // (tests/io/kitti_raw_test.cpp).
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <istream>
 #include <string_view>
@@ -53,13 +54,24 @@ std::vector<Pose> oxts_to_poses(const std::vector<OxtsRecord>& records);
 /// record is `origin`. For writing drives from known poses.
 std::vector<OxtsRecord> poses_to_oxts(const std::vector<Pose>& imu_poses, const OxtsRecord& origin);
 
-/// A timestamps file: seconds since 1970-01-01 00:00 of the file's clock
-/// (the date taken as UTC), one per line, increasing. InputError naming the
-/// file and the line for a malformed date or time, or a time that does not
-/// increase. Empty lines are skipped.
+inline constexpr std::int64_t kNanosPerSecond = 1000000000;
+/// Nanoseconds as seconds (a double holds about 0.2 us at today's epoch
+/// times: subtract nanoseconds first where that matters).
+[[nodiscard]] inline double nanos_to_seconds(std::int64_t nanos) { return static_cast<double>(nanos) / 1e9; }
+
+/// A timestamps file: nanoseconds since 1970-01-01 00:00 of the file's clock
+/// (the date taken as UTC), one per line, increasing; exact, so that times
+/// of a drive relative to its first scan are those written. InputError
+/// naming the file and the line for a malformed date or time, or a time
+/// that does not increase. Empty lines are skipped.
+std::vector<std::int64_t> parse_kitti_timestamps_ns(std::istream& in, const std::filesystem::path& file);
+std::vector<std::int64_t> read_kitti_timestamps_ns(const std::filesystem::path& file);
+/// The same in seconds since the epoch.
 std::vector<double> parse_kitti_timestamps(std::istream& in, const std::filesystem::path& file);
 std::vector<double> read_kitti_timestamps(const std::filesystem::path& file);
-/// Writes seconds since the epoch as KITTI timestamp lines (nanosecond digits).
+/// Writes nanoseconds (or seconds, rounded to nanoseconds) since the epoch
+/// as KITTI timestamp lines.
+void write_kitti_timestamps_ns(const std::filesystem::path& file, const std::vector<std::int64_t>& nanos);
 void write_kitti_timestamps(const std::filesystem::path& file, const std::vector<double>& seconds);
 
 /// T_velo<-imu from calib_imu_to_velo.txt (R re-orthonormalised; InputError

@@ -53,23 +53,23 @@ void KittiRawDrive::read_times() {
     info_.notes.push_back("times: no velodyne_points/timestamps.txt, 0.1 s steps assumed");
     return;
   }
-  std::vector<double> stamps = read_kitti_timestamps(file);
+  std::vector<std::int64_t> stamps = read_kitti_timestamps_ns(file);
   if (stamps.size() < scans_.size()) throw InputError(file, fmt::format("{} timestamps for {} scans", stamps.size(), scans_.size()));
   stamps.resize(scans_.size());
-  first_stamp_ = stamps.front();
+  first_stamp_ = nanos_to_seconds(stamps.front());
   info_.times.resize(stamps.size());
-  for (std::size_t i = 0; i < stamps.size(); ++i) info_.times[i] = stamps[i] - first_stamp_;
+  for (std::size_t i = 0; i < stamps.size(); ++i) info_.times[i] = nanos_to_seconds(stamps[i] - stamps.front());
   info_.notes.push_back("times: velodyne_points/timestamps.txt (laser facing forward), since the first scan");
 
   const fs::path start = drive_ / "velodyne_points" / "timestamps_start.txt";
   const fs::path end = drive_ / "velodyne_points" / "timestamps_end.txt";
   if (fs::is_regular_file(start, ec) && fs::is_regular_file(end, ec)) {
-    const auto a = read_kitti_timestamps(start);
-    const auto b = read_kitti_timestamps(end);
+    const auto a = read_kitti_timestamps_ns(start);
+    const auto b = read_kitti_timestamps_ns(end);
     if (a.size() >= scans_.size() && b.size() >= scans_.size()) {
       std::vector<double> durations(scans_.size());
       double sum = 0.0;
-      for (std::size_t i = 0; i < durations.size(); ++i) sum += durations[i] = b[i] - a[i];
+      for (std::size_t i = 0; i < durations.size(); ++i) sum += durations[i] = nanos_to_seconds(b[i] - a[i]);
       info_.notes.push_back(fmt::format("sweeps: {:.4f} s on average (timestamps_start/_end.txt)",
                                          sum / static_cast<double>(durations.size())));
       sweep_durations_ = std::move(durations);

@@ -1,5 +1,7 @@
 #include "saloam/sources/sequence_writer.hpp"
 
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
@@ -67,10 +69,14 @@ void write_kitti_raw(FrameSource& in, const fs::path& out) {
   if (!lidar) throw InputError(out, "a KITTI raw drive needs reference poses (oxts), and the source has none");
   const fs::path data = out / "velodyne_points" / "data";
   for (std::size_t i = 0; i < in.size(); ++i) write_scan_bin(data / fmt::format("{:010d}.bin", i), in.scan(i));
-  std::vector<double> stamps = in.info().times;
-  for (double& t : stamps) t = t < kAbsoluteTimeThreshold ? kKittiRawEpoch + t : t;
-  write_kitti_timestamps(out / "velodyne_points" / "timestamps.txt", stamps);
-  write_kitti_timestamps(out / "oxts" / "timestamps.txt", stamps);
+  // Nanoseconds after an epoch of whole seconds: relative times come back exactly as they were.
+  std::vector<std::int64_t> stamps;
+  for (const double t : in.info().times) {
+    const auto epoch = static_cast<std::int64_t>(kKittiRawEpoch) * kNanosPerSecond;
+    stamps.push_back(std::llround(t * 1e9) + (t < kAbsoluteTimeThreshold ? epoch : 0));
+  }
+  write_kitti_timestamps_ns(out / "velodyne_points" / "timestamps.txt", stamps);
+  write_kitti_timestamps_ns(out / "oxts" / "timestamps.txt", stamps);
   const Pose velo_imu = kitti_imu_to_velo();
   std::vector<Pose> imu(lidar->size());
   const Pose first_inv = lidar->front().inverse();  // the reference starts at the identity
