@@ -59,6 +59,35 @@ std::filesystem::path config_file_path(const std::string& name);
 /// loop.sgpr_model, else the model shipped in data_dir()/models/sgpr/saloam.sgw;
 /// ConfigError saying how to pass one when there is none.
 std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config);
+/// The network plugin of the segmentation (beside the program in a build
+/// tree, in <prefix>/lib/saloam when installed); it exists only in builds
+/// with libtorch.
+std::filesystem::path segmentation_plugin_path();
+
+/// The segmentation model to load: `given` (--segmenter), else the config's
+/// segmentation.model, else the shipped data_dir()/models/segmenter/saloam.yaml.
+/// A TorchScript file (.pt) needs its description: `projection` (--projection
+/// FILE.yaml) or the .yaml of the same name beside it. ConfigError saying how
+/// to pass one when there is none.
+std::filesystem::path segmenter_description_path(const std::string& given, const std::string& projection,
+                                                 const SaloamConfig& config);
+
+/// --segment, --segmenter FILE and --projection FILE of the commands that can
+/// label raw scans in-process.
+struct SegmentOptions {
+  bool segment = false;
+  std::string segmenter;
+  std::string projection;
+  void add_to(CLI::App& app);
+  /// True when the run segments (--segment, or a --segmenter given).
+  [[nodiscard]] bool enabled() const { return segment || !segmenter.empty(); }
+};
+
+/// Replaces this process by the program `name` beside saloam (a trainer
+/// built only with libtorch), handing it `arguments` and the verbosity.
+/// Returns 2 with a message when the program was not built.
+int forward_to_program(const std::string& name, const std::vector<std::string>& arguments);
+
 /// --no-calib of the runs (odom, slam): without it a missing calib.txt is an
 /// error; with it poses.txt holds LiDAR-frame poses.
 void add_no_calib_flag(CLI::App& app, bool& no_calib);
