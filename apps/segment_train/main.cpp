@@ -55,10 +55,10 @@ void keep_recipe(const fs::path& out, const DataRecipe& recipe) {
   if (!file) throw InputError(out / "recipe.yaml", "cannot be written");
 }
 
-std::vector<ScanSequence> build_sequences(const std::vector<SourceSpec>& specs, const fs::path& out, bool cache) {
-  std::vector<ScanSequence> sequences;
+std::vector<TrainingScanSet> build_sequences(const std::vector<SourceSpec>& specs, const fs::path& out, bool cache) {
+  std::vector<TrainingScanSet> sequences;
   for (const auto& spec : specs) {
-    sequences.push_back(build_scan_sequence(spec, FeatureConfig{}, cache ? std::optional(out / "scans") : std::nullopt,
+    sequences.push_back(build_training_scans(spec, FeatureConfig{}, cache ? std::optional(out / "scans") : std::nullopt,
                                             spdlog::get_level() <= spdlog::level::info));
     if (stop_requested()) return {};
     const auto& s = sequences.back();

@@ -257,11 +257,11 @@ TrainingScan compact_scan(const LabelledCloud& cloud, const std::vector<std::int
   return scan;
 }
 
-ScanSequence build_scan_sequence(const SourceSpec& spec, const FeatureConfig& rings,
+TrainingScanSet build_training_scans(const SourceSpec& spec, const FeatureConfig& rings,
                                  const std::optional<fs::path>& cache_dir, bool show_progress) {
   if (spec.kind == SourceSpec::Kind::kSimulated && spec.noisy_labels)
     throw InputError(spec.path, "segmentation trains on ground truth: set `labels: gt` (" + spec.name() + ")");
-  ScanSequence sequence{spec.name(), {}};
+  TrainingScanSet sequence{spec.name(), {}};
   const std::string key = cache_key(spec, rings);
   const fs::path cache = cache_dir ? *cache_dir / (spec.name() + ".scans") : fs::path();
   if (cache_dir)
@@ -275,7 +275,7 @@ ScanSequence build_scan_sequence(const SourceSpec& spec, const FeatureConfig& ri
   return sequence;
 }
 
-std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<ScanSequence>& sequences) {
+std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<TrainingScanSet>& sequences) {
   std::array<std::uint64_t, kNumLearningClasses> counts{};
   for (const auto& s : sequences)
     for (const auto& scan : s.scans)
@@ -299,7 +299,7 @@ std::vector<std::int16_t> training_scan_rings(const TrainingScan& scan) {
   return ring;
 }
 
-void fit_channel_statistics(const std::vector<ScanSequence>& sequences, ProjectionSpec& spec, std::size_t step) {
+void fit_channel_statistics(const std::vector<TrainingScanSet>& sequences, ProjectionSpec& spec, std::size_t step) {
   const std::size_t channels = spec.channels.size();
   ProjectionSpec raw = spec;
   raw.means.assign(channels, 0.0f);

@@ -37,7 +37,7 @@ inline constexpr std::uint8_t kNoRing = 255;
 /// learning classes, points farther than 163 m are dropped.
 TrainingScan compact_scan(const LabelledCloud& cloud, const std::vector<std::int16_t>& ring, int beams);
 
-struct ScanSequence {
+struct TrainingScanSet {
   std::string name;
   std::vector<TrainingScan> scans;
 };
@@ -48,15 +48,15 @@ struct ScanSequence {
 /// `cache_dir`, kept there as <name>.scans and reused while the source is
 /// unchanged. InputError for a source without labels or with noisy labels.
 /// Stops early (returning what it has) on stop_requested().
-ScanSequence build_scan_sequence(const SourceSpec& spec, const FeatureConfig& rings,
+TrainingScanSet build_training_scans(const SourceSpec& spec, const FeatureConfig& rings,
                                  const std::optional<std::filesystem::path>& cache_dir, bool show_progress);
 
 /// Points per learning class over all scans (class frequencies of the loss weights).
-std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<ScanSequence>& sequences);
+std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<TrainingScanSet>& sequences);
 
 /// Mean and standard deviation of each channel over the pixels with a point
 /// of every `step`-th scan, projected without augmentation.
-void fit_channel_statistics(const std::vector<ScanSequence>& sequences, ProjectionSpec& spec, std::size_t step);
+void fit_channel_statistics(const std::vector<TrainingScanSet>& sequences, ProjectionSpec& spec, std::size_t step);
 
 /// Augmentations that prepare the network for sensors and scenes it was not
 /// trained on. Each draw is a pure function of the sample's seed.

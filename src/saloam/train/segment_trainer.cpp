@@ -282,7 +282,7 @@ using Batch = std::vector<PlannedSample>;
 
 /// The batches of one epoch: scans drawn uniformly, grouped by beam count
 /// into batches, in random order.
-std::vector<Batch> plan_epoch(const std::vector<ScanSequence>& train, const SegmentTrainOptions& options, int epoch) {
+std::vector<Batch> plan_epoch(const std::vector<TrainingScanSet>& train, const SegmentTrainOptions& options, int epoch) {
   std::vector<PlannedSample> all;
   for (std::uint32_t s = 0; s < train.size(); ++s)
     for (std::uint32_t k = 0; k < train[s].scans.size(); ++k) all.push_back({s, k, 0});
@@ -303,7 +303,7 @@ std::vector<Batch> plan_epoch(const std::vector<ScanSequence>& train, const Segm
   return batches;
 }
 
-std::vector<TrainingSample> prepare(const Batch& batch, const std::vector<ScanSequence>& train,
+std::vector<TrainingSample> prepare(const Batch& batch, const std::vector<TrainingScanSet>& train,
                                     const ProjectionSpec& projection, const SegmentTrainOptions& options) {
   std::vector<TrainingSample> samples;
   for (const auto& p : batch) {
@@ -322,7 +322,7 @@ struct EpochLoss {
   bool interrupted = false;
 };
 
-EpochLoss train_epoch(SegmentTrainer& trainer, const std::vector<ScanSequence>& train, const ProjectionSpec& projection,
+EpochLoss train_epoch(SegmentTrainer& trainer, const std::vector<TrainingScanSet>& train, const ProjectionSpec& projection,
                       const SegmentTrainOptions& options, int epoch) {
   const std::vector<Batch> batches = plan_epoch(train, options, epoch);
   ProgressBar progress(batches.size(), fmt::format("epoch {}", epoch), options.show_progress);
@@ -357,7 +357,7 @@ EpochLoss train_epoch(SegmentTrainer& trainer, const std::vector<ScanSequence>& 
 }
 
 /// Validation scans, at most `limit`, evenly spread over all sequences.
-std::vector<const TrainingScan*> validation_subset(const std::vector<ScanSequence>& validation, std::size_t limit) {
+std::vector<const TrainingScan*> validation_subset(const std::vector<TrainingScanSet>& validation, std::size_t limit) {
   std::vector<const TrainingScan*> all;
   for (const auto& s : validation)
     for (const auto& scan : s.scans) all.push_back(&scan);
@@ -431,7 +431,7 @@ nlohmann::json projection_json(const ProjectionSpec& p) { return {{"means", p.me
 
 /// The model's description: ring rows, the beam counts trained on, the
 /// training data's channel statistics, the 20 SemanticKITTI classes.
-SegmenterSpec initial_spec(const std::vector<ScanSequence>& train, const SegmentTrainOptions& options) {
+SegmenterSpec initial_spec(const std::vector<TrainingScanSet>& train, const SegmentTrainOptions& options) {
   SegmenterSpec spec;
   spec.network.shape = options.shape;
   spec.projection.row_mode = RowMode::kRing;
@@ -446,7 +446,7 @@ SegmenterSpec initial_spec(const std::vector<ScanSequence>& train, const Segment
   return spec;
 }
 
-void check_data(const std::vector<ScanSequence>& train, const SegmentTrainOptions& options) {
+void check_data(const std::vector<TrainingScanSet>& train, const SegmentTrainOptions& options) {
   if (options.epochs < 1) throw ConfigError("--epochs must be at least 1");
   if (options.batch < 1) throw ConfigError("--batch must be at least 1");
   std::size_t scans = 0;
@@ -472,7 +472,7 @@ SegmentTrainOptions resumed_options(const fs::path& out, const SegmentTrainOptio
   }
 }
 
-SegmentTrainResult train_segmenter(const std::vector<ScanSequence>& train, const std::vector<ScanSequence>& validation,
+SegmentTrainResult train_segmenter(const std::vector<TrainingScanSet>& train, const std::vector<TrainingScanSet>& validation,
                                    const SegmentTrainOptions& options, const nlohmann::json& run_info,
                                    const std::function<void(const SegmentEpochRecord&)>& on_epoch) {
   check_data(train, options);

@@ -79,7 +79,7 @@ inline constexpr std::array<int, 8> kBigClasses{9, 11, 13, 15, 17, 14, 1, 10};
 ///   training.json          options, data, per-epoch records (per-class IoU)
 ///   curves.png             training loss and validation mean IoU per epoch
 /// On stop_requested() the current epoch is abandoned and the last checkpoint kept.
-SegmentTrainResult train_segmenter(const std::vector<ScanSequence>& train, const std::vector<ScanSequence>& validation,
+SegmentTrainResult train_segmenter(const std::vector<TrainingScanSet>& train, const std::vector<TrainingScanSet>& validation,
                                    const SegmentTrainOptions& options, const nlohmann::json& run_info = {},
                                    const std::function<void(const SegmentEpochRecord&)>& on_epoch = {});
 
