@@ -132,6 +132,7 @@ std::function<int()> add_segment_train_options(CLI::App& app) {
                  "POSES.txt, beams: 64|32|16) or folders (folder: DIR); see docs/segmentation.md");
   app.add_option("--out", args->out, "Output folder of a new run (models, checkpoint/, training.json, curves.png, scans/)");
   app.add_option("--resume", args->resume, "Continue the run in this folder from its last checkpoint (with its options)");
+  app.add_option("--init", o.init, "A SegNet description (.yaml) to fine-tune (same architecture); default: from scratch");
   app.add_option("--epochs", o.epochs, "Epochs in all (a resumed run continues up to this)")
       ->check(CLI::Range(1, 100000))
       ->capture_default_str();

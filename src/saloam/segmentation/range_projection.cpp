@@ -52,6 +52,12 @@ float channel_value(ImageChannel channel, const Eigen::Vector3f& p, float range,
 
 }  // namespace
 
+std::vector<ImageChannel> all_channels() {
+  std::vector<ImageChannel> channels;
+  for (int c = 0; c <= static_cast<int>(ImageChannel::kMask); ++c) channels.push_back(static_cast<ImageChannel>(c));
+  return channels;
+}
+
 std::string_view channel_name(ImageChannel channel) {
   switch (channel) {
     case ImageChannel::kRange: return "range";

@@ -37,14 +37,16 @@ enum class ImageChannel : std::uint8_t { kRange, kX, kY, kZ, kRemission, kMask }
 /// "range", "x", "y", "z", "remission", "mask".
 std::string_view channel_name(ImageChannel channel);
 
+/// range, x, y, z, remission, mask: saloam's own networks' channels.
+std::vector<ImageChannel> all_channels();
+
 struct ProjectionSpec {
   RowMode row_mode = RowMode::kRing;
   int rows = 64;                 ///< kElevation: image rows (kRing: one per beam of the scan)
   double fov_up_deg = 3.0;       ///< kElevation: elevation of the top edge of row 0 [deg]
   double fov_down_deg = -25.0;   ///< kElevation: elevation of the bottom edge of the last row [deg]
   int columns = 2048;
-  std::vector<ImageChannel> channels{ImageChannel::kRange, ImageChannel::kX, ImageChannel::kY,
-                                     ImageChannel::kZ, ImageChannel::kRemission, ImageChannel::kMask};
+  std::vector<ImageChannel> channels = all_channels();
   std::vector<float> means{0, 0, 0, 0, 0, 0};  ///< per channel
   std::vector<float> stds{1, 1, 1, 1, 1, 1};   ///< per channel, > 0
 };

@@ -88,8 +88,7 @@ class MapReader {
 };
 
 ImageChannel channel_from_name(const std::string& name, const MapReader& reader) {
-  for (auto c : {ImageChannel::kRange, ImageChannel::kX, ImageChannel::kY, ImageChannel::kZ, ImageChannel::kRemission,
-                 ImageChannel::kMask})
+  for (const auto c : all_channels())
     if (channel_name(c) == name) return c;
   reader.fail("channels", fmt::format("unknown channel '{}' (range, x, y, z, remission, mask)", name.substr(0, 40)));
 }

@@ -189,6 +189,7 @@ nlohmann::json options_json(const SegmentTrainOptions& o) {
           {"stem_stride", o.shape.stem_stride},
           {"context_blocks", o.shape.context_blocks},
           {"validation_scans", o.validation_scans},
+          {"init", o.init.empty() ? std::string("scratch") : fs::absolute(o.init).lexically_normal().string()},
           {"augment",
            {{"rotate", a.rotate},
             {"flip", a.flip},
@@ -219,6 +220,7 @@ SegmentTrainOptions options_from_json(const nlohmann::json& j, SegmentTrainOptio
   o.shape.stem_stride = j.at("stem_stride").get<int>();
   o.shape.context_blocks = j.at("context_blocks").get<int>();
   o.validation_scans = j.at("validation_scans").get<std::size_t>();
+  if (const auto init = j.value("init", std::string("scratch")); init != "scratch") o.init = init;
   const auto& a = j.at("augment");
   auto& t = o.augment;
   t.rotate = a.at("rotate").get<bool>();
@@ -472,6 +474,94 @@ SegmentTrainOptions resumed_options(const fs::path& out, const SegmentTrainOptio
   }
 }
 
+namespace {
+
+/// A run's network, description and history so far: fresh (channel
+/// statistics fitted on the training data), fine-tuned from --init, or
+/// resumed from the checkpoint in options.out.
+struct RunState {
+  SegmenterSpec spec;
+  std::unique_ptr<SegmentTrainer> trainer;
+  SegmentTrainResult result;
+};
+
+RunState start_run(const std::vector<TrainingScanSet>& train, const SegmentTrainOptions& options,
+                   const nlohmann::json& options_key) {
+  RunState run;
+  run.spec = initial_spec(train, options);
+  run.trainer = std::make_unique<SegmentTrainer>(run.spec.network.shape, options.seed, options);
+  run.trainer->set_class_weights(class_weights_from_counts(class_counts(train)));
+  if (options.resume) {
+    const nlohmann::json state = read_checkpoint_state(options.out);
+    if (state["options"] != options_key)
+      throw ConfigError(fmt::format("--resume: the options differ from those of the run in {} ({} there, {} now); resume "
+                                    "with the same options (only --epochs may change)",
+                                    options.out.string(), state["options"].dump(), options_key.dump()));
+    run.spec.projection.means = state.at("projection").at("means").get<std::vector<float>>();
+    run.spec.projection.stds = state.at("projection").at("stds").get<std::vector<float>>();
+    run.trainer->load_model(options.out / "checkpoint" / "model.pt");
+    run.trainer->load_optimizer(options.out / "checkpoint" / "optimizer.pt");
+    run.result.best_epoch = state.at("best_epoch").get<int>();
+    for (const auto& r : state.at("history")) run.result.history.push_back(record_from_json(r));
+    spdlog::info("resuming after epoch {} of {}", run.result.history.size(), options.out.string());
+  } else if (!options.init.empty()) {
+    const SegmenterSpec init = read_segmenter_spec(options.init);
+    if (init.network.format != NetworkFormat::kSegNet || init.network.shape.widths != run.spec.network.shape.widths ||
+        init.network.shape.stem_stride != run.spec.network.shape.stem_stride ||
+        init.network.shape.context_blocks != run.spec.network.shape.context_blocks ||
+        init.projection.channels != run.spec.projection.channels || init.classes != run.spec.classes)
+      throw InputError(options.init, "--init: not a SegNet of this run's architecture, channels and classes");
+    run.spec.projection.means = init.projection.means;
+    run.spec.projection.stds = init.projection.stds;
+    run.trainer->load_model(init.network.weights);
+  } else {
+    fit_channel_statistics(train, run.spec.projection, 10);
+  }
+  return run;
+}
+
+SegmentEpochRecord epoch_record(int epoch, const EpochLoss& trained, const SegmentationScore& validation,
+                                std::chrono::steady_clock::time_point start) {
+  SegmentEpochRecord record;
+  record.epoch = epoch;
+  record.loss = trained.loss;
+  record.learning_rate = trained.learning_rate;
+  record.samples = trained.samples;
+  record.samples_per_second = trained.seconds > 0 ? static_cast<double>(trained.samples) / trained.seconds : 0.0;
+  fill_validation(record, validation);
+  record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return record;
+}
+
+/// After an epoch: the models, the checkpoint, training.json and the curves.
+void write_epoch(const RunState& run, const SegmentTrainOptions& options, const nlohmann::json& options_key,
+                 const nlohmann::json& run_info, const std::array<std::uint64_t, kNumLearningClasses>& counts) {
+  const auto& history = run.result.history;
+  if (run.result.best_epoch == history.back().epoch) write_model(*run.trainer, run.spec, options.out, "best");
+  write_model(*run.trainer, run.spec, options.out, "model");
+  replace_checkpoint(options.out, [&](const fs::path& dir) {
+    run.trainer->save_model(dir / "model.pt");
+    run.trainer->save_optimizer(dir / "optimizer.pt");
+    nlohmann::json state{{"epochs_done", history.back().epoch}, {"options", options_key},
+                         {"best_epoch", run.result.best_epoch}, {"projection", projection_json(run.spec.projection)},
+                         {"history", nlohmann::json::array()}};
+    for (const auto& r : history) state["history"].push_back(record_json(r));
+    write_json_atomically(dir / "state.json", state);
+  });
+  nlohmann::json log = run_info;
+  log["options"] = options_key;
+  log["epochs_planned"] = options.epochs;
+  log["class_points"] = counts;
+  log["projection"] = projection_json(run.spec.projection);
+  log["best_epoch"] = run.result.best_epoch;
+  log["epochs"] = nlohmann::json::array();
+  for (const auto& r : history) log["epochs"].push_back(record_json(r));
+  write_json_atomically(options.out / "training.json", log);
+  plot_curves(options.out / "curves.png", run.result);
+}
+
+}  // namespace
+
 SegmentTrainResult train_segmenter(const std::vector<TrainingScanSet>& train, const std::vector<TrainingScanSet>& validation,
                                    const SegmentTrainOptions& options, const nlohmann::json& run_info,
                                    const std::function<void(const SegmentEpochRecord&)>& on_epoch) {
@@ -479,76 +569,29 @@ SegmentTrainResult train_segmenter(const std::vector<TrainingScanSet>& train, co
   set_training_threads(options.threads);
   create_folder(options.out);
   const nlohmann::json options_key = options_json(options);
-  SegmenterSpec spec = initial_spec(train, options);
-  SegmentTrainer trainer(spec.network.shape, options.seed, options);
+  RunState run = start_run(train, options, options_key);
   const auto counts = class_counts(train);
-  trainer.set_class_weights(class_weights_from_counts(counts));
-
-  SegmentTrainResult result;
-  if (options.resume) {
-    const nlohmann::json state = read_checkpoint_state(options.out);
-    if (state["options"] != options_key)
-      throw ConfigError(fmt::format("--resume: the options differ from those of the run in {} ({} there, {} now); resume "
-                                    "with the same options (only --epochs may change)",
-                                    options.out.string(), state["options"].dump(), options_key.dump()));
-    spec.projection.means = state.at("projection").at("means").get<std::vector<float>>();
-    spec.projection.stds = state.at("projection").at("stds").get<std::vector<float>>();
-    trainer.load_model(options.out / "checkpoint" / "model.pt");
-    trainer.load_optimizer(options.out / "checkpoint" / "optimizer.pt");
-    result.best_epoch = state.at("best_epoch").get<int>();
-    for (const auto& r : state.at("history")) result.history.push_back(record_from_json(r));
-    spdlog::info("resuming after epoch {} of {}", result.history.size(), options.out.string());
-  } else {
-    fit_channel_statistics(train, spec.projection, 10);
-  }
-
   const auto subset = validation_subset(validation, options.validation_scans);
-  const int first_epoch = result.history.empty() ? 1 : result.history.back().epoch + 1;
+  const int first_epoch = run.result.history.empty() ? 1 : run.result.history.back().epoch + 1;
   for (int epoch = first_epoch; epoch <= options.epochs; ++epoch) {
     const auto start = std::chrono::steady_clock::now();
-    const EpochLoss trained = train_epoch(trainer, train, spec.projection, options, epoch);
+    const EpochLoss trained = train_epoch(*run.trainer, train, run.spec.projection, options, epoch);
     if (trained.interrupted) {
-      result.interrupted = true;
+      run.result.interrupted = true;
       spdlog::warn("interrupted in epoch {}: it is dropped; the checkpoint after epoch {} is kept (continue with --resume)",
                    epoch, epoch - 1);
       break;
     }
-    SegmentEpochRecord record;
-    record.epoch = epoch;
-    record.loss = trained.loss;
-    record.learning_rate = trained.learning_rate;
-    record.samples = trained.samples;
-    record.samples_per_second = trained.seconds > 0 ? static_cast<double>(trained.samples) / trained.seconds : 0.0;
-    fill_validation(record, score_scans(Segmenter(spec, trainer.runner()), subset));
-    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    const bool best = result.best_epoch == 0 || record.val_miou > result.history.at(result.best_epoch - 1).val_miou;
-    result.history.push_back(record);
-    if (best) {
+    const SegmentEpochRecord record =
+        epoch_record(epoch, trained, score_scans(Segmenter(run.spec, run.trainer->runner()), subset), start);
+    auto& result = run.result;
+    if (result.best_epoch == 0 || record.val_miou > result.history.at(result.best_epoch - 1).val_miou)
       result.best_epoch = epoch;
-      write_model(trainer, spec, options.out, "best");
-    }
-    write_model(trainer, spec, options.out, "model");
-    replace_checkpoint(options.out, [&](const fs::path& dir) {
-      trainer.save_model(dir / "model.pt");
-      trainer.save_optimizer(dir / "optimizer.pt");
-      nlohmann::json state{{"epochs_done", epoch}, {"options", options_key}, {"best_epoch", result.best_epoch},
-                           {"projection", projection_json(spec.projection)}, {"history", nlohmann::json::array()}};
-      for (const auto& r : result.history) state["history"].push_back(record_json(r));
-      write_json_atomically(dir / "state.json", state);
-    });
-    nlohmann::json log = run_info;
-    log["options"] = options_key;
-    log["epochs_planned"] = options.epochs;
-    log["class_points"] = counts;
-    log["projection"] = projection_json(spec.projection);
-    log["best_epoch"] = result.best_epoch;
-    log["epochs"] = nlohmann::json::array();
-    for (const auto& r : result.history) log["epochs"].push_back(record_json(r));
-    write_json_atomically(options.out / "training.json", log);
-    plot_curves(options.out / "curves.png", result);
+    result.history.push_back(record);
+    write_epoch(run, options, options_key, run_info, counts);
     if (on_epoch) on_epoch(record);
   }
-  return result;
+  return run.result;
 }
 
 }  // namespace saloam

@@ -34,6 +34,7 @@ namespace saloam {
 struct SegmentTrainOptions {
   std::filesystem::path out;   ///< output folder: models, checkpoint/, training.json, curves.png, scans/ (cache)
   bool resume = false;         ///< continue the run in `out` from its last checkpoint
+  std::filesystem::path init;  ///< a SegNet description (.yaml) to fine-tune; empty = from scratch
   int epochs = 30;
   std::size_t samples_per_epoch = 2000;
   int batch = 8;                       ///< samples per step
