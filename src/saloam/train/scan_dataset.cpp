@@ -323,6 +323,13 @@ void fit_channel_statistics(const std::vector<TrainingScanSet>& sequences, Proje
     }
   if (count < 2) throw ConfigError("no training scan has a point: cannot fit the channel statistics");
   for (std::size_t c = 0; c < channels; ++c) {
+    // The mask is 1 on every pixel measured here: it keeps 0 / 1, so that it
+    // tells the network which pixels have a point.
+    if (spec.channels[c] == ImageChannel::kMask) {
+      spec.means[c] = 0.0f;
+      spec.stds[c] = 1.0f;
+      continue;
+    }
     const double mean = sum[c] / count;
     const double variance = std::max(sum_sq[c] / count - mean * mean, 0.0);
     spec.means[c] = static_cast<float>(mean);

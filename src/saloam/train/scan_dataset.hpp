@@ -55,7 +55,8 @@ TrainingScanSet build_training_scans(const SourceSpec& spec, const FeatureConfig
 std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<TrainingScanSet>& sequences);
 
 /// Mean and standard deviation of each channel over the pixels with a point
-/// of every `step`-th scan, projected without augmentation.
+/// of every `step`-th scan, projected without augmentation; the mask channel
+/// keeps mean 0 and deviation 1 (1 where a point is, 0 elsewhere).
 void fit_channel_statistics(const std::vector<TrainingScanSet>& sequences, ProjectionSpec& spec, std::size_t step);
 
 /// Augmentations that prepare the network for sensors and scenes it was not
