@@ -11,8 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
-#include "saloam/core/frame_range.hpp"
-#include "saloam/io/sequence.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/runs/segment_run.hpp"
 
 namespace saloam::cli {
@@ -21,13 +20,11 @@ namespace {
 namespace fs = std::filesystem;
 
 struct SegmentArgs {
-  std::string sequence;
+  SourceArgs source;  ///< --segment is implied
   std::string out;
-  std::string frames;
   std::string truth;
   bool no_score = false;
   std::optional<std::size_t> picture;
-  SegmentOptions segmenter;
   ConfigOptions config;
 };
 
@@ -37,7 +34,7 @@ std::optional<fs::path> truth_folder(const SegmentArgs& args) {
   if (!args.truth.empty()) return fs::path(args.truth);
   std::error_code error;
   for (const char* name : {"labels_gt", "labels"})
-    if (const auto folder = fs::path(args.sequence) / name; fs::is_directory(folder, error)) return folder;
+    if (const auto folder = fs::path(args.source.path) / name; fs::is_directory(folder, error)) return folder;
   return std::nullopt;
 }
 
@@ -50,32 +47,22 @@ void print_score(const SegmentationScore& score, const fs::path& truth) {
                                100 * score.iou(c), score.truth_count(c));
 }
 
-int run_segment(const SegmentArgs& args) {
+int run_segment(SegmentArgs args) {
   const SaloamConfig config = args.config.resolve();
-  const SegmenterSpec spec =
-      read_segmenter_spec(segmenter_description_path(args.segmenter.segmenter, args.segmenter.projection, config));
-  SequenceOptions sequence_options;
-  sequence_options.ignore_labels = true;
-  const SequenceReader reader(args.sequence, sequence_options);
-  SequenceFolderSource folder(reader);
-  SegmentedSource source(
-      folder, [&] { return std::make_unique<Segmenter>(spec, segmentation_plugin_path(), config.odometry.features); },
-      config.segmentation.workers, config.segmentation.lookahead);
-
+  args.source.segment.segment = true;
+  args.source.no_calib = true;  // labels need no calibration
+  const std::unique_ptr<FrameSource> source = args.source.open(false, config);
   SegmentRunOptions options;
-  std::tie(options.first_frame, options.end_frame) = FrameRange::parse(args.frames).clip(reader.size());
   options.truth = truth_folder(args);
   options.picture_frame = args.picture;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
-  const SegmentRunResult result = run_segmentation(source, args.out, options);
+  const SegmentRunResult result = run_segmentation(*source, args.out, options);
 
-  auto ms = result.segment_ms;
-  std::sort(ms.begin(), ms.end());
-  const double median = ms.empty() ? 0.0 : ms[ms.size() / 2];
-  std::cout << fmt::format("{} scans, {} points, network stage median {:.1f} ms/scan ({:.1f} Hz per worker, {} "
-                           "worker(s)); model {}\n",
-                           result.frames, result.points, median, median > 0 ? 1000.0 / median : 0.0,
-                           config.segmentation.workers, spec.file.string());
+  const Summary wall = summarize(column(result.segment_times, &StageTime::wall_ms));
+  const Summary cpu = summarize(column(result.segment_times, &StageTime::cpu_ms));
+  std::cout << fmt::format("{} scans, {} points; segmentation stage per scan: median {:.1f} ms CPU, {:.1f} ms wall ({} "
+                           "worker(s))\n",
+                           result.frames, result.points, cpu.median, wall.median, config.segmentation.workers);
   if (result.score) print_score(*result.score, *options.truth);
   std::cout << fmt::format("wrote {} .label files to {}; picture {}\n", result.frames, args.out, result.picture.string());
   if (result.interrupted) {
@@ -88,18 +75,13 @@ int run_segment(const SegmentArgs& args) {
 const CommandRegistration kRegistration{Command{
     "segment", "Label raw scans with the segmentation network (SemanticKITTI .label files)", 25, [](CLI::App& app) {
       auto args = std::make_shared<SegmentArgs>();
-      app.add_option("SEQ_DIR", args->sequence, "Sequence folder (velodyne/; labels are not read but to score)")
-          ->required();
+      args->source.add_to(app, "Sequence folder (velodyne/; labels are read only to score)");
       app.add_option("--out", args->out, "Folder for the .label files (and segment_NNNNNN.png)")->required();
-      app.add_option("--frames", args->frames, "Frame range A:B (B exclusive; A: = to the end)");
       app.add_option("--truth", args->truth,
                      "Ground-truth .label folder to score against (default: SEQ/labels_gt, else SEQ/labels)");
       app.add_flag("--no-score", args->no_score, "Do not score against ground truth");
       app.add_option("--picture", args->picture, "Frame drawn coloured by predicted class (default: the middle one)")
           ->check(non_negative_integer());
-      app.add_option("--segmenter", args->segmenter.segmenter,
-                     "Segmentation model: a description (.yaml) or a TorchScript network (.pt); default: the shipped one");
-      app.add_option("--projection", args->segmenter.projection, "Description (.yaml) of a --segmenter TorchScript network");
       args->config.add_to(app);
       return [args] { return run_segment(*args); };
     }}};

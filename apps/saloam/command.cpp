@@ -16,6 +16,8 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/segmentation/segmenter.hpp"
+#include "saloam/core/frame_range.hpp"
+#include "saloam/sources/open_source.hpp"
 
 namespace saloam::cli {
 
@@ -150,6 +152,38 @@ int forward_to_program(const std::string& name, const std::vector<std::string>& 
   argv.push_back(nullptr);
   execv(argv[0], argv.data());
   throw InputError(program, std::string("cannot run: ") + std::strerror(errno));
+}
+
+std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig& config) const {
+  if (!enabled()) return std::nullopt;
+  SegmentationStageOptions stage;
+  stage.model = read_segmenter_spec(segmenter_description_path(segmenter, projection, config));
+  stage.plugin = segmentation_plugin_path();
+  stage.rings = config.odometry.features;
+  stage.workers = config.segmentation.workers;
+  stage.lookahead = static_cast<std::size_t>(config.segmentation.lookahead);
+  return stage;
+}
+
+void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
+  app.add_option("SEQ_DIR", path, path_help)->required();
+  app.add_option("--labels", labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+  app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
+  segment.add_to(app);
+}
+
+std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, const SaloamConfig& config) const {
+  if (segment.enabled() && ignore_labels)
+    throw ConfigError("--segment labels the scans, but this run does not use labels (--no-semantics, or a label-free "
+                      "method): leave out one of them");
+  if (segment.enabled() && !labels.empty()) throw ConfigError("give --labels DIR or --segment, not both");
+  SourceOptions options;
+  if (!labels.empty()) options.labels = labels;
+  options.ignore_labels = ignore_labels;
+  options.ignore_calib = no_calib;
+  options.frames = FrameRange::parse(frames);
+  options.segmentation = segment.stage(config);
+  return open_source(path, options);
 }
 
 void add_no_calib_flag(CLI::App& app, bool& no_calib) {

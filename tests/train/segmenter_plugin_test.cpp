@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "saloam/runs/segmented_source.hpp"
+#include "saloam/segmentation/segmented_source.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/train/segment_trainer.hpp"
@@ -98,31 +98,31 @@ TEST(SegmenterPlugin, SegNetWeightsRunAsTheTrainerRunsThem) {
 /// Serves scans() as a source.
 class ListSource final : public FrameSource {
  public:
-  [[nodiscard]] std::string name() const override { return "list"; }
-  [[nodiscard]] std::size_t size() const override { return scans().size(); }
-  [[nodiscard]] bool has_labels() const override { return false; }
-  [[nodiscard]] const std::vector<double>& times() const override { return times_; }
-  [[nodiscard]] std::optional<Pose> velo_to_cam() const override { return std::nullopt; }
-  [[nodiscard]] std::optional<std::vector<Pose>> camera_poses() const override { return std::nullopt; }
-  [[nodiscard]] std::optional<std::vector<Pose>> sensor_camera_poses() const override { return std::nullopt; }
-  [[nodiscard]] std::optional<fs::path> folder() const override { return std::nullopt; }
+  ListSource() {
+    info_.name = "list";
+    for (std::size_t i = 0; i < scans().size(); ++i) info_.times.push_back(0.1 * static_cast<double>(i));
+  }
+  [[nodiscard]] const SourceInfo& info() const override { return info_; }
   LabelledCloud scan(std::size_t i) override { return scans().at(i); }
-  [[nodiscard]] bool rereadable() const override { return true; }
 
  private:
-  std::vector<double> times_ = std::vector<double>(scans().size(), 0.0);
+  SourceInfo info_;
 };
 
 std::vector<std::vector<std::uint16_t>> segmented(const fs::path& model, int workers) {
-  ListSource list;
   const SegmenterSpec spec = read_segmenter_spec(model);
-  SegmentedSource source(list, [&] { return std::make_unique<Segmenter>(spec, kPlugin); }, workers, 2);
+  SegmentedSource source(std::make_unique<ListSource>(), [&] { return std::make_unique<Segmenter>(spec, kPlugin); },
+                         workers, 2);
+  EXPECT_TRUE(source.info().has_labels);
+  EXPECT_FALSE(source.info().rereadable);
   std::vector<std::vector<std::uint16_t>> labels;
   for (std::size_t i = 0; i < source.size(); ++i) {
     const LabelledCloud cloud = source.scan(i);
     EXPECT_TRUE(cloud.has_labels);
     labels.push_back(cloud.label);
   }
+  EXPECT_EQ(source.stage_times().back().name, "segmentation");
+  EXPECT_EQ(source.stage_times().back().per_frame.size(), source.size());
   return labels;
 }
 

@@ -17,8 +17,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void refuse_input_folder(const SegmentedSource& source, const fs::path& out_dir) {
-  const auto folder = source.folder();
+void refuse_input_folder(const FrameSource& source, const fs::path& out_dir) {
+  const auto& folder = source.info().folder;
   if (!folder) return;
   std::error_code error;
   for (const char* labels : {"labels", "labels_gt"})
@@ -36,27 +36,34 @@ std::vector<std::uint16_t> truth_labels(const fs::path& folder, std::size_t fram
   return labels;
 }
 
+std::vector<StageTime> segmentation_times(const FrameSource& source) {
+  for (auto& stage : source.stage_times())
+    if (stage.name == "segmentation") return stage.per_frame;
+  return {};
+}
+
 }  // namespace
 
-SegmentRunResult run_segmentation(SegmentedSource& source, const fs::path& out_dir, const SegmentRunOptions& options) {
-  const std::size_t end = std::min(options.end_frame, source.size());
-  if (options.first_frame >= end) throw ConfigError("segment: the frame range holds no scan");
+SegmentRunResult run_segmentation(FrameSource& source, const fs::path& out_dir, const SegmentRunOptions& options) {
+  if (!source.info().has_labels) throw std::logic_error("run_segmentation: a source with labels expected");
   refuse_input_folder(source, out_dir);
   create_folder(out_dir);
-  const std::size_t picture = options.picture_frame.value_or(options.first_frame + (end - options.first_frame) / 2);
+  const std::size_t first = source.info().first_frame;
+  const std::size_t picture = options.picture_frame.value_or(first + source.size() / 2);
   SegmentRunResult result;
   if (options.truth) result.score.emplace();
-  ProgressBar progress(end - options.first_frame, "segment", options.show_progress);
-  for (std::size_t i = options.first_frame; i < end; ++i) {
+  ProgressBar progress(source.size(), "segment", options.show_progress);
+  for (std::size_t i = 0; i < source.size(); ++i) {
     if (stop_requested()) {
       result.interrupted = true;
       break;
     }
     const LabelledCloud cloud = source.scan(i);
-    write_scan_labels(out_dir / (frame_name(i) + ".label"), cloud);
-    if (result.score) result.score->add(truth_labels(*options.truth, i, cloud.size()), cloud.label);
-    if (i == picture) {
-      result.picture = out_dir / fmt::format("segment_{}.png", frame_name(i));
+    const std::size_t frame = first + i;
+    write_scan_labels(out_dir / (frame_name(frame) + ".label"), cloud);
+    if (result.score) result.score->add(truth_labels(*options.truth, frame, cloud.size()), cloud.label);
+    if (frame == picture) {
+      result.picture = out_dir / fmt::format("segment_{}.png", frame_name(frame));
       render_range_image(cloud, result.picture);
     }
     ++result.frames;
@@ -64,7 +71,7 @@ SegmentRunResult run_segmentation(SegmentedSource& source, const fs::path& out_d
     progress.advance();
   }
   progress.finish();
-  result.segment_ms = source.segment_ms();
+  result.segment_times = segmentation_times(source);
   return result;
 }
 

@@ -1,28 +1,27 @@
 #pragma once
-// `saloam segment`: labels the scans of a source with the segmentation stage
-// and writes them as SemanticKITTI .label files (NNNNNN.label, the scan's
-// number; class in the low 16 bits, instance 0), which any run reads back
-// with --labels DIR. When ground-truth labels are at hand, the predictions
-// are scored against them (per-class IoU, SemanticKITTI's mIoU).
+// `saloam segment`: writes the labels of a source's scans (a source whose
+// last stage is the segmentation) as SemanticKITTI .label files
+// (NNNNNN.label, the scan's number in its folder; class in the low 16 bits,
+// instance 0), which any run reads back with --labels DIR. When ground-truth
+// labels are at hand, the predictions are scored against them (per-class
+// IoU, SemanticKITTI's mIoU).
 
 #include <cstddef>
 #include <filesystem>
 #include <functional>
-#include <limits>
 #include <optional>
 #include <vector>
 
-#include "saloam/runs/segmented_source.hpp"
+#include "saloam/io/frame_source.hpp"
 #include "saloam/sim/label_noise.hpp"
 
 namespace saloam {
 
 struct SegmentRunOptions {
-  std::size_t first_frame = 0;
-  std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the source
   /// A folder of ground-truth .label files to score against (none: no score).
   std::optional<std::filesystem::path> truth;
-  /// Frame drawn as a range image coloured by predicted class (none: the middle frame).
+  /// Frame (the folder's number) drawn as a range image coloured by predicted
+  /// class (none: the middle frame of the source).
   std::optional<std::size_t> picture_frame;
   bool show_progress = true;
 };
@@ -30,15 +29,15 @@ struct SegmentRunOptions {
 struct SegmentRunResult {
   std::size_t frames = 0;
   std::size_t points = 0;
-  std::vector<double> segment_ms;       ///< per frame: the network stage's wall time
+  std::vector<StageTime> segment_times;  ///< per frame: the segmentation stage's time
   std::optional<SegmentationScore> score;
   std::filesystem::path picture;
   bool interrupted = false;
 };
 
-/// Segments frames [first_frame, end_frame) of `source` into `out_dir`
-/// (created; it must not be the source's own labels folder).
-SegmentRunResult run_segmentation(SegmentedSource& source, const std::filesystem::path& out_dir,
+/// Writes the labels of every frame of `source` (which has labels) into
+/// `out_dir` (created; never the source folder's own labels/ or labels_gt/).
+SegmentRunResult run_segmentation(FrameSource& source, const std::filesystem::path& out_dir,
                                   const SegmentRunOptions& options);
 
 }  // namespace saloam

@@ -1,7 +1,6 @@
 #include "saloam/train/sgpr_trainer.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <fstream>
 #include <numeric>
 #include <random>
@@ -12,6 +11,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/place/sgpr_network.hpp"
 #include "saloam/train/sgpr_torch.hpp"
@@ -208,7 +208,7 @@ EpochLoss train_epoch(SgprTrainer& trainer, std::span<const GraphSequence> train
   EpochLoss result;
   const std::size_t batch = static_cast<std::size_t>(std::max(1, options.batch));
   ProgressBar progress(pairs.size(), fmt::format("epoch {}/{}", epoch, options.epochs), options.show_progress);
-  const auto start = std::chrono::steady_clock::now();
+  const StageTimer timer;
   double loss_sum = 0;
   for (std::size_t begin = 0; begin < pairs.size(); begin += batch) {
     if (stop_requested()) {
@@ -237,7 +237,7 @@ EpochLoss train_epoch(SgprTrainer& trainer, std::span<const GraphSequence> train
     progress.advance(targets.size());
   }
   progress.finish();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = timer.elapsed_s();
   result.loss = result.pairs ? loss_sum / static_cast<double>(result.pairs) : 0.0;
   return result;
 }
@@ -347,7 +347,7 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
 
   const int first_epoch = result.history.empty() ? 1 : result.history.back().epoch + 1;
   for (int epoch = first_epoch; epoch <= options.epochs; ++epoch) {
-    const auto start = std::chrono::steady_clock::now();
+    const StageTimer timer;
     std::mt19937_64 rng = epoch_generator(options.seed, epoch);
     const auto pairs = epoch_pairs(trainer->weights(), train, positives, options, rng);
     const EpochLoss trained = train_epoch(*trainer, train, pairs, options, epoch, rng);
@@ -366,7 +366,7 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
     record.pairs_per_second = trained.seconds > 0 ? static_cast<double>(trained.pairs) / trained.seconds : 0.0;
     record.val_max_f1 = val.max_f1;
     record.val_recall_at_full_precision = val.recall_at_full_precision;
-    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.seconds = timer.elapsed_s();
     const bool best = val.max_f1 > best_f1(result);
     result.history.push_back(record);
     if (best) {
