@@ -8,7 +8,7 @@ namespace saloam {
 std::unique_ptr<FrameSource> open_reader(const std::filesystem::path& path, const SourceOptions& options) {
   SequenceOptions sequence;
   sequence.labels_dir = options.labels;
-  sequence.ignore_labels = options.ignore_labels;
+  sequence.ignore_labels = options.ignore_labels || options.segmentation.has_value();
   auto source = std::make_unique<SequenceFolderSource>(SequenceReader(path, sequence), !options.ignore_calib);
   if (!options.ignore_calib && !source->info().velo_to_cam) {
     throw InputError(path / "calib.txt",
@@ -23,6 +23,7 @@ std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, con
   if (options.frames.first > 0 || options.frames.end < source->size()) {
     source = std::make_unique<FrameRangeSource>(std::move(source), options.frames);
   }
+  if (options.segmentation) source = std::make_unique<SegmentedSource>(std::move(source), *options.segmentation);
   return source;
 }
 
