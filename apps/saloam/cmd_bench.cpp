@@ -55,7 +55,7 @@ int run_bench_command(BenchOptions options) {
   const int threads = config.odometry.threads;
   if (options.no_semantics) config.odometry.use_semantics = false;
   options.source.no_calib = true;  // the bench writes no poses: calib.txt is not needed
-  const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics);
+  const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics, config);
   const BenchResult r = run_bench(*source, config.odometry);
   if (r.frames == 0) return 130;
 

@@ -22,6 +22,7 @@ struct ConvertArgs {
   std::string encoding;
   std::string bag_topic = "/points";
   bool no_labels = false;
+  ConfigOptions config;
 };
 
 const std::map<std::string, PcdEncoding> kPcdEncodings{
@@ -55,7 +56,7 @@ SequenceWriteOptions write_options(const ConvertArgs& args) {
 
 int run_convert(const ConvertArgs& args) {
   const SequenceWriteOptions options = write_options(args);  // before anything is read
-  const auto source = args.source.open(args.no_labels);
+  const auto source = args.source.open(args.no_labels, args.config.resolve());
   write_scan_sequence(*source, args.out, options);
   std::cout << fmt::format("wrote {} frames of {} ({}) as {} into {}\n", source->size(), source->info().name,
                            source->info().format, args.to, args.out);
@@ -79,6 +80,7 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--bag-topic", args->bag_topic, "Topic of the written bag's PointCloud2 messages")
           ->capture_default_str();
       app.add_flag("--no-labels", args->no_labels, "Leave the labels out");
+      args->config.add_to(app);
       return [args] { return run_convert(*args); };
     }}};
 

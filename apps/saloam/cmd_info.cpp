@@ -47,7 +47,7 @@ void print_summary(const FrameSource& source, const SequenceSummary& s, bool for
 }
 
 int run_info(const InfoArgs& args) {
-  const auto source = args.source.open(false);
+  const auto source = args.source.open(false, SaloamConfig{});
   const SequenceSummary summary = summarize(*source, args.scans);
   print_summary(*source, summary, args.source.format != "auto");
   return 0;

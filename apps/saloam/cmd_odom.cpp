@@ -26,7 +26,7 @@ struct OdomOptions {
 int run_odom(const OdomOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (options.no_semantics) config.odometry.use_semantics = false;
-  const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics);
+  const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics, config);
   const std::filesystem::path out_dir(options.out);
   const OdometryRunResult result = run_odometry(*source, config.odometry, out_dir);
   const double median_ms = result.median_frame_ms();

@@ -55,8 +55,10 @@ int run_place_eval_command(PlaceEvalArgs args) {
   const SaloamConfig config = args.config.resolve();
   const PlaceDetector detector = parse_place_detector(run.method);
   if (uses_sgpr(detector)) run.model = sgpr_model_path(args.model, config);
-  run.labels = args.source.labels.empty() ? std::string("labels/") : args.source.labels;
-  const std::unique_ptr<FrameSource> source = args.source.open(!needs_labels(detector));
+  run.labels = args.source.segment.enabled() ? std::string("segmented in-process")
+               : args.source.labels.empty()  ? std::string("labels/")
+                                             : args.source.labels;
+  const std::unique_ptr<FrameSource> source = args.source.open(!needs_labels(detector), config);
   const std::filesystem::path out = args.out.empty() ? "place_eval_" + run.method : args.out;
   const PlaceEvalResult result = run_place_eval(*source, config, run, out);
   if (result.interrupted) return 130;

@@ -69,7 +69,7 @@ int run_slam_command(const SlamOptions& options) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
   const bool labels = config.odometry.use_semantics || needs_labels(parse_place_detector(config.loop.detector));
-  const std::unique_ptr<FrameSource> source = options.source.open(!labels);
+  const std::unique_ptr<FrameSource> source = options.source.open(!labels, config);
   SlamRunOptions run_options;
   run_options.write_map = !options.no_map;
 

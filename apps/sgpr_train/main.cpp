@@ -56,7 +56,7 @@ void keep_recipe(const fs::path& out, const DataRecipe& recipe) {
   file << recipe_to_json(recipe).dump(2) << '\n';
 }
 
-std::vector<GraphSequence> build_sequences(const std::vector<GraphSourceSpec>& specs, const fs::path& out, bool cache) {
+std::vector<GraphSequence> build_sequences(const std::vector<SourceSpec>& specs, const fs::path& out, bool cache) {
   std::vector<GraphSequence> sequences;
   for (const auto& spec : specs) {
     const StageTimer timer;

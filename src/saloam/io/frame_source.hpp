@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "saloam/core/frame_range.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/core/types.hpp"
 
 namespace saloam {
@@ -73,12 +74,22 @@ struct SourceInfo {
   [[nodiscard]] std::size_t size() const { return times.size(); }
 };
 
+/// The time a stage spent on each frame it served (in the order served),
+/// for timing reports.
+struct SourceStageTimes {
+  std::string name;                 ///< e.g. "segmentation"
+  std::vector<StageTime> per_frame;
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
   [[nodiscard]] virtual const SourceInfo& info() const = 0;
   /// Frame i < size(), as promised above.
   virtual LabelledCloud scan(std::size_t i) = 0;
+  /// The times of the stages that prepared the frames served so far (a
+  /// stage adds its own to those of the source it wraps); none for a reader.
+  [[nodiscard]] virtual std::vector<SourceStageTimes> stage_times() const { return {}; }
 
   [[nodiscard]] std::size_t size() const { return info().size(); }
 };
@@ -93,6 +104,7 @@ class FrameRangeSource final : public FrameSource {
 
   [[nodiscard]] const SourceInfo& info() const override { return info_; }
   LabelledCloud scan(std::size_t i) override;
+  [[nodiscard]] std::vector<SourceStageTimes> stage_times() const override { return inner_->stage_times(); }
 
  private:
   std::unique_ptr<FrameSource> inner_;

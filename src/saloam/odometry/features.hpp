@@ -107,6 +107,13 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
 std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
                                                               const FeatureConfig& config, int expected_rings);
 
+/// Point indices per ring (top ring first), each ring in azimuth order, as
+/// extract_features() finds them: from the storage order when the scan is
+/// stored ring by ring (and config.ring_from_point_order), else from the
+/// elevation angle. Points in no ring (outside the layout's field of view,
+/// invalid) are left out.
+std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, const FeatureConfig& config);
+
 /// The class index of a raw label for the odometry, or -1 when the point must
 /// not be used (dynamic classes, unlabeled, outlier).
 int odometry_class(std::uint16_t raw_label);

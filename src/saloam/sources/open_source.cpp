@@ -92,7 +92,9 @@ ScanFormat detect_scan_format(const fs::path& path) {
   throw InputError(path, ec ? fmt::format("cannot access: {}", ec.message()) : std::string("is not a file or folder"));
 }
 
-std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptions& options) {
+std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptions& given) {
+  SourceOptions options = given;
+  options.ignore_labels = given.ignore_labels || given.segmentation.has_value();
   const ScanFormat format = options.format == ScanFormat::kAuto ? detect_scan_format(path) : options.format;
   switch (format) {
     case ScanFormat::kSemanticKitti: return open_semantic_kitti(path, options);
@@ -109,6 +111,7 @@ std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, con
   if (options.frames.first > 0 || options.frames.end < source->size()) {
     source = std::make_unique<FrameRangeSource>(std::move(source), options.frames);
   }
+  if (options.segmentation) source = std::make_unique<SegmentedSource>(std::move(source), *options.segmentation);
   return source;
 }
 

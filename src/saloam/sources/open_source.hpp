@@ -8,7 +8,8 @@
 //              kitti-raw      KittiRawDrive        (sources/kitti_raw_drive.hpp)
 //              pcd, ply       PointCloudFolder     (sources/point_cloud_folder.hpp)
 //              rosbag         RosbagSource         (sources/rosbag_source.hpp)
-//   stages   the frame range (--frames A:B, FrameRangeSource)
+//   stages   the frame range (--frames A:B, FrameRangeSource), then the
+//            segmentation (--segment: labels from a network, SegmentedSource)
 // A new reader is one more case in open_reader() (and in detect_scan_format
 // when a path can say what it is); a new stage wraps the source in
 // add_stages(), in the order frames should pass it, with its option in
@@ -37,13 +38,15 @@ namespace saloam {
 ScanFormat detect_scan_format(const std::filesystem::path& path);
 
 /// The reader for `path` as `options.format` (detected when kAuto), with
-/// options.topic, labels, ignore_labels and ignore_calib. InputError naming
+/// options.topic, labels, ignore_labels and ignore_calib (labels are not
+/// read when the segmentation stage makes them). InputError naming
 /// the file for a missing path, a layout that is not that format, a corrupt
 /// file or (for a bag) a build without rosbag_storage.
 std::unique_ptr<FrameSource> open_reader(const std::filesystem::path& path, const SourceOptions& options);
 
 /// `source` behind the stages `options` asks for: the frame range
-/// (ConfigError when it holds no frame).
+/// (ConfigError when it holds no frame), then the segmentation (InputError
+/// when its model cannot be opened).
 std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, const SourceOptions& options);
 
 /// add_stages(open_reader(path, options), options).

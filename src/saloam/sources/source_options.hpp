@@ -1,6 +1,6 @@
 #pragma once
 // What a command asks of a source: the layout to read it as, the bag topic,
-// labels, calibration and the frame range. Shared by open_reader() and the
+// labels, calibration, the frame range and the segmentation stage. Shared by open_reader() and the
 // readers (sources/*.hpp); the commands fill it from cli::SourceArgs
 // (SEQ_DIR, --format, --topic, --labels, --frames, --no-calib).
 //
@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "saloam/core/frame_range.hpp"
+#include "saloam/segmentation/segmented_source.hpp"
 
 namespace saloam {
 
@@ -44,6 +45,8 @@ struct SourceOptions {
   /// source without calib.txt runs so anyway.
   bool ignore_calib = false;
   FrameRange frames;  ///< --frames A:B; everything by default
+  /// --segment: every scan labelled by this model (the reader's labels are not read).
+  std::optional<SegmentationStageOptions> segmentation;
 };
 
 }  // namespace saloam
