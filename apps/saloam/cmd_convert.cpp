@@ -56,7 +56,8 @@ SequenceWriteOptions write_options(const ConvertArgs& args) {
 
 int run_convert(const ConvertArgs& args) {
   const SequenceWriteOptions options = write_options(args);  // before anything is read
-  const auto source = args.source.open(args.no_labels, args.config.resolve());
+  SaloamConfig config = args.config.resolve();
+  const auto source = args.source.open(args.no_labels, config);
   write_scan_sequence(*source, args.out, options);
   std::cout << fmt::format("wrote {} frames of {} ({}) as {} into {}\n", source->size(), source->info().name,
                            source->info().format, args.to, args.out);

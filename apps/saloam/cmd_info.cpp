@@ -1,6 +1,7 @@
 // `saloam info PATH`: what a scan source holds before anything runs on it:
-// format, frames, rate, duration, point fields, beams, labels, calibration,
-// reference poses.
+// format, frames, rate, duration, point fields, beams, the sensor a run would
+// take (--sensor: the guess from the first scan by default), labels,
+// calibration, reference poses.
 
 #include <iostream>
 
@@ -19,16 +20,16 @@ struct InfoArgs {
 };
 
 std::string beams_text(const SequenceSummary& s) {
-  if (!s.beams) return "unknown";
-  switch (s.beams->method) {
-    case BeamMethod::kRingField: return fmt::format("{} (ring field)", s.beams->beams);
-    case BeamMethod::kAzimuthWraps: return fmt::format("about {} (azimuth wraps: points stored laser by laser)", s.beams->beams);
-    case BeamMethod::kElevation: break;
-  }
-  return fmt::format("about {} (elevation angles; no ring field)", s.beams->beams);
+  if (!s.lasers) return "unknown";
+  const std::string about = s.lasers->exact() ? "" : "about ";
+  return fmt::format("{}{} ({})", about, s.lasers->count(), beam_method_text(s.lasers->method));
 }
 
-void print_summary(const FrameSource& source, const SequenceSummary& s, bool format_given) {
+std::string sensor_text(const SensorChoice& sensor) {
+  return sensor.profile ? fmt::format("{}, {}", sensor.profile->title(), sensor.how) : sensor.how;
+}
+
+void print_summary(const FrameSource& source, const SequenceSummary& s, const SensorChoice& sensor, bool format_given) {
   std::cout << source.info().name << '\n';
   std::cout << fmt::format("  format:      {}{}\n", s.format, format_given ? "" : " (detected)");
   const double duration = s.last_time - s.first_time;
@@ -39,6 +40,7 @@ void print_summary(const FrameSource& source, const SequenceSummary& s, bool for
   std::cout << fmt::format("  fields:      {}\n", s.fields);
   std::cout << fmt::format("  points:      {:.0f} per scan (mean of {} scans read)\n", s.mean_points, s.scans_read);
   std::cout << fmt::format("  beams:       {}\n", beams_text(s));
+  std::cout << fmt::format("  sensor:      {}\n", sensor_text(sensor));
   std::cout << fmt::format("  point times: {}\n", s.per_point_times ? fmt::format("yes, spanning {:.4f} s in the first scan", s.sweep_seconds)
                                                                      : std::string("no (de-skew uses the sweep model)"));
   std::cout << fmt::format("  labels:      {}\n", s.labels ? "yes" : "no");
@@ -47,9 +49,11 @@ void print_summary(const FrameSource& source, const SequenceSummary& s, bool for
 }
 
 int run_info(const InfoArgs& args) {
-  const auto source = args.source.open(false, SaloamConfig{});
+  SaloamConfig config;
+  SensorChoice sensor;
+  const auto source = args.source.open(false, config, &sensor);
   const SequenceSummary summary = summarize(*source, args.scans);
-  print_summary(*source, summary, args.source.format != "auto");
+  print_summary(*source, summary, sensor, args.source.format != "auto");
   return 0;
 }
 

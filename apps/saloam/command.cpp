@@ -18,6 +18,7 @@
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/sources/open_source.hpp"
+#include "saloam/sources/sensor_guess.hpp"
 
 namespace saloam::cli {
 
@@ -173,6 +174,10 @@ void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
       ->check(CLI::IsMember(scan_format_names()))
       ->capture_default_str();
   app.add_option("--topic", topic, "ROS bag topic of sensor_msgs/PointCloud2 (default: the only one)");
+  app.add_option("--sensor", sensor,
+                 "Sensor profile: auto (guessed from the first scan), none, a shipped one (hdl64e, hdl32e, vlp16, os1-64, "
+                 "os1-128: config/sensors/) or a profile file")
+      ->capture_default_str();
   app.add_option("--labels", labels, "Folder of .label files (named like the scans) instead of SEQ_DIR/labels");
   app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
   segment.add_to(app);
@@ -193,14 +198,61 @@ SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
 }
 }  // namespace
 
-std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, const SaloamConfig& config) const {
+std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& config, SensorChoice* chosen) const {
   if (segment.enabled() && ignore_labels)
     throw ConfigError("--segment labels the scans, but this run does not use labels (--no-semantics, or a label-free "
                       "method): leave out one of them");
   if (segment.enabled() && !labels.empty()) throw ConfigError("give --labels DIR or --segment, not both");
   SourceOptions options = source_options(*this, ignore_labels);
-  options.segmentation = segment.stage(config);
-  return open_source(path, options);
+  options.segmentation = segment.stage(config);  // checks the model before anything is read
+  auto reader = open_reader(path, options);
+  SensorChoice choice = choose_sensor(sensor, *reader);
+  if (choice.profile) {
+    apply_sensor_profile(*choice.profile, config.odometry.features);
+    validate_config(config, fmt::format("--sensor {}", choice.profile->name));
+    spdlog::info("sensor: {}, {}", choice.profile->title(), choice.how);
+  }
+  if (options.segmentation) options.segmentation->rings = config.odometry.features;
+  if (chosen) *chosen = std::move(choice);
+  return add_stages(std::move(reader), options);
+}
+
+std::vector<SensorProfile> shipped_sensor_profiles() { return load_sensor_profiles(data_dir() / "config" / "sensors"); }
+
+SensorProfile sensor_profile(const std::string& name_or_file) {
+  const std::filesystem::path given(name_or_file);
+  std::error_code error;
+  if (std::filesystem::is_regular_file(given, error)) return load_sensor_profile(given);
+  const auto shipped = shipped_sensor_profiles();
+  for (const auto& p : shipped) {
+    if (p.name == name_or_file) return p;
+  }
+  std::vector<std::string> names;
+  for (const auto& p : shipped) names.push_back(p.name);
+  throw ConfigError(fmt::format("--sensor {}: no such profile file, nor a shipped profile (in {}: {}; or auto, none)",
+                                name_or_file, (data_dir() / "config" / "sensors").string(), fmt::join(names, ", ")));
+}
+
+SensorChoice choose_sensor(const std::string& sensor, FrameSource& source) {
+  SensorChoice choice;
+  if (sensor == "none") {
+    choice.how = "none (--sensor none)";
+    return choice;
+  }
+  if (sensor != "auto") {
+    choice.profile = sensor_profile(sensor);
+    choice.how = fmt::format("as given (--sensor {})", sensor);
+    return choice;
+  }
+  if (!source.info().rereadable || source.size() == 0) {
+    choice.how = "none: a stream cannot be looked at before the run (give --sensor NAME)";
+    return choice;
+  }
+  const auto profiles = shipped_sensor_profiles();
+  const SensorGuess guess = guess_sensor(source.scan(0), profiles);
+  choice.profile = profiles[guess.profile];
+  choice.how = fmt::format("guessed from the first scan: {} (--sensor NAME to choose another)", guess.found());
+  return choice;
 }
 
 void add_no_calib_flag(CLI::App& app, bool& no_calib) {

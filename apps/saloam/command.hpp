@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "saloam/core/config.hpp"
+#include "saloam/core/sensor_profile.hpp"
 #include "saloam/segmentation/segmented_source.hpp"
 #include "saloam/io/frame_source.hpp"
 
@@ -60,13 +61,33 @@ struct SegmentOptions {
 };
 
 /// The options that choose a run's frames, shared by the commands that read
-/// a source (odom, slam, place-eval, bench, info): SEQ_DIR (any layout of
-/// sources/source_options.hpp), --format, --topic, --labels and --frames;
+/// a source (odom, slam, place-eval, bench, info, convert, segment): SEQ_DIR
+/// (any layout of sources/source_options.hpp), --format, --topic, --sensor,
+/// --labels, --frames and the segmentation's options;
 /// commands where calibration matters add --no-calib (add_no_calib_flag).
 /// Call `open()` after parsing.
+/// The sensor profile a run works with (--sensor), and how it was chosen.
+struct SensorChoice {
+  std::optional<SensorProfile> profile;  ///< none with --sensor none
+  std::string how;                       ///< "given (--sensor vlp16)", "guessed from the first scan: ..."
+};
+
+/// The sensor profiles shipped in data_dir()/config/sensors/ (by name).
+std::vector<SensorProfile> shipped_sensor_profiles();
+/// --sensor NAME (a shipped profile) or FILE (a profile of one's own,
+/// format in core/sensor_profile.hpp); ConfigError naming the shipped ones
+/// when it is neither.
+SensorProfile sensor_profile(const std::string& name_or_file);
+/// What --sensor `sensor` means for `source`: "none" (no profile: rings from
+/// the storage order or the HDL-64E/HDL-32E/VLP-16 layouts, as before
+/// profiles), a profile by name or file, or "auto": the shipped profile that
+/// fits the source's first scan best (sources/sensor_guess.hpp).
+SensorChoice choose_sensor(const std::string& sensor, FrameSource& source);
+
 struct SourceArgs {
   std::string path;
   std::string format = "auto";
+  std::string sensor = "auto";
   std::string topic;
   std::string labels;
   std::string frames;
@@ -75,8 +96,11 @@ struct SourceArgs {
   void add_to(CLI::App& app, const std::string& path_help);
   /// open_source() with these options; whether labels are read is the
   /// command's choice (ConfigError when it ignores them but --segment asks
-  /// for them). `config` sets up the segmentation stage.
-  [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, const SaloamConfig& config) const;
+  /// for them). The sensor (--sensor, chosen on the reader and said in one
+  /// log line) goes into config.odometry.features (apply_sensor_profile)
+  /// before `config` sets up the segmentation stage; `chosen` receives it.
+  [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, SaloamConfig& config,
+                                                  SensorChoice* chosen = nullptr) const;
 };
 
 /// The folder of the running program (from /proc/self/exe); none when it

@@ -332,13 +332,13 @@ TEST(Sources, SummaryOfASimulatedSequence) {
   EXPECT_NEAR(s.median_interval, 0.1, 1e-9);
   EXPECT_EQ(s.scans_read, 2u);
   EXPECT_EQ(s.fields, "x y z remission");
-  ASSERT_TRUE(s.beams.has_value());
-  EXPECT_EQ(s.beams->beams, 16u) << static_cast<int>(s.beams->method);  // the simulator's 16 lasers
+  ASSERT_TRUE(s.lasers.has_value());
+  EXPECT_EQ(s.lasers->count(), 16u) << static_cast<int>(s.lasers->method);  // the simulator's 16 lasers
   EXPECT_TRUE(s.labels && s.calibration);
   EXPECT_EQ(s.reference_poses, 4u);
   WithPointFields with_fields(*seq);
-  EXPECT_EQ(estimate_beams(with_fields.scan(0)).method, BeamMethod::kRingField);
-  EXPECT_EQ(estimate_beams(with_fields.scan(0)).beams, 16u);
+  EXPECT_EQ(find_lasers(with_fields.scan(0)).method, BeamMethod::kRingField);
+  EXPECT_EQ(find_lasers(with_fields.scan(0)).count(), 16u);
 }
 
 }  // namespace
