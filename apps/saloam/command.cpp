@@ -249,7 +249,16 @@ SensorChoice choose_sensor(const std::string& sensor, FrameSource& source) {
     return choice;
   }
   const auto profiles = shipped_sensor_profiles();
-  const SensorGuess guess = guess_sensor(source.scan(0), profiles);
+  LabelledCloud first;
+  try {
+    first = source.scan(0);
+  } catch (const InputError&) {
+    // The run reads it again and fails there, as a run does (its outputs
+    // say so); the guess only stands aside.
+    choice.how = "none: the first scan cannot be read";
+    return choice;
+  }
+  const SensorGuess guess = guess_sensor(first, profiles);
   choice.profile = profiles[guess.profile];
   choice.how = fmt::format("guessed from the first scan: {} (--sensor NAME to choose another)", guess.found());
   return choice;
