@@ -266,7 +266,13 @@ SensorChoice choose_sensor(const std::string& sensor, FrameSource& source) {
   }
   const SensorGuess guess = guess_sensor(first, profiles);
   choice.profile = profiles[guess.profile];
-  choice.how = fmt::format("guessed from the first scan: {} (--sensor NAME to choose another)", guess.found());
+  std::string subset;
+  if (auto kept = laser_subset(*choice.profile, guess.lasers)) {
+    subset = fmt::format(", {} of its {} lasers", kept->beams(), choice.profile->beams());
+    choice.profile = std::move(kept);
+  }
+  choice.how =
+      fmt::format("guessed from the first scan: {}{} (--sensor NAME to choose another)", guess.found(), subset);
   return choice;
 }
 

@@ -81,7 +81,8 @@ SensorProfile sensor_profile(const std::string& name_or_file);
 /// What --sensor `sensor` means for `source`: "none" (no profile: rings from
 /// the storage order or the HDL-64E/HDL-32E/VLP-16 layouts, as before
 /// profiles), a profile by name or file, or "auto": the shipped profile that
-/// fits the source's first scan best (sources/sensor_guess.hpp); none when
+/// fits the source's first scan best (sources/sensor_guess.hpp), cut down to
+/// the lasers found when the scan keeps only some of them (laser_subset); none when
 /// that scan cannot be read (the run then fails on it as it would anyway).
 SensorChoice choose_sensor(const std::string& sensor, FrameSource& source);
 

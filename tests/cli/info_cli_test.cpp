@@ -37,7 +37,8 @@ TEST(InfoCli, SaysWhatEachSourceHolds) {
   EXPECT_NE(output.find("rate:        10.00 Hz"), std::string::npos) << output;
   EXPECT_NE(output.find("beams:       16 (points stored laser by laser)"), std::string::npos) << output;
   // 16 of the HDL-64E's lasers (--beams 16): still that sensor.
-  EXPECT_NE(output.find("sensor:      hdl64e (Velodyne HDL-64E (KITTI)), guessed from the first scan: 16 lasers"),
+  EXPECT_NE(output.find("sensor:      hdl64e (Velodyne HDL-64E (KITTI)), guessed from the first scan: 16 lasers (points "
+                        "stored laser by laser) from +2.0 to -23.3 deg, 16 of its 64 lasers"),
             std::string::npos)
       << output;
   EXPECT_NE(output.find("reference:   3 poses"), std::string::npos) << output;

@@ -1,13 +1,14 @@
 // `--sensor auto` (sources/sensor_guess.hpp): each shipped profile, rendered
 // by the simulator, is recognised from one scan, with its ring field and
 // without (storage order, then elevations alone); the HDL-64E's 32 and 16
-// laser subsets are still an HDL-64E.
+// laser subsets are still an HDL-64E, whose runs take the lasers kept.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 
 #include "saloam/core/error.hpp"
+#include "saloam/sim/lidar.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sources/lasers.hpp"
 #include "saloam/sources/sensor_guess.hpp"
@@ -54,7 +55,16 @@ TEST(SensorGuess, ThinnedHdl64eIsStillAnHdl64eAndShuffledScansFallBackOnElevatio
     SCOPED_TRACE(beams);
     const LabelledCloud cloud = first_scan(std::nullopt, beams);
     EXPECT_EQ(guessed(cloud), "hdl64e");
+    // A run takes the lasers the scans keep: the simulator's every 2nd or 4th.
+    const auto hdl = std::find_if(shipped().begin(), shipped().end(), [](const auto& p) { return p.name == "hdl64e"; });
+    const auto subset = laser_subset(*hdl, find_lasers(cloud));
+    ASSERT_TRUE(subset.has_value());
+    const auto expected = LidarModel::hdl64e(beams).elevation_deg;
+    ASSERT_EQ(subset->elevation_deg.size(), expected.size());
+    for (std::size_t i = 0; i < expected.size(); ++i) EXPECT_NEAR(subset->elevation_deg[i], expected[i], 1e-4) << i;
   }
+  // Every laser, or most of them: the profile as it is.
+  for (const auto& profile : shipped()) EXPECT_FALSE(laser_subset(profile, find_lasers(first_scan(profile))).has_value());
   // Points in no order: lasers from the elevation clusters alone.
   const auto vlp = std::find_if(shipped().begin(), shipped().end(), [](const auto& p) { return p.name == "vlp16"; });
   LabelledCloud cloud = first_scan(*vlp);

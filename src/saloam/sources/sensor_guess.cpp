@@ -50,6 +50,21 @@ double sensor_score(const SensorProfile& profile, const FoundLasers& lasers) {
   return score;
 }
 
+std::optional<SensorProfile> laser_subset(const SensorProfile& profile, const FoundLasers& lasers) {
+  const auto& lasers_of = profile.elevation_deg;
+  if (!lasers.exact() || lasers.count() == 0 || 2 * lasers.count() > lasers_of.size()) return std::nullopt;
+  std::vector<double> kept;
+  for (const double e : lasers.elevation_deg) {
+    const auto nearest = std::min_element(lasers_of.begin(), lasers_of.end(),
+                                          [e](double a, double b) { return std::abs(a - e) < std::abs(b - e); });
+    if (!kept.empty() && !(*nearest < kept.back())) return std::nullopt;  // two lasers on one, or out of order
+    kept.push_back(*nearest);
+  }
+  SensorProfile subset = profile;
+  subset.elevation_deg = std::move(kept);
+  return subset;
+}
+
 SensorGuess guess_sensor(const LabelledCloud& scan, const std::vector<SensorProfile>& profiles) {
   if (profiles.empty()) throw ConfigError("no sensor profile to choose from");
   SensorGuess guess;

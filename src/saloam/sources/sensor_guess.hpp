@@ -13,6 +13,7 @@
 // The profile with the lowest score wins; the guess says what was found.
 
 #include <cstddef>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,14 @@ struct SensorGuess {
 
 /// The score of `profile` for `lasers` (see above).
 double sensor_score(const SensorProfile& profile, const FoundLasers& lasers);
+
+/// `profile` cut down to the lasers found, for scans that keep only some of
+/// its lasers (a simulated HDL-64E with --beams 32 or 16, a driver set to
+/// every 2nd laser): when the lasers were counted exactly (ring field or
+/// storage order) and are at most half of the profile's, each found laser's
+/// nearest laser of the profile, top first. nullopt otherwise, or when two
+/// found lasers have the same nearest one.
+std::optional<SensorProfile> laser_subset(const SensorProfile& profile, const FoundLasers& lasers);
 
 /// The best of `profiles` (not empty) for `scan`; ConfigError when `profiles` is empty.
 SensorGuess guess_sensor(const LabelledCloud& scan, const std::vector<SensorProfile>& profiles);
