@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 
@@ -228,7 +229,7 @@ RingSelection select_ring_features(const std::vector<double>& gap_sq, const std:
         const int j = i + step * k;
         const int prev = j - step;
         if (j < 0 || j >= n) break;
-        if (gap_sq[std::min(j, prev)] > 0.05) break;
+        if (gap_sq[std::min(j, prev)] > kSameSurfaceGapSq) break;
         blocked[j] = 1;
       }
     }
@@ -292,6 +293,84 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const PointMask& unreliable, const FeatureConfig& config,
                                    const PointMask& not_edge) {
   return select_ring_features(squared_gaps(ring), roughness, unreliable, config, not_edge);
+}
+
+bool is_thin_round(std::uint16_t static_class_id) {
+  return static_class_id == cls::kPole || static_class_id == cls::kTrunk;
+}
+
+namespace {
+/// Horizontal angle between two points seen from the sensor [rad].
+double azimuth_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y()));
+}
+
+/// Mean of sqrt(r^2 - x^2) over x in [s - h, s + h] within [-r, r]: how far
+/// in front of a disc's centre a ray at lateral offset s (known to +-h) meets it.
+double mean_chord_depth(double r, double s, double h) {
+  const double a = std::max(s - h, -r), b = std::min(s + h, r);
+  if (b - a <= 1e-9 * r) return std::sqrt(std::max(0.0, r * r - s * s));
+  const auto antiderivative = [r](double x) {
+    return 0.5 * (x * std::sqrt(std::max(0.0, r * r - x * x)) + r * r * std::asin(std::clamp(x / r, -1.0, 1.0)));
+  };
+  return (antiderivative(b) - antiderivative(a)) / (b - a);
+}
+
+/// Ring indices [first, last] of the surface around index k: neighbours
+/// without a gap above kSameSurfaceGapSq.
+std::pair<int, int> surface_run(const std::vector<double>& gap_sq, int k) {
+  int first = k, last = k;
+  while (first > 0 && gap_sq[first - 1] <= kSameSurfaceGapSq) --first;
+  while (last + 1 < static_cast<int>(gap_sq.size()) && gap_sq[last] <= kSameSurfaceGapSq) ++last;
+  return {first, last};
+}
+
+/// The mean distance from the sensor to the axis of a disc of radius r on
+/// the horizontal ray `axis_ray`, estimated by each return of the run.
+double axis_distance(const std::vector<Eigen::Vector3d>& ring, int first, int last, const Eigen::Vector2d& axis_ray,
+                     double radius, double half_step_width) {
+  const Eigen::Vector2d across(-axis_ray.y(), axis_ray.x());
+  double sum = 0.0;
+  for (int j = first; j <= last; ++j) {
+    const Eigen::Vector2d p = ring[j].head<2>();
+    sum += p.dot(axis_ray) + mean_chord_depth(radius, p.dot(across), half_step_width);
+  }
+  return sum / (last - first + 1);
+}
+}  // namespace
+
+std::optional<ThinObjectAxis> thin_object_axis(const std::vector<Eigen::Vector3d>& ring,
+                                               const std::vector<double>& gap_sq, int k, double max_radius) {
+  const int n = static_cast<int>(ring.size());
+  if (k < 0 || k >= n || n < 2) return std::nullopt;
+  const auto [first, last] = surface_run(gap_sq, k);
+  const int count = last - first + 1;
+  const double step = count > 1 ? azimuth_between(ring[first], ring[last]) / (count - 1)
+                                : azimuth_between(ring[k], ring[k + 1 < n ? k + 1 : k - 1]);
+  const Eigen::Vector2d towards = ring[first].head<2>().normalized() + ring[last].head<2>().normalized();
+  if (!(towards.squaredNorm() > 0.0) || !(step > 0.0)) return std::nullopt;
+  const Eigen::Vector2d axis_ray = towards.normalized();
+  double distance = 0.0, mean_z = 0.0;
+  for (int j = first; j <= last; ++j) {
+    distance += ring[j].head<2>().norm();
+    mean_z += ring[j].z();
+  }
+  distance /= count;
+  mean_z /= count;
+  // The run's angular width is the chord's as seen at the axis's distance:
+  // the radius and that distance are refined once from each other.
+  double radius = 0.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double half_step_width = 0.5 * step * distance;
+    radius = count * half_step_width;
+    if (!(radius <= max_radius)) return std::nullopt;
+    distance = axis_distance(ring, first, last, axis_ray, radius, half_step_width);
+  }
+  ThinObjectAxis axis;
+  axis.point << distance * axis_ray, mean_z;
+  axis.central = (first + last) / 2;
+  axis.radius = radius;
+  return axis;
 }
 
 namespace {
@@ -528,7 +607,9 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
       }
     }
     const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
-    auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
+    // An edge of a thin round object stands for its axis (ThinObjectAxis).
+    const bool axes = use_labels && config.thin_object_axes;
+    auto emit = [&](const std::vector<int>& indices, bool edges, FeatureCloud& target) {
       for (const int k : indices) {
         const std::uint32_t i = ring[k];
         int c = 0;
@@ -536,11 +617,17 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
           c = odometry_class(class_table, cloud.label[i]);
           if (c < 0) continue;
         }
+        if (edges && axes && is_thin_round(static_class(cloud.label[i]))) {
+          const auto axis = thin_object_axis(ring_points, gap_sq, k, config.thin_object_max_radius);
+          if (!axis) continue;
+          target.push_back(axis->point, static_cast<ClassIndex>(c), times[ring[static_cast<std::size_t>(axis->central)]]);
+          continue;
+        }
         target.push_back(ring_points[k], static_cast<ClassIndex>(c), times[i]);
       }
     };
-    emit(selection.edges, per_ring[r].edges);
-    emit(selection.planars, per_ring[r].planars);
+    emit(selection.edges, true, per_ring[r].edges);
+    emit(selection.planars, false, per_ring[r].planars);
   };
   for_each_index(rings.size(), parallel, 1, process_ring);
   auto append = [](FeatureCloud& to, const FeatureCloud& from) {
