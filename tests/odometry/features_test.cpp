@@ -319,7 +319,6 @@ TEST(ExtractFeatures, LabelledScanDropsDynamicClassesUnlabeledKeepsOneClass) {
 /// `step` [rad] starting at `phase` steps, ranges with Gaussian noise.
 struct CylinderRing {
   std::vector<Eigen::Vector3d> points;
-  std::vector<double> gap_sq;
   int on_cylinder = -1;  ///< index of a return on the cylinder
 };
 CylinderRing cylinder_ring(const Eigen::Vector2d& centre, double r, double wall, double step, double phase,
@@ -336,9 +335,6 @@ CylinderRing cylinder_ring(const Eigen::Vector2d& centre, double r, double wall,
     const double t = (hit ? b - std::sqrt(disc) : wall) + range_noise(rng);
     if (hit && ring.on_cylinder < 0) ring.on_cylinder = static_cast<int>(ring.points.size());
     ring.points.emplace_back(t * u.x(), t * u.y(), -1.0);
-  }
-  for (std::size_t i = 0; i < ring.points.size(); ++i) {
-    ring.gap_sq.push_back(i + 1 < ring.points.size() ? (ring.points[i + 1] - ring.points[i]).squaredNorm() : 0.0);
   }
   return ring;
 }
@@ -360,7 +356,7 @@ TEST(ThinObjectAxis, FindsThePoleAxisFromAnyViewpointWithoutBias) {
         const Eigen::Vector2d centre = distance * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
         const CylinderRing ring = cylinder_ring(centre, r, distance + 8.0, kStep, phase(rng), 0.02, rng);
         if (ring.on_cylinder < 0) continue;
-        const auto axis = thin_object_axis(ring.points, ring.gap_sq, ring.on_cylinder, 0.5);
+        const auto axis = thin_object_axis(ring.points, ring.on_cylinder, 0.5);
         ASSERT_TRUE(axis) << r << " " << distance;
         EXPECT_NEAR(axis->point.z(), -1.0, 0.05);
         const Eigen::Vector2d ray = centre.normalized();
@@ -382,11 +378,19 @@ TEST(ThinObjectAxis, AWideRunIsNoThinObject) {
   std::mt19937 rng(2);
   // A 1 m "trunk" in front of a wall 0.1 m behind it: the run merges with the wall.
   const CylinderRing wide = cylinder_ring({10.0, 0.0}, 1.0, 20.0, 2.0 * M_PI / 2083, 0.3, 0.0, rng);
-  EXPECT_FALSE(thin_object_axis(wide.points, wide.gap_sq, wide.on_cylinder, 0.5));
+  EXPECT_FALSE(thin_object_axis(wide.points, wide.on_cylinder, 0.5));
   const CylinderRing merged = cylinder_ring({10.0, 0.0}, 0.1, 10.05, 2.0 * M_PI / 2083, 0.3, 0.0, rng);
-  EXPECT_FALSE(thin_object_axis(merged.points, merged.gap_sq, merged.on_cylinder, 0.5));
+  EXPECT_FALSE(thin_object_axis(merged.points, merged.on_cylinder, 0.5));
+  // A pole half hidden behind a nearer one: the crossing's end is cut.
+  CylinderRing hidden = cylinder_ring({10.0, 0.0}, 0.1, 20.0, 2.0 * M_PI / 2083, 0.3, 0.0, rng);
+  int last = hidden.on_cylinder;
+  while (hidden.points[static_cast<std::size_t>(last) + 1].norm() < 15.0) ++last;
+  for (std::size_t i = static_cast<std::size_t>(last) - 1; i < hidden.points.size() && hidden.points[i].norm() > 5.0; ++i) {
+    hidden.points[i] *= 5.0 / hidden.points[i].norm();  // from the middle on, a nearer object 5 m away
+  }
+  EXPECT_FALSE(thin_object_axis(hidden.points, hidden.on_cylinder, 0.5));
   const CylinderRing thin = cylinder_ring({10.0, 0.0}, 0.1, 20.0, 2.0 * M_PI / 2083, 0.3, 0.0, rng);
-  const auto axis = thin_object_axis(thin.points, thin.gap_sq, thin.on_cylinder, 0.5);
+  const auto axis = thin_object_axis(thin.points, thin.on_cylinder, 0.5);
   ASSERT_TRUE(axis);
   EXPECT_NEAR(axis->radius, 0.1, 0.03);
   EXPECT_NEAR(axis->point.x(), 10.0, 0.02);

@@ -229,7 +229,7 @@ RingSelection select_ring_features(const std::vector<double>& gap_sq, const std:
         const int j = i + step * k;
         const int prev = j - step;
         if (j < 0 || j >= n) break;
-        if (gap_sq[std::min(j, prev)] > kSameSurfaceGapSq) break;
+        if (gap_sq[std::min(j, prev)] > 0.05) break;
         blocked[j] = 1;
       }
     }
@@ -316,17 +316,8 @@ double mean_chord_depth(double r, double s, double h) {
   return (antiderivative(b) - antiderivative(a)) / (b - a);
 }
 
-/// Ring indices [first, last] of the surface around index k: neighbours
-/// without a gap above kSameSurfaceGapSq.
-std::pair<int, int> surface_run(const std::vector<double>& gap_sq, int k) {
-  int first = k, last = k;
-  while (first > 0 && gap_sq[first - 1] <= kSameSurfaceGapSq) --first;
-  while (last + 1 < static_cast<int>(gap_sq.size()) && gap_sq[last] <= kSameSurfaceGapSq) ++last;
-  return {first, last};
-}
-
 /// The mean distance from the sensor to the axis of a disc of radius r on
-/// the horizontal ray `axis_ray`, estimated by each return of the run.
+/// the horizontal ray `axis_ray`, estimated by each return of [first, last].
 double axis_distance(const std::vector<Eigen::Vector3d>& ring, int first, int last, const Eigen::Vector2d& axis_ray,
                      double radius, double half_step_width) {
   const Eigen::Vector2d across(-axis_ray.y(), axis_ray.x());
@@ -337,22 +328,60 @@ double axis_distance(const std::vector<Eigen::Vector3d>& ring, int first, int la
   }
   return sum / (last - first + 1);
 }
+
+double horizontal_range(const Eigen::Vector3d& p) { return p.head<2>().norm(); }
+
+/// Ring neighbours farther apart in azimuth than this many steps have no
+/// return between them.
+constexpr double kMaxStepsBetweenReturns = 2.5;
+
+/// The returns of one object crossing, ring indices [first, last], and the
+/// azimuth step between returns.
+struct Crossing {
+  int first = 0, last = 0;
+  double step = 0.0;
+};
+
+/// The crossing around ring index k: the neighbours whose horizontal ranges
+/// change by less than `max_radius` from one to the next (the near side of
+/// a disc of that radius, its silhouette's grazing returns included), or
+/// nothing when something nearer cuts it at either end.
+std::optional<Crossing> crossing_at(const std::vector<Eigen::Vector3d>& ring, int k, double max_radius) {
+  const int n = static_cast<int>(ring.size());
+  // The step: the smaller azimuth gap to a neighbour (the other may be a hole).
+  const double step = std::min(k > 0 ? azimuth_between(ring[k - 1], ring[k]) : M_PI,
+                               k + 1 < n ? azimuth_between(ring[k], ring[k + 1]) : M_PI);
+  if (!(step > 0.0) || step >= M_PI) return std::nullopt;
+  const auto adjacent = [&](int a, int b) { return azimuth_between(ring[a], ring[b]) <= kMaxStepsBetweenReturns * step; };
+  const auto same_object = [&](int a, int b) {
+    return adjacent(a, b) && std::abs(horizontal_range(ring[a]) - horizontal_range(ring[b])) < max_radius;
+  };
+  Crossing c{k, k, step};
+  while (c.first > 0 && same_object(c.first - 1, c.first)) --c.first;
+  while (c.last + 1 < n && same_object(c.last, c.last + 1)) ++c.last;
+  // Beyond each end: no return, or a farther surface; a nearer one hides part of the object.
+  const auto cut = [&](int end, int beyond) {
+    if (beyond < 0 || beyond >= n) return true;
+    return adjacent(end, beyond) && horizontal_range(ring[beyond]) < horizontal_range(ring[end]);
+  };
+  if (cut(c.first, c.first - 1) || cut(c.last, c.last + 1)) return std::nullopt;
+  if (c.last > c.first) c.step = azimuth_between(ring[c.first], ring[c.last]) / (c.last - c.first);
+  return c;
+}
 }  // namespace
 
-std::optional<ThinObjectAxis> thin_object_axis(const std::vector<Eigen::Vector3d>& ring,
-                                               const std::vector<double>& gap_sq, int k, double max_radius) {
-  const int n = static_cast<int>(ring.size());
-  if (k < 0 || k >= n || n < 2) return std::nullopt;
-  const auto [first, last] = surface_run(gap_sq, k);
+std::optional<ThinObjectAxis> thin_object_axis(const std::vector<Eigen::Vector3d>& ring, int k, double max_radius) {
+  if (k < 0 || k >= static_cast<int>(ring.size()) || ring.size() < 2) return std::nullopt;
+  const auto crossing = crossing_at(ring, k, max_radius);
+  if (!crossing) return std::nullopt;
+  const auto [first, last, step] = *crossing;
   const int count = last - first + 1;
-  const double step = count > 1 ? azimuth_between(ring[first], ring[last]) / (count - 1)
-                                : azimuth_between(ring[k], ring[k + 1 < n ? k + 1 : k - 1]);
   const Eigen::Vector2d towards = ring[first].head<2>().normalized() + ring[last].head<2>().normalized();
-  if (!(towards.squaredNorm() > 0.0) || !(step > 0.0)) return std::nullopt;
+  if (!(towards.squaredNorm() > 0.0)) return std::nullopt;
   const Eigen::Vector2d axis_ray = towards.normalized();
   double distance = 0.0, mean_z = 0.0;
   for (int j = first; j <= last; ++j) {
-    distance += ring[j].head<2>().norm();
+    distance += horizontal_range(ring[j]);
     mean_z += ring[j].z();
   }
   distance /= count;
@@ -618,7 +647,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
           if (c < 0) continue;
         }
         if (edges && axes && is_thin_round(static_class(cloud.label[i]))) {
-          const auto axis = thin_object_axis(ring_points, gap_sq, k, config.thin_object_max_radius);
+          const auto axis = thin_object_axis(ring_points, k, config.thin_object_max_radius);
           if (!axis) continue;
           target.push_back(axis->point, static_cast<ClassIndex>(c), times[ring[static_cast<std::size_t>(axis->central)]]);
           continue;
