@@ -2,9 +2,7 @@
 // feature extraction, local-map update (incremental neighbour grid; kd-tree
 // rebuild and nanoflann's dynamic index for comparison),
 // registration and the whole pipeline per frame, single-threaded unless
-// stated. Peak memory is reported as a counter (max RSS, getrusage).
-
-#include <sys/resource.h>
+// stated. Peak memory is reported as a counter (max RSS, core/profiling.hpp).
 
 #include <cstdio>
 #include <deque>
@@ -21,6 +19,7 @@
 #include <nanoflann.hpp>
 #pragma GCC diagnostic pop
 
+#include "saloam/core/profiling.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
 
@@ -44,12 +43,6 @@ OdometryConfig kitti_config() {
   OdometryConfig config;
   config.features.pose_time_in_sweep = 0.05;
   return config;
-}
-
-double peak_rss_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
 }
 
 void BM_ExtractFeatures(benchmark::State& state) {

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "saloam/train/sgpr_trainer.hpp"
+#include "saloam/train/training_run.hpp"
 
 namespace {
 

@@ -76,7 +76,7 @@ int run(const OracleOptions& o) {
     graph.add_edge({*match, k, gt[frames[*match]].inverse() * gt[i], information, EdgeKind::kLoop});
     ++loops;
   }
-  PoseGraphOptions options;
+  PoseGraphOptions options = PoseGraphOptions::from_config(SlamConfig{});
   options.max_iterations = 50;
   const PoseGraphSummary summary = graph.optimize(options);
 

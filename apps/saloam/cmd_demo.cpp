@@ -7,7 +7,6 @@
 // scans reach the disk only with --keep-sequence. Evaluates both against the
 // ground truth and writes the semantic map and pictures.
 
-#include <chrono>
 #include <cmath>
 #include <iostream>
 #include <memory>
@@ -16,29 +15,35 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
-#include "saloam/core/frame_range.hpp"
-#include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/frame_range.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/eval/evaluation_report.hpp"
-#include "saloam/io/sequence.hpp"
-#include "saloam/odometry/semantic_odometry.hpp"
-#include "saloam/runs/frame_source.hpp"
-#include "saloam/runs/trajectory_writer.hpp"
+#include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
+#include "saloam/sim/simulated_source.hpp"
 #include "saloam/sim/simulator.hpp"
+#include "saloam/sources/open_source.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 
 namespace saloam::cli {
 namespace {
 
+/// The demo's route (it revisits places both ways); the other simulation
+/// defaults are SimulationOptions'.
+SimulationOptions demo_route() {
+  SimulationOptions sim;
+  sim.preset = "figure-eight";
+  return sim;
+}
+
 struct DemoOptions {
   std::string out = "demo_output";
-  std::string preset = "figure-eight";
+  SimulationOptions sim = demo_route();  ///< --preset, --beams, --seed
   std::string frames;
-  int beams = 64;
-  std::uint64_t seed = 1;
   bool gt_labels = false;
   bool keep_sequence = false;
   bool reuse = false;
@@ -49,10 +54,7 @@ struct DemoOptions {
 void heading(const std::string& text) { std::cout << "\n== " << text << " ==\n" << std::flush; }
 
 SimulationOptions simulation_options(const DemoOptions& options) {
-  SimulationOptions sim;
-  sim.preset = options.preset;
-  sim.beams = options.beams;
-  sim.seed = options.seed;
+  SimulationOptions sim = options.sim;
   sim.labels = options.gt_labels ? LabelMode::kGroundTruth : LabelMode::kNoisy;
   sim.show_progress = false;
   if (!options.frames.empty()) {
@@ -69,25 +71,6 @@ OdometryConfig without_semantics(OdometryConfig config) {
   config.use_semantics = false;
   return config;
 }
-
-const std::filesystem::path& created(const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
-  return folder;
-}
-
-class BaselineOdometry {
- public:
-  BaselineOdometry(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> tr)
-      : odometry_(without_semantics(config)),
-        writer_(created(out_dir) / "poses.txt", out_dir / "poses_tum.txt", tr) {}
-  void process(const LabelledCloud& scan, double t) { output_.push_back(writer_.write(t, odometry_.register_frame(scan, t))); }
-  [[nodiscard]] const std::vector<Pose>& output_poses() const { return output_; }
-
- private:
-  SemanticOdometry odometry_;
-  TrajectoryWriter writer_;
-  std::vector<Pose> output_;
-};
 
 std::uintmax_t disk_usage(const std::filesystem::path& folder) {
   std::uintmax_t bytes = 0;
@@ -140,63 +123,38 @@ void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequen
   }
 }
 
-int run_demo(const DemoOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  SaloamConfig config = options.config.resolve();
-  if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
-  const std::filesystem::path out(options.out);
-  const std::filesystem::path sequence_dir = out / "sequence";
-  const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
+/// The demo's frames: the simulator streaming them (it renders ahead on
+/// another thread while the SLAM runs, and writes them to `sequence_dir`
+/// only with --keep-sequence), or with --reuse the sequence kept earlier.
+struct DemoSource {
+  std::unique_ptr<SimulatedSequence> simulated;  ///< none when read from disk
+  std::unique_ptr<FrameSource> frames;           ///< declared last: destroyed first (it streams `simulated`)
+};
 
-  heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.preset, options.beams,
-                      options.gt_labels ? "ground-truth" : "noisy (emulated network)",
-                      from_disk ? " (reusing " + sequence_dir.string() + ")" : ""));
-  std::optional<SimulatedSequence> simulated;
-  std::optional<SimulatedSource> stream;
-  std::optional<SequenceReader> reader;
-  std::optional<SequenceFolderSource> folder;
-  FrameSource* source = nullptr;
+DemoSource open_demo_source(const DemoOptions& options, const std::filesystem::path& sequence_dir, bool from_disk) {
+  DemoSource source;
   if (from_disk) {
-    reader.emplace(sequence_dir);
-    source = &folder.emplace(*reader);
-  } else {
-    std::filesystem::remove_all(sequence_dir);
-    simulated.emplace(simulation_options(options));
-    // The simulator renders ahead on another thread while the SLAM runs; the
-    // scans are written to disk only with --keep-sequence.
-    const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
-    source = &stream.emplace(*simulated, 16, keep);
+    source.frames = open_source(sequence_dir, {});
+    return source;
   }
-  std::cout << fmt::format("{} frames; the simulator renders them {}\n", source->size(),
-                           from_disk ? "from disk" : options.keep_sequence ? "ahead and writes them to " + sequence_dir.string()
-                                                                             : "ahead, in memory");
+  std::filesystem::remove_all(sequence_dir);
+  source.simulated = std::make_unique<SimulatedSequence>(simulation_options(options));
+  const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
+  source.frames = add_stages(std::make_unique<SimulatedSource>(*source.simulated, 16, keep), {});
+  return source;
+}
 
-  std::optional<BaselineOdometry> baseline;
-  if (options.baseline) baseline.emplace(config.odometry, out / "odometry_baseline", source->velo_to_cam());
-  const std::size_t shown = source->size() / 2;
-  SlamRunOptions run_options;
-  run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
-    if (baseline) baseline->process(scan, t);
-    if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
-  };
-  const SlamRunResult slam = run_slam(*source, config, load_loop_network(config), out / "slam", run_options);
-  if (slam.interrupted) return 130;
-  const std::optional<std::vector<Pose>> ground_truth = source->camera_poses();
-  source = nullptr;
-  stream.reset();  // stops the simulator's thread; finishes the kept sequence folder
+/// eval_baseline.{json,png}: the label-agnostic odometry against the ground truth.
+TrajectoryEvaluation evaluate_baseline(const std::filesystem::path& out, const std::vector<Pose>& ground_truth,
+                                       const std::vector<Pose>& baseline) {
+  const TrajectoryEvaluation evaluation = evaluate_trajectories(ground_truth, baseline);
+  const EvaluationLabels labels{"ground truth", "odometry_baseline/poses.txt"};
+  write_evaluation_json(out / "eval_baseline.json", evaluation, labels);
+  plot_evaluation(out / "eval_baseline.png", ground_truth, baseline, evaluation, labels);
+  return evaluation;
+}
 
-  std::optional<TrajectoryEvaluation> baseline_eval;
-  if (baseline && ground_truth) {
-    const auto& gt = *ground_truth;
-    baseline_eval = evaluate_trajectories(gt, baseline->output_poses());
-    const EvaluationLabels labels{"ground truth", "odometry_baseline/poses.txt"};
-    write_evaluation_json(out / "eval_baseline.json", *baseline_eval, labels);
-    plot_evaluation(out / "eval_baseline.png", gt, baseline->output_poses(), *baseline_eval, labels);
-  }
-
-  heading("2/2 summary");
-  print_summary(slam, baseline_eval);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+void print_outputs(const SlamRunResult& slam, double seconds, const std::filesystem::path& out) {
   std::cout << fmt::format("\n{} frames in {:.0f} s; SLAM median {:.1f} Hz, loop closure {:.2f} ms/frame amortised; "
                            "{:.0f} MB written to {}\n",
                            slam.frames, seconds, 1000.0 / std::max(slam.median_frame_ms, 1e-9), slam.mean_loop_ms,
@@ -206,7 +164,46 @@ int run_demo(const DemoOptions& options) {
   std::cout << fmt::format("plots: {}, {}\n", (out / "slam/trajectories.png").string(),
                            (out / "slam/eval_slam.png").string());
   std::cout << "trajectories: " << (out / "slam/poses.txt").string() << " (KITTI camera frame)\n";
-  write_view_page(out / "slam", simulated && !options.keep_sequence ? &*simulated : nullptr);
+}
+
+int run_demo(const DemoOptions& options) {
+  const StageTimer timer;
+  SaloamConfig config = options.config.resolve();
+  if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
+  const std::filesystem::path out(options.out);
+  const std::filesystem::path sequence_dir = out / "sequence";
+  const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
+
+  heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.sim.preset,
+                      options.sim.beams,
+                      options.gt_labels ? "ground-truth" : "noisy (emulated network)",
+                      from_disk ? " (reusing " + sequence_dir.string() + ")" : ""));
+  DemoSource source = open_demo_source(options, sequence_dir, from_disk);
+  const SourceInfo info = source.frames->info();
+  std::cout << fmt::format("{} frames; the simulator renders them {}\n", info.size(),
+                           from_disk ? "from disk" : options.keep_sequence ? "ahead and writes them to " + sequence_dir.string()
+                                                                             : "ahead, in memory");
+  std::optional<OdometryRun> baseline;
+  if (options.baseline) {
+    create_folder(out / "odometry_baseline");
+    baseline.emplace(without_semantics(config.odometry), out / "odometry_baseline", info.velo_to_cam);
+  }
+  const std::size_t shown = info.size() / 2;
+  SlamRunOptions run_options;
+  run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
+    if (baseline) baseline->add(scan, t);
+    if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
+  };
+  const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), out / "slam", run_options);
+  if (slam.interrupted) return 130;
+  source.frames.reset();  // stops the simulator's thread; finishes the kept sequence folder
+
+  std::optional<TrajectoryEvaluation> baseline_eval;
+  if (baseline && info.camera_poses) baseline_eval = evaluate_baseline(out, *info.camera_poses, baseline->result().output_poses);
+  heading("2/2 summary");
+  print_summary(slam, baseline_eval);
+  print_outputs(slam, timer.elapsed_s(), out);
+  write_view_page(out / "slam", source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
   return 0;
 }
 
@@ -215,10 +212,10 @@ const CommandRegistration kRegistration{Command{
     [](CLI::App& app) {
       auto options = std::make_shared<DemoOptions>();
       app.add_option("--out", options->out, "Output folder (default demo_output)");
-      app.add_option("--preset", options->preset, "Simulated route: figure-eight (default), urban-loop, straight");
+      app.add_option("--preset", options->sim.preset, "Simulated route: figure-eight (default), urban-loop, straight");
       app.add_option("--frames", options->frames, "Only frames A:B of the route (quicker runs)");
-      app.add_option("--beams", options->beams, "LiDAR beams: 64, 32 or 16")->check(CLI::IsMember({64, 32, 16}));
-      app.add_option("--seed", options->seed, "Simulation seed");
+      app.add_option("--beams", options->sim.beams, "LiDAR beams: 64, 32 or 16")->check(CLI::IsMember({64, 32, 16}));
+      app.add_option("--seed", options->sim.seed, "Simulation seed");
       app.add_flag("--gt-labels", options->gt_labels, "Use ground-truth labels instead of emulated network output");
       app.add_flag("--keep-sequence", options->keep_sequence,
                    "Also write the simulated sequence to OUT/sequence (about 2.4 MB per 64-beam scan)");

@@ -1,6 +1,5 @@
 // `saloam graph`: the semantic graph of one labelled scan, as SGPR JSON.
 
-#include <chrono>
 #include <iostream>
 #include <map>
 
@@ -8,6 +7,7 @@
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/place/graph_json.hpp"
 #include "saloam/place/semantic_graph.hpp"
@@ -34,9 +34,9 @@ int run_graph(const GraphArgs& args) {
 
   GraphBuilderConfig config;
   config.use_instances = !args.no_instances;
-  const auto start = std::chrono::steady_clock::now();
+  const StageTimer timer;
   SemanticGraph graph = build_semantic_graph(cloud, config);
-  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  const double ms = timer.elapsed_ms();
   if (reader.has_poses()) {
     // SGPR stores the KITTI (camera-frame) pose line of the scan.
     const Pose& p = reader.camera_poses().at(args.frame);

@@ -2,7 +2,7 @@
 // Writes poses.txt (KITTI camera-frame convention, comparable with the
 // ground truth), poses_tum.txt (LiDAR frame) and timing.json. Poses are
 // flushed frame by frame so an interrupted run keeps what it computed
-// (see pipeline/odometry_run.hpp).
+// (see runs/odometry_run.hpp).
 
 #include <iostream>
 #include <memory>
@@ -11,36 +11,24 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
-#include "saloam/core/frame_range.hpp"
-#include "saloam/io/sequence.hpp"
 #include "saloam/runs/odometry_run.hpp"
 
 namespace saloam::cli {
 namespace {
 
 struct OdomOptions {
-  std::string sequence;
+  SourceArgs source;
   std::string out;
-  std::string labels;
-  std::string frames;
   bool no_semantics = false;
-  bool no_calib = false;
   ConfigOptions config;
 };
 
 int run_odom(const OdomOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (options.no_semantics) config.odometry.use_semantics = false;
-  SequenceOptions seq_options;
-  if (!options.labels.empty()) seq_options.labels_dir = options.labels;
-  seq_options.ignore_labels = !config.odometry.use_semantics;
-  const SequenceReader reader(options.sequence, seq_options);
-  OdometryRunOptions run_options;
-  run_options.no_calib = options.no_calib;
-  std::tie(run_options.first_frame, run_options.end_frame) = FrameRange::parse(options.frames).clip(reader.size());
-
+  const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics, config);
   const std::filesystem::path out_dir(options.out);
-  const OdometryRunResult result = run_odometry(reader, config.odometry, out_dir, run_options);
+  const OdometryRunResult result = run_odometry(*source, config.odometry, out_dir);
   const double median_ms = result.median_frame_ms();
   std::cout << fmt::format("{} frames, {} registration failures, median {:.1f} ms/frame ({:.1f} Hz)\n", result.frames,
                            result.registration_failures, median_ms, median_ms > 0 ? 1000.0 / median_ms : 0.0);
@@ -56,14 +44,11 @@ int run_odom(const OdomOptions& options) {
 const CommandRegistration kRegistration{Command{
     "odom", "Semantic-assisted LOAM odometry over a sequence folder", 30, [](CLI::App& app) {
       auto options = std::make_shared<OdomOptions>();
-      app.add_option("SEQ_DIR", options->sequence, "Sequence folder (velodyne/, labels/, calib.txt, times.txt)")
-          ->required();
+      options->source.add_to(app, "Sequence folder (velodyne/, labels/, calib.txt, times.txt)");
       app.add_option("--out", options->out, "Output folder for poses.txt, poses_tum.txt, timing.json")->required();
-      app.add_option("--labels", options->labels, "Folder of .label files to use instead of SEQ_DIR/labels");
       app.add_flag("--no-semantics", options->no_semantics,
                    "Label-agnostic run with plain voxel grid (FLOAM-like baseline)");
-      app.add_option("--frames", options->frames, "Frame range A:B (B exclusive; A: = to the end)");
-      add_no_calib_flag(app, options->no_calib);
+      add_no_calib_flag(app, options->source.no_calib);
       options->config.add_to(app);
       return [options] { return run_odom(*options); };
     }}};

@@ -19,8 +19,7 @@ struct RenderArgs {
   std::string sequence;
   std::string out;
   std::size_t frame = 0;
-  double resolution = 0.25;
-  std::size_t frame_step = 0;
+  MapRenderOptions map;  ///< --resolution, --frame-step and every default
   std::string labels_dir;
 };
 
@@ -37,9 +36,7 @@ int run_render(const RenderArgs& args) {
   render_range_image(reader.load_scan(args.frame), range_png);
   std::cout << "range image: " << range_png.string() << '\n';
 
-  MapRenderOptions options;
-  options.picture.metres_per_pixel = args.resolution;
-  options.frame_step = args.frame_step;
+  MapRenderOptions options = args.map;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
   const auto map_png = out / "map.png";
   const MapRenderStats s = render_map(args.sequence, map_png, options);
@@ -55,8 +52,10 @@ const CommandRegistration kRegistration{Command{
       app.add_option("sequence", args->sequence, "Sequence folder (velodyne/, labels/, poses.txt, calib.txt)")->required();
       app.add_option("--out", args->out, "Output folder for map.png and range_NNNNNN.png")->required();
       app.add_option("--frame", args->frame, "Scan shown as a range image (default 0)")->check(non_negative_integer());
-      app.add_option("--resolution", args->resolution, "Map metres per pixel (default 0.25)")->check(positive_number());
-      app.add_option("--frame-step", args->frame_step, "Accumulate every n-th scan (default: about 300 scans)")
+      app.add_option("--resolution", args->map.picture.metres_per_pixel, "Map metres per pixel")
+          ->check(positive_number())
+          ->capture_default_str();
+      app.add_option("--frame-step", args->map.frame_step, "Accumulate every n-th scan (default 0: about 300 scans)")
           ->check(non_negative_integer());
       app.add_option("--labels-dir", args->labels_dir, "Labels folder instead of labels/ (e.g. labels_gt or predictions)");
       return [args] { return run_render(*args); };

@@ -26,11 +26,8 @@ struct SimulateArgs {
   std::string calib;
   std::string preset;
   std::string frames;
-  std::size_t stride = 1;
-  std::uint64_t seed = 1;
-  std::string labels = "gt";
-  int beams = 64;
-  int azimuth_steps = 2083;
+  std::string labels;  ///< gt or noisy; SimulationOptions' by default
+  SimulationOptions sim;  ///< --stride, --seed, --beams, --azimuth-steps and every default
   bool no_skew = false;
   bool no_dynamic = false;
   bool stats = false;
@@ -49,8 +46,9 @@ Pose load_velo_to_cam(const std::filesystem::path& calib, const std::filesystem:
   }
 }
 
-int run_simulate(const SimulateArgs& args) {
-  SimulationOptions options;
+/// The simulation the options ask for; defaults are SimulationOptions'.
+SimulationOptions simulation_options(const SimulateArgs& args) {
+  SimulationOptions options = args.sim;
   if (!args.trajectory.empty()) {
     if (!args.preset.empty()) throw ConfigError("give either --trajectory or --preset, not both");
     if (args.calib.empty()) throw ConfigError("--trajectory needs --calib (a KITTI calib.txt or calib_velo_to_cam.txt)");
@@ -60,24 +58,21 @@ int run_simulate(const SimulateArgs& args) {
     options.velo_to_cam_given = true;
   } else {
     if (!args.calib.empty()) throw ConfigError("--calib is only used with --trajectory");
-    options.preset = args.preset.empty() ? "urban-loop" : args.preset;
+    if (!args.preset.empty()) options.preset = args.preset;
   }
   const auto range = FrameRange::parse(args.frames);
   options.first_frame = range.first;
   options.end_frame = range.end;
-  options.stride = args.stride;
-  options.seed = args.seed;
-  if (args.labels == "noisy") {
-    options.labels = LabelMode::kNoisy;
-  } else if (args.labels != "gt") {
-    throw ConfigError(fmt::format("--labels '{}': use gt or noisy", args.labels));
-  }
-  options.beams = args.beams;
-  options.azimuth_steps = args.azimuth_steps;
+  if (args.labels == "noisy") options.labels = LabelMode::kNoisy;
+  if (args.labels == "gt") options.labels = LabelMode::kGroundTruth;
   options.skew = !args.no_skew;
   options.world.dynamic_objects = !args.no_dynamic;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
+  return options;
+}
 
+int run_simulate(const SimulateArgs& args) {
+  const SimulationOptions options = simulation_options(args);
   const std::string source = args.trajectory.empty() ? "preset " + options.preset : args.trajectory;
   if (args.out.empty()) {
     if (!args.stats) throw ConfigError("--out is required (or --stats alone to measure the class shares)");
@@ -88,7 +83,7 @@ int run_simulate(const SimulateArgs& args) {
     return 0;
   }
   spdlog::info("simulating {} ({} beams, seed {}, skew {}, labels {}) into {}", source, options.beams, options.seed,
-               options.skew ? "on" : "off", args.labels, args.out);
+               options.skew ? "on" : "off", options.labels == LabelMode::kNoisy ? "noisy" : "gt", args.out);
   const SimulationSummary s = simulate_sequence(options, args.out);
   if (args.stats) std::cout << "ground-truth class shares:\n" << format_class_shares(s.shares);
   std::cout << fmt::format("wrote {} frames, {} points ({:.0f} per frame) to {} in {:.1f} s ({:.2f} frames/s)\n", s.frames,
@@ -125,15 +120,15 @@ const CommandRegistration kRegistration{Command{
                      "KITTI calib.txt with a Tr: line, or a per-sequence list (NN: ...) picked by the pose file's name")
           ->check(CLI::ExistingFile);
       const auto names = preset_names();
-      app.add_option("--preset", args->preset, fmt::format("Built-in route: {} (default urban-loop)", fmt::join(names, ", ")))
+      app.add_option("--preset", args->preset, fmt::format("Built-in route: {} (default {})", fmt::join(names, ", "), args->sim.preset))
           ->check(CLI::IsMember(names));
       app.add_option("--frames", args->frames, "Source frames A:B (B exclusive; A: or :B allowed)");
-      app.add_option("--stride", args->stride, "Use every K-th source pose (frames K x 0.1 s apart in times.txt; each sweep still lasts 0.1 s)")->check(CLI::Range(1, 100000));
-      app.add_option("--seed", args->seed, "World and noise seed");
+      app.add_option("--stride", args->sim.stride, "Use every K-th source pose (frames K x 0.1 s apart in times.txt; each sweep still lasts 0.1 s)")->check(CLI::Range(1, 100000));
+      app.add_option("--seed", args->sim.seed, "World and noise seed");
       app.add_option("--labels", args->labels, "gt: exact labels; noisy: emulated network output in labels/, truth in labels_gt/")
           ->check(CLI::IsMember({"gt", "noisy"}));
-      app.add_option("--beams", args->beams, "Number of beams: 64 (HDL-64E), 32 or 16")->check(CLI::IsMember({64, 32, 16}));
-      app.add_option("--azimuth-steps", args->azimuth_steps, "Columns per turn (HDL-64E: about 2083)")
+      app.add_option("--beams", args->sim.beams, "Number of beams: 64 (HDL-64E), 32 or 16")->check(CLI::IsMember({64, 32, 16}));
+      app.add_option("--azimuth-steps", args->sim.azimuth_steps, "Columns per turn (HDL-64E: about 2083)")
           ->check(CLI::Range(16, 8000));
       app.add_flag("--no-skew", args->no_skew, "Take each scan at one instant (no motion distortion)");
       app.add_flag("--no-dynamic", args->no_dynamic, "No moving cars or pedestrians");

@@ -10,9 +10,7 @@
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
-#include "saloam/core/frame_range.hpp"
 #include "saloam/eval/evaluation_report.hpp"
-#include "saloam/io/sequence.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 
@@ -20,14 +18,11 @@ namespace saloam::cli {
 namespace {
 
 struct SlamOptions {
-  std::string sequence;
+  SourceArgs source;
   std::string out;
-  std::string labels;
-  std::string frames;
   std::string detector;
   std::string model;
   bool no_map = false;
-  bool no_calib = false;
   ConfigOptions config;
 };
 
@@ -73,17 +68,13 @@ int run_slam_command(const SlamOptions& options) {
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
-  SequenceOptions seq_options;
-  if (!options.labels.empty()) seq_options.labels_dir = options.labels;
-  seq_options.ignore_labels = !config.odometry.use_semantics && !needs_labels(parse_place_detector(config.loop.detector));
-  const SequenceReader reader(options.sequence, seq_options);
+  const bool labels = config.odometry.use_semantics || needs_labels(parse_place_detector(config.loop.detector));
+  const std::unique_ptr<FrameSource> source = options.source.open(!labels, config);
   SlamRunOptions run_options;
-  std::tie(run_options.first_frame, run_options.end_frame) = FrameRange::parse(options.frames).clip(reader.size());
   run_options.write_map = !options.no_map;
-  run_options.no_calib = options.no_calib;
 
   const std::filesystem::path out_dir(options.out);
-  const SlamRunResult result = run_slam(reader, config, load_loop_network(config), out_dir, run_options);
+  const SlamRunResult result = run_slam(*source, config, load_loop_network(config), out_dir, run_options);
   print_summary(result);
   std::cout << fmt::format("wrote {} (poses.txt, poses_odometry.txt, loops.csv, map.ply, map.png, trajectories.png, "
                            "timing.json)\n",
@@ -100,17 +91,14 @@ const CommandRegistration kRegistration{Command{
     "slam", "SA-LOAM SLAM: semantic odometry with loop closure, pose graph and global semantic map", 25,
     [](CLI::App& app) {
       auto options = std::make_shared<SlamOptions>();
-      app.add_option("SEQ_DIR", options->sequence, "Sequence folder (velodyne/, labels/, calib.txt, times.txt)")
-          ->required();
+      options->source.add_to(app, "Sequence folder (velodyne/, labels/, calib.txt, times.txt)");
       app.add_option("--out", options->out, "Output folder")->required();
-      app.add_option("--labels", options->labels, "Folder of .label files to use instead of SEQ_DIR/labels");
-      app.add_option("--frames", options->frames, "Frame range A:B (B exclusive; A: = to the end)");
       app.add_option("--detector", options->detector, "Loop detector: scancontext, sgpr, hybrid or ssc (loop.detector)")
           ->check(CLI::IsMember({"scancontext", "sgpr", "hybrid", "ssc"}));
       app.add_option("--model", options->model, "SGPR weights (.sgw) for the sgpr and hybrid detectors (loop.sgpr_model)")
           ->check(CLI::ExistingFile);
       app.add_flag("--no-map", options->no_map, "Skip the global map (map.ply, map.png)");
-      add_no_calib_flag(app, options->no_calib);
+      add_no_calib_flag(app, options->source.no_calib);
       options->config.add_to(app);
       return [options] { return run_slam_command(*options); };
     }}};

@@ -5,10 +5,19 @@
 #include <cstdlib>
 #include <optional>
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/segmentation/segmenter.hpp"
+#include "saloam/core/frame_range.hpp"
+#include "saloam/sources/open_source.hpp"
 
 namespace saloam::cli {
 
@@ -90,6 +99,91 @@ std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConf
       "SGPR needs weights: pass --model FILE.sgw or --set loop.sgpr_model=FILE.sgw (the shipped model is missing "
       "from {}; set SALOAM_DATA_DIR if saloam was moved)",
       shipped.parent_path().string()));
+}
+
+std::filesystem::path segmentation_plugin_path() {
+  const auto bin = program_dir();
+  if (!bin) return kSegmentationPlugin;
+  std::error_code error;
+  if (const auto beside = *bin / kSegmentationPlugin; std::filesystem::is_regular_file(beside, error)) return beside;
+  return (*bin / SALOAM_INSTALL_PLUGIN_RELATIVE / kSegmentationPlugin).lexically_normal();
+}
+
+std::filesystem::path segmenter_description_path(const std::string& given, const std::string& projection,
+                                                 const SaloamConfig& config) {
+  const std::filesystem::path model = !given.empty() ? given : config.segmentation.model;
+  if (model.empty()) return data_dir() / "models" / "segmenter" / "saloam.yaml";
+  if (!projection.empty()) return projection;
+  if (model.extension() != ".pt") return model;
+  auto beside = model;
+  beside.replace_extension(".yaml");
+  std::error_code error;
+  if (std::filesystem::is_regular_file(beside, error)) return beside;
+  throw ConfigError(fmt::format("--segmenter {}: a TorchScript model needs a description of its projection and classes: "
+                                "--projection FILE.yaml, or {} beside it (docs/segmentation.md)",
+                                model.string(), beside.string()));
+}
+
+void SegmentOptions::add_to(CLI::App& app) {
+  app.add_flag("--segment", segment,
+               "Label every scan in-process with the segmentation network (the shipped model unless --segmenter)");
+  app.add_option("--segmenter", segmenter,
+                 "Segmentation model: a description (.yaml) or a TorchScript network (.pt) with its description beside "
+                 "it or in --projection; implies --segment");
+  app.add_option("--projection", projection, "Description (.yaml) of a --segmenter TorchScript network's projection");
+}
+
+int forward_to_program(const std::string& name, const std::vector<std::string>& arguments) {
+  const auto bin = program_dir();
+  const auto program = bin ? *bin / name : std::filesystem::path(name);
+  std::error_code error;
+  if (!bin || !std::filesystem::is_regular_file(program, error)) {
+    spdlog::error("this saloam was built without libtorch: {} is not available (install libtorch-dev, e.g. "
+                  "scripts/install_deps.sh, and rebuild)",
+                  program.string());
+    return 2;
+  }
+  std::vector<std::string> args{program.string()};
+  if (spdlog::get_level() >= spdlog::level::warn) args.emplace_back("--quiet");
+  if (spdlog::get_level() <= spdlog::level::debug) args.emplace_back("--verbose");
+  args.insert(args.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  execv(argv[0], argv.data());
+  throw InputError(program, std::string("cannot run: ") + std::strerror(errno));
+}
+
+std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig& config) const {
+  if (!enabled()) return std::nullopt;
+  SegmentationStageOptions stage;
+  stage.model = read_segmenter_spec(segmenter_description_path(segmenter, projection, config));
+  stage.plugin = segmentation_plugin_path();
+  stage.rings = config.odometry.features;
+  stage.workers = config.segmentation.workers;
+  stage.lookahead = static_cast<std::size_t>(config.segmentation.lookahead);
+  return stage;
+}
+
+void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
+  app.add_option("SEQ_DIR", path, path_help)->required();
+  app.add_option("--labels", labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+  app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
+  segment.add_to(app);
+}
+
+std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, const SaloamConfig& config) const {
+  if (segment.enabled() && ignore_labels)
+    throw ConfigError("--segment labels the scans, but this run does not use labels (--no-semantics, or a label-free "
+                      "method): leave out one of them");
+  if (segment.enabled() && !labels.empty()) throw ConfigError("give --labels DIR or --segment, not both");
+  SourceOptions options;
+  if (!labels.empty()) options.labels = labels;
+  options.ignore_labels = ignore_labels;
+  options.ignore_calib = no_calib;
+  options.frames = FrameRange::parse(frames);
+  options.segmentation = segment.stage(config);
+  return open_source(path, options);
 }
 
 void add_no_calib_flag(CLI::App& app, bool& no_calib) {

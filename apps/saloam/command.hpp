@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include <CLI/CLI.hpp>
 
 #include "saloam/core/config.hpp"
+#include "saloam/segmentation/segmented_source.hpp"
+#include "saloam/io/frame_source.hpp"
 
 namespace saloam::cli {
 
@@ -42,6 +45,39 @@ struct ConfigOptions {
   [[nodiscard]] SaloamConfig resolve() const;
 };
 
+/// --segment, --segmenter FILE and --projection FILE of the commands that can
+/// label raw scans in-process.
+struct SegmentOptions {
+  bool segment = false;
+  std::string segmenter;
+  std::string projection;
+  void add_to(CLI::App& app);
+  /// True when the run segments (--segment, or a --segmenter given).
+  [[nodiscard]] bool enabled() const { return segment || !segmenter.empty(); }
+  /// The segmentation stage these options ask for (the model read and
+  /// checked; workers, look-ahead and ring recovery from `config`), or none.
+  [[nodiscard]] std::optional<SegmentationStageOptions> stage(const SaloamConfig& config) const;
+};
+
+
+
+/// The options that choose a run's frames, shared by the commands that run
+/// over a sequence (odom, slam, place-eval, bench): SEQ_DIR, --labels and
+/// --frames; commands where calibration matters add --no-calib
+/// (add_no_calib_flag). Call `open()` after parsing.
+struct SourceArgs {
+  std::string path;
+  std::string labels;
+  std::string frames;
+  bool no_calib = false;
+  SegmentOptions segment;  ///< --segment, --segmenter, --projection
+  void add_to(CLI::App& app, const std::string& path_help);
+  /// open_source() with these options; whether labels are read is the
+  /// command's choice (ConfigError when it ignores them but --segment asks
+  /// for them). `config` sets up the segmentation stage.
+  [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, const SaloamConfig& config) const;
+};
+
 /// The folder of the running program (from /proc/self/exe); none when it
 /// cannot be read. Installed data and the trainer are found from it.
 std::optional<std::filesystem::path> program_dir();
@@ -59,6 +95,24 @@ std::filesystem::path config_file_path(const std::string& name);
 /// loop.sgpr_model, else the model shipped in data_dir()/models/sgpr/saloam.sgw;
 /// ConfigError saying how to pass one when there is none.
 std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config);
+/// The network plugin of the segmentation (beside the program in a build
+/// tree, in <prefix>/lib/saloam when installed); it exists only in builds
+/// with libtorch.
+std::filesystem::path segmentation_plugin_path();
+
+/// The segmentation model to load: `given` (--segmenter), else the config's
+/// segmentation.model, else the shipped data_dir()/models/segmenter/saloam.yaml.
+/// A TorchScript file (.pt) needs its description: `projection` (--projection
+/// FILE.yaml) or the .yaml of the same name beside it. ConfigError saying how
+/// to pass one when there is none.
+std::filesystem::path segmenter_description_path(const std::string& given, const std::string& projection,
+                                                 const SaloamConfig& config);
+
+/// Replaces this process by the program `name` beside saloam (a trainer
+/// built only with libtorch), handing it `arguments` and the verbosity.
+/// Returns 2 with a message when the program was not built.
+int forward_to_program(const std::string& name, const std::vector<std::string>& arguments);
+
 /// --no-calib of the runs (odom, slam): without it a missing calib.txt is an
 /// error; with it poses.txt holds LiDAR-frame poses.
 void add_no_calib_flag(CLI::App& app, bool& no_calib);

@@ -5,7 +5,6 @@
 // hands its arguments over: a program of its own, so that only training
 // loads libtorch (whose start-up costs every other command about a second).
 
-#include <chrono>
 #include <cstdint>
 #include <fstream>
 #include <iostream>
@@ -23,6 +22,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/train/graph_dataset.hpp"
 #include "saloam/train/sgpr_trainer.hpp"
 
@@ -56,10 +56,10 @@ void keep_recipe(const fs::path& out, const DataRecipe& recipe) {
   file << recipe_to_json(recipe).dump(2) << '\n';
 }
 
-std::vector<GraphSequence> build_sequences(const std::vector<GraphSourceSpec>& specs, const fs::path& out, bool cache) {
+std::vector<GraphSequence> build_sequences(const std::vector<SourceSpec>& specs, const fs::path& out, bool cache) {
   std::vector<GraphSequence> sequences;
   for (const auto& spec : specs) {
-    const auto start = std::chrono::steady_clock::now();
+    const StageTimer timer;
     sequences.push_back(build_graph_sequence(spec, GraphBuilderConfig{}, cache ? std::optional(out / "graphs") : std::nullopt,
                                              spdlog::get_level() <= spdlog::level::info));
     if (stop_requested()) return {};
@@ -68,7 +68,7 @@ std::vector<GraphSequence> build_sequences(const std::vector<GraphSourceSpec>& s
     for (const auto& g : s.graphs) nodes += static_cast<double>(g.size());
     spdlog::info("{}: {} graphs, {:.1f} nodes on average ({:.1f} s)", s.name, s.graphs.size(),
                  s.graphs.empty() ? 0.0 : nodes / static_cast<double>(s.graphs.size()),
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+                 timer.elapsed_s());
   }
   return sequences;
 }

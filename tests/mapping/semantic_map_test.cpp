@@ -69,7 +69,7 @@ TEST(SemanticMap, MajorityVoteAndRangeLimit) {
 
 TEST(MapRender, WritesAPicture) {
   testing::TempDir dir;
-  SemanticMap map;
+  SemanticMap map(SemanticMapOptions::from_config(SlamConfig{}));
   map.insert(scene(), Pose::Identity());
   std::vector<Pose> trajectory(3, Pose::Identity());
   trajectory[1].translation().x() = 1.0;

@@ -208,8 +208,10 @@ TEST(Registration, SameResultWithAnyNumberOfThreads) {
   const ScanFeatures scan = seen_from(f, se3_exp(xi));
   auto settings = RegistrationSettings::from_config(OdometryConfig{});
   settings.parallel = false;
+  settings.inlier_distance = LoopClosureConfig{}.inlier_distance;  // inliers are counted as loop verification counts them
   const auto serial = register_scan(scan.edges, scan.planars, map, Pose::Identity(), settings);
   ASSERT_TRUE(serial.ok);
+  ASSERT_GT(serial.inliers, 0);
   ASSERT_GT(scan.edges.size() + scan.planars.size(), 4000u);  // several blocks of residuals
   settings.parallel = true;
   for (const int threads : {1, 2}) {

@@ -10,8 +10,15 @@
 namespace saloam {
 namespace {
 
+/// The gate of Table I (config/paper.yaml's loop.sigma 0.05); the rest as configured by default.
+CandidateGate table_one_gate() {
+  LoopClosureConfig config;
+  config.sigma = 0.05;
+  return CandidateGate::from_config(config);
+}
+
 TEST(SearchRadius, FollowsEquationThree) {
-  CandidateGate gate;  // Table I: sigma 0.05, delta_min 15, delta_max 100
+  const CandidateGate gate = table_one_gate();  // sigma 0.05, delta_min 15, delta_max 100
   EXPECT_DOUBLE_EQ(search_radius(gate, 0.0), 15.0);     // bounded below
   EXPECT_DOUBLE_EQ(search_radius(gate, 200.0), 15.0);   // 0.05 * 200 = 10 < 15
   EXPECT_DOUBLE_EQ(search_radius(gate, 1000.0), 50.0);  // sigma * d
@@ -39,7 +46,7 @@ std::vector<KeyframePlace> along_x(int n) {
 }
 
 TEST(LoopCandidates, GatesByRadiusAndRecentTravel) {
-  CandidateGate gate;
+  CandidateGate gate = CandidateGate::from_config(LoopClosureConfig{});
   gate.delta_min = 15;
   gate.sigma = 0.0;  // radius delta_min everywhere
   gate.exclude_recent_distance = 50;
@@ -59,7 +66,7 @@ TEST(LoopCandidates, GatesByRadiusAndRecentTravel) {
 }
 
 TEST(LoopCandidates, RadiusGrowsWithTravelledDistance) {
-  CandidateGate gate;  // sigma 0.05
+  CandidateGate gate = table_one_gate();
   gate.exclude_recent_distance = 0;
   std::mt19937_64 rng(1);
   const std::vector<KeyframePlace> earlier{{Eigen::Vector3d(0, 0, 0), 0.0}};
@@ -69,7 +76,7 @@ TEST(LoopCandidates, RadiusGrowsWithTravelledDistance) {
 }
 
 TEST(LoopCandidates, DrawsAtMostNCandiReproducibly) {
-  CandidateGate gate;
+  CandidateGate gate = CandidateGate::from_config(LoopClosureConfig{});
   gate.delta_min = 1000;  // everything qualifies
   gate.exclude_recent_distance = 0;
   gate.max_candidates = 64;

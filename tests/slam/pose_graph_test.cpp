@@ -109,7 +109,7 @@ TEST(PoseGraph, RecoversExactMeasurementsFromADriftedStart) {
   const Matrix6d info = Matrix6d::Identity() * 100;
   for (int i = 1; i < 40; ++i) graph.add_edge({std::size_t(i - 1), std::size_t(i), truth[i - 1].inverse() * truth[i], info, EdgeKind::kOdometry});
   graph.add_edge({0, 39, truth[0].inverse() * truth[39], info, EdgeKind::kLoop});
-  const PoseGraphSummary s = graph.optimize();
+  const PoseGraphSummary s = graph.optimize(PoseGraphOptions::from_config(SlamConfig{}));
   ASSERT_TRUE(s.usable);
   EXPECT_LT(s.final_cost, 1e-12);
   for (int i = 0; i < 40; ++i) {
@@ -148,7 +148,7 @@ TEST(PoseGraph, OneLoopEdgeRemovesMostOfTheOdometryDrift) {
   const double before = error();
   ASSERT_GT(before, 1.0);
   graph.add_edge({0, std::size_t(n - 1), truth[0].inverse() * truth[n - 1], odometry_info, EdgeKind::kLoop});
-  ASSERT_TRUE(graph.optimize().usable);
+  ASSERT_TRUE(graph.optimize(PoseGraphOptions::from_config(SlamConfig{})).usable);
   const double after = error();
   EXPECT_LT(after, 0.1 * before) << "before " << before << " m, after " << after << " m";
   // The error is spread over the chain: the loop edge keeps only a few

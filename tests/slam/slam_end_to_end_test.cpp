@@ -9,7 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
-#include "saloam/io/sequence.hpp"
+#include "saloam/io/sequence_source.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/simulator.hpp"
@@ -30,14 +30,14 @@ TEST(SlamEndToEnd, ShortLoopClosesWithLowerErrorAndNoFalseLoop) {
   const auto simulated = simulate_sequence(sim, dir / "sequence");
   ASSERT_GT(simulated.frames, 300u);
 
-  const SequenceReader reader(dir / "sequence");
+  SequenceFolderSource source{SequenceReader(dir / "sequence")};
   SaloamConfig config;  // the defaults: Scan Context detector, normalized acceptance
   SlamRunOptions options;
   options.show_progress = false;
   options.write_map = false;
-  const SlamRunResult result = run_slam(reader, config, std::nullopt, dir / "out", options);
+  const SlamRunResult result = run_slam(source, config, std::nullopt, dir / "out", options);
 
-  ASSERT_EQ(result.frames, reader.size());
+  ASSERT_EQ(result.frames, source.size());
   ASSERT_TRUE(result.odometry_evaluation && result.slam_evaluation && result.loop_summary);
   const LoopSummary& loops = *result.loop_summary;
   const double ate_odometry = result.odometry_evaluation->ate.aligned.rmse;
@@ -57,7 +57,7 @@ TEST(SlamEndToEnd, ShortLoopClosesWithLowerErrorAndNoFalseLoop) {
   std::ifstream poses(dir / "out" / "poses.txt");
   std::size_t lines = 0;
   for (std::string line; std::getline(poses, line);) ++lines;
-  EXPECT_EQ(lines, reader.size());
+  EXPECT_EQ(lines, source.size());
 }
 
 }  // namespace
@@ -109,16 +109,16 @@ TEST(SlamEndToEnd, RefusesToWriteOverTheSequence) {
   sim.show_progress = false;
   simulate_sequence(sim, dir.path());
   const auto before = std::filesystem::file_size(dir / "poses.txt");
-  const SequenceReader reader(dir.path());
+  SequenceFolderSource source{SequenceReader(dir.path())};
   SlamRunOptions options;
   options.show_progress = false;
   const std::string slam_error = testing::input_error_of(
-      [&] { run_slam(reader, SaloamConfig{}, std::nullopt, dir.path() / ".", options); });
+      [&] { run_slam(source, SaloamConfig{}, std::nullopt, dir.path() / ".", options); });
   EXPECT_NE(slam_error.find("is the sequence folder"), std::string::npos) << slam_error;
   OdometryRunOptions odometry_options;
   odometry_options.show_progress = false;
   const std::string odometry_error =
-      testing::input_error_of([&] { run_odometry(reader, OdometryConfig{}, dir.path(), odometry_options); });
+      testing::input_error_of([&] { run_odometry(source, OdometryConfig{}, dir.path(), odometry_options); });
   EXPECT_NE(odometry_error.find("overwrite its ground truth"), std::string::npos) << odometry_error;
   EXPECT_EQ(std::filesystem::file_size(dir / "poses.txt"), before);
 }

@@ -8,11 +8,11 @@
 #include <gtest/gtest.h>
 
 #include "saloam/io/ply.hpp"
-#include "saloam/io/sequence.hpp"
+#include "saloam/io/sequence_source.hpp"
 #include "saloam/io/trajectory_io.hpp"
-#include "saloam/runs/frame_source.hpp"
 #include "saloam/runs/map_building.hpp"
 #include "saloam/runs/slam_run.hpp"
+#include "saloam/sim/simulated_source.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "testing/test_support.hpp"
 
@@ -46,9 +46,9 @@ TEST(StreamedRun, GivesTheRunOverTheWrittenSequenceAndKeepsTheSameSequence) {
   testing::TempDir dir("saloam_streamed_run");
   const SimulationOptions sim = short_route();
   simulate_sequence(sim, dir / "written");
-  const SequenceReader reader(dir / "written");
+  SequenceFolderSource folder{SequenceReader(dir / "written")};
   const SaloamConfig config;
-  const SlamRunResult from_folder = run_slam(reader, config, std::nullopt, dir / "out_folder", quiet_run());
+  const SlamRunResult from_folder = run_slam(folder, config, std::nullopt, dir / "out_folder", quiet_run());
 
   const SimulatedSequence sequence(sim);
   SlamRunResult streamed;
@@ -94,7 +94,7 @@ TEST(StreamedRun, ServesFramesOnceInOrderAndStopsWhenDestroyedEarly) {
   const SimulatedSequence sequence(short_route());
   {
     SimulatedSource source(sequence, 2, dir / "kept");
-    EXPECT_FALSE(source.rereadable());
+    EXPECT_FALSE(source.info().rereadable);
     EXPECT_THROW((void)source.scan(1), std::logic_error);  // frame 0 comes first
     EXPECT_GT(source.scan(0).size(), 1000u);
     EXPECT_GT(source.scan(1).size(), 1000u);
@@ -115,14 +115,14 @@ TEST(MapScanStore, KeepsOnlyEveryStepthScanAndBuildsTheMapOfTheScans) {
   const SimulationOptions sim = short_route();
   simulate_sequence(sim, dir.path());
   const SequenceReader reader(dir.path());
-  SequenceFolderSource source(reader);
+  SequenceFolderSource source{SequenceReader(dir.path())};
   SemanticMapOptions options;
   options.voxel_size = 0.25;
   const std::vector<Pose> poses = reader.lidar_poses();
 
   MapScanStore store(options, 3);
   for (std::size_t k = 0; k < reader.size(); ++k) store.offer(k, reader.load_scan(k));
-  const LabelledCloud direct = build_semantic_map(source, poses, 0, options, 3, false);
+  const LabelledCloud direct = build_semantic_map(source, poses, options, 3, false);
   const LabelledCloud stored = store.build(poses, false);
   ASSERT_GT(direct.size(), 1000u);
   EXPECT_NEAR(static_cast<double>(stored.size()), static_cast<double>(direct.size()),

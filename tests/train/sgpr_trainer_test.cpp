@@ -10,6 +10,7 @@
 
 #include "saloam/place/sgpr_network.hpp"
 #include "saloam/train/sgpr_trainer.hpp"
+#include "saloam/train/training_run.hpp"
 #include "synthetic_graphs.hpp"
 #include "testing/test_support.hpp"
 

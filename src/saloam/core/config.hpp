@@ -270,10 +270,25 @@ struct SlamConfig {
   int map_frame_step = 2;           ///< every n-th frame goes into the global map
 };
 
+/// In-process semantic segmentation of raw scans (`--segment`; the first
+/// box of the paper's Fig. 2): the model, and the pipeline stage that runs it
+/// beside the odometry.
+struct SegmentationConfig {
+  /// Model description (.yaml, docs/segmentation.md); empty: the shipped
+  /// models/segmenter/saloam.yaml. `--segmenter FILE` overrides it.
+  std::string model;
+  /// Scans segmented at once, each on a thread of its own (one intra-op
+  /// thread each: labels do not depend on this number).
+  int workers = 1;
+  /// Scans segmented ahead of the consumer (odometry, SLAM).
+  int lookahead = 4;
+};
+
 struct SaloamConfig {
   OdometryConfig odometry;
   LoopClosureConfig loop;
   SlamConfig slam;
+  SegmentationConfig segmentation;
 };
 
 /// Calls v(name, member, description, range) for every field; range is the
@@ -373,6 +388,13 @@ void visit_fields(SlamConfig& c, Visitor&& v) {
   v("map_frame_step", c.map_frame_step, "every n-th frame goes into the global map", AtLeast{1});
 }
 
+template <class Visitor>
+void visit_fields(SegmentationConfig& c, Visitor&& v) {
+  v("model", c.model, "segmentation model description (.yaml; empty: the shipped one)", Any{});
+  v("workers", c.workers, "scans segmented at once (one thread each)", Range{1, 64});
+  v("lookahead", c.lookahead, "scans segmented ahead of the odometry", Range{1, 256});
+}
+
 /// Calls v(section, struct) for every section; nested sections use dots.
 template <class Visitor>
 void visit_sections(SaloamConfig& c, Visitor&& v) {
@@ -381,6 +403,7 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
   v("loop", c.loop);
   v("loop.ssc", c.loop.ssc);
   v("slam", c.slam);
+  v("segmentation", c.segmentation);
 }
 
 /// Throws ConfigError, starting with `origin`, for the first field outside

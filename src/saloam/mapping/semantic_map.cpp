@@ -8,6 +8,12 @@
 
 namespace saloam {
 
+SemanticMapOptions SemanticMapOptions::from_config(const SlamConfig& config) {
+  SemanticMapOptions options;
+  options.voxel_size = config.map_voxel_size;
+  return options;
+}
+
 SemanticMap::SemanticMap(SemanticMapOptions options) : options_(options) {}
 
 void SemanticMap::insert(const LabelledCloud& scan, const Pose& world_from_sensor) {

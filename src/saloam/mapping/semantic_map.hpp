@@ -11,20 +11,24 @@
 #include <tsl/robin_map.h>
 
 #include "saloam/core/hash.hpp"
+#include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
 
 namespace saloam {
 
 struct SemanticMapOptions {
-  double voxel_size = 0.2;      ///< [m] map resolution
+  double voxel_size{};          ///< [m] map resolution (slam.map_voxel_size)
   double max_range = 60.0;      ///< [m] farther returns are noisy and sparse: skipped
   bool skip_dynamic = true;     ///< leave out moving objects and people
   bool skip_unlabeled = false;  ///< leave out class 0 (unlabeled) points
+
+  /// The resolution from the configuration, which holds its default.
+  static SemanticMapOptions from_config(const SlamConfig& config);
 };
 
 class SemanticMap {
  public:
-  explicit SemanticMap(SemanticMapOptions options = {});
+  explicit SemanticMap(SemanticMapOptions options);
 
   /// Adds a scan given in its sensor frame, with T_world<-sensor.
   void insert(const LabelledCloud& scan, const Pose& world_from_sensor);

@@ -597,7 +597,19 @@ std::vector<std::vector<std::uint32_t>> rings_from_elevation(const LabelledCloud
   }
   return rings;
 }
+
+std::vector<std::vector<std::uint32_t>> rings_from_times(const LabelledCloud& cloud, const std::vector<float>& times,
+                                                         const FeatureConfig& config) {
+  std::vector<std::vector<std::uint32_t>> rings;
+  if (config.ring_from_point_order) rings = rings_from_storage(times, config, config.num_beams);
+  if (rings.empty()) rings = rings_from_elevation(cloud, times, config);
+  return rings;
+}
 }  // namespace
+
+std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, const FeatureConfig& config) {
+  return rings_from_times(cloud, point_sweep_times(cloud, config, false), config);
+}
 
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
                               bool parallel) {
@@ -606,9 +618,7 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // is stored ring by ring (exact even for scans whose points were moved by
   // motion compensation), else from the elevation angle.
   const std::vector<float> times = point_sweep_times(cloud, config, parallel);
-  std::vector<std::vector<std::uint32_t>> rings;
-  if (config.ring_from_point_order) rings = rings_from_storage(times, config, config.num_beams);
-  if (rings.empty()) rings = rings_from_elevation(cloud, times, config);
+  const std::vector<std::vector<std::uint32_t>> rings = rings_from_times(cloud, times, config);
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.
   std::vector<ScanFeatures> per_ring(rings.size());

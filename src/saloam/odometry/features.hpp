@@ -108,6 +108,13 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
 std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
                                                               const FeatureConfig& config, int expected_rings);
 
+/// Point indices per ring (top ring first), each ring in azimuth order, as
+/// extract_features() finds them: from the storage order when the scan is
+/// stored ring by ring (and config.ring_from_point_order), else from the
+/// elevation angle. Points in no ring (outside the layout's field of view,
+/// invalid) are left out.
+std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, const FeatureConfig& config);
+
 /// Poles and tree trunks: objects whose cross-section is a small disc.
 bool is_thin_round(std::uint16_t static_class_id);
 

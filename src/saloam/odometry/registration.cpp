@@ -33,7 +33,7 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
 
 namespace {
 
-constexpr int kMaxNeighbours = 32;
+constexpr int kMaxNeighbours = kMaxFitNeighbours;
 
 struct EdgeMatch {
   Line line;

@@ -18,22 +18,26 @@
 
 namespace saloam {
 
+/// Built from the configuration (odometry.*), which holds the defaults; a
+/// default-constructed value is all zeros.
 struct RegistrationSettings {
-  int edge_neighbours = 5;         ///< N_ne
-  int planar_neighbours = 5;       ///< N_np
-  double max_correspondence_distance = 1.0;  ///< [m]
-  double robust_kernel_scale = 0.1;  ///< [m] Huber scale
-  int max_iterations = 10;
-  int outer_iterations = 3;
+  int edge_neighbours{};                ///< N_ne
+  int planar_neighbours{};              ///< N_np
+  double max_correspondence_distance{};  ///< [m]
+  double robust_kernel_scale{};         ///< [m] Huber scale
+  int max_iterations{};
+  int outer_iterations{};
   /// An outer round that moved the pose less than this ends the re-association.
-  double reassociation_min_translation = 0.0;  ///< [m] (0: always all rounds)
-  double reassociation_min_rotation = 0.0;     ///< [rad]
-  double plane_normal_tolerance = 0.05;  ///< plane constraint: tolerance on |n . z|
+  double reassociation_min_translation{};  ///< [m] (0: always all rounds)
+  double reassociation_min_rotation{};     ///< [rad]
+  double plane_normal_tolerance{};         ///< plane constraint: tolerance on |n . z|
   std::array<double, kNumClassIndices> class_weight{};          ///< w^l
   std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
-  bool parallel = false;  ///< associate and sum the normal equations with TBB (inside the caller's task arena); same result
-  /// [m] a final correspondence closer than this counts as an inlier (RegistrationResult::inliers).
-  double inlier_distance = 0.2;
+  bool parallel{};  ///< associate and sum the normal equations with TBB (inside the caller's task arena); same result
+  /// [m] a final correspondence closer than this counts as an inlier
+  /// (RegistrationResult::inliers). Loop verification sets loop.inlier_distance;
+  /// the odometry counts none (0): nothing reads its inliers.
+  double inlier_distance{};
 
   /// From the config; without semantics all weights are 1 and no plane constraint applies.
   static RegistrationSettings from_config(const OdometryConfig& config);

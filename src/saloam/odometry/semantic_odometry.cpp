@@ -1,18 +1,15 @@
 #include "saloam/odometry/semantic_odometry.hpp"
 
-#include <time.h>
-
 #include <algorithm>
-#include <chrono>
 #include <thread>
 
 #include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/odometry/deskew.hpp"
 
 namespace saloam {
 
 namespace {
-using Clock = std::chrono::steady_clock;
 // A registered sweep motion that differs from the one the scan was de-skewed
 // with by more than this moves points by more than ~1 cm: de-skew again.
 constexpr double kRedeskewTranslation = 0.01;           // [m per frame]
@@ -41,16 +38,6 @@ constexpr double kMaxWeightRatio = 4.0;
 constexpr double kBootstrapSettledTranslation = 0.01;           // [m]
 constexpr double kBootstrapSettledRotation = 0.1 * M_PI / 180;  // [rad]
 
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-double thread_cpu_ms() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) * 1e3 + static_cast<double>(ts.tv_nsec) * 1e-6;
-}
-
 }  // namespace
 
 SemanticOdometry::SemanticOdometry(OdometryConfig config)
@@ -75,28 +62,20 @@ Pose SemanticOdometry::register_frame(const LabelledCloud& cloud, double timesta
 }
 
 Pose SemanticOdometry::process(const LabelledCloud& cloud, double timestamp) {
-  FrameTimings timing, cpu;
-  // Stage times, wall-clock and CPU: each lap returns the wall time since the
-  // last and stores the CPU time since the last in `*cpu_stage`.
-  auto lap = [start = Clock::now(), cpu_start = thread_cpu_ms()](double* cpu_stage) mutable {
-    const double ms = ms_since(start);
-    const double cpu_now = thread_cpu_ms();
-    *cpu_stage = cpu_now - cpu_start;
-    start = Clock::now();
-    cpu_start = cpu_now;
-    return ms;
-  };
+  StageTimer timer;
   ScanFeatures measured = extract_frame_features(cloud);
-  timing.features_ms = lap(&cpu.features_ms);
+  const StageTime features_time = timer.lap();
   const MotionPrediction prediction = predict_motion(timestamp);
   ScanFeatures features = downsample_and_deskew(measured, prediction);
-  timing.deskew_downsample_ms = lap(&cpu.deskew_downsample_ms);
+  const StageTime deskew_time = timer.lap();
   const Pose sweep_pose = align(features, measured, prediction);
   if (config_.adaptive_class_weights && config_.use_semantics) update_class_weights(last_stats_.registration);
-  timing.registration_ms = lap(&cpu.registration_ms);
+  const StageTime registration_time = timer.lap();
   update_map(features, sweep_pose);
-  timing.map_update_ms = lap(&cpu.map_update_ms);
-  return record_frame(std::move(features), sweep_pose, timestamp, timing, cpu);
+  const StageTime map_time = timer.lap();
+  return record_frame(std::move(features), sweep_pose, timestamp,
+                      {features_time.wall_ms, deskew_time.wall_ms, registration_time.wall_ms, map_time.wall_ms},
+                      {features_time.cpu_ms, deskew_time.cpu_ms, registration_time.cpu_ms, map_time.cpu_ms});
 }
 
 ScanFeatures SemanticOdometry::extract_frame_features(const LabelledCloud& cloud) const {

@@ -13,6 +13,12 @@ double heading_deg(const Pose& relative) {
 }
 }  // namespace
 
+LoopTruthOptions LoopTruthOptions::from_config(const LoopClosureConfig& config) {
+  LoopTruthOptions options;
+  options.exclude_recent_distance = config.exclude_recent_distance;
+  return options;
+}
+
 LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const LoopTruthOptions& options) {
   LoopTruth truth;
   const Pose& gt_match = gt.at(loop.match_frame);

@@ -16,7 +16,11 @@ struct LoopTruthOptions {
   double max_translation_error = 0.5;  ///< [m]
   double max_rotation_error_deg = 2.0;
   double revisit_distance = 3.0;       ///< [m] a keyframe this close (GT) to an earlier one revisits it
-  double exclude_recent_distance = 50.0;  ///< [m] earlier = travelled at least this much before
+  /// [m] earlier = travelled at least this much before: the SLAM's
+  /// loop.exclude_recent_distance (from_config), as its search.
+  double exclude_recent_distance{};
+
+  static LoopTruthOptions from_config(const LoopClosureConfig& config);
 };
 
 struct LoopTruth {
@@ -48,6 +52,6 @@ struct LoopSummary {
   std::size_t missed_reverse_stretches = 0;
 };
 
-LoopSummary summarize_loops(const SlamSystem& slam, const std::vector<Pose>& gt, const LoopTruthOptions& options = {});
+LoopSummary summarize_loops(const SlamSystem& slam, const std::vector<Pose>& gt, const LoopTruthOptions& options);
 
 }  // namespace saloam

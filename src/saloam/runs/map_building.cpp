@@ -9,14 +9,14 @@
 
 namespace saloam {
 
-LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& lidar_poses, std::size_t first_frame,
+LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& lidar_poses,
                                  const SemanticMapOptions& options, std::size_t frame_step, bool show_progress) {
   frame_step = std::max<std::size_t>(frame_step, 1);
   SemanticMap map(options);
-  const std::size_t count = std::min(lidar_poses.size(), source.size() - std::min(first_frame, source.size()));
+  const std::size_t count = std::min(lidar_poses.size(), source.size());
   ProgressBar progress((count + frame_step - 1) / frame_step, "map", show_progress);
   for (std::size_t k = 0; k < count && !stop_requested(); k += frame_step) {
-    map.insert(source.scan(first_frame + k), lidar_poses[k]);
+    map.insert(source.scan(k), lidar_poses[k]);
     progress.advance();
   }
   progress.finish();

@@ -9,15 +9,15 @@
 
 #include "saloam/core/types.hpp"
 #include "saloam/mapping/semantic_map.hpp"
-#include "saloam/runs/frame_source.hpp"
+#include "saloam/io/frame_source.hpp"
 
 namespace saloam {
 
-/// Inserts scan `first_frame + k` with lidar_poses[k] (every `frame_step`-th
-/// pose) into a SemanticMap and returns its points (world frame). The source
-/// must be rereadable().
-LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& lidar_poses, std::size_t first_frame,
-                                 const SemanticMapOptions& options, std::size_t frame_step = 1,
+/// Inserts scan k with lidar_poses[k] (every `frame_step`-th pose) into a
+/// SemanticMap and returns its points (world frame). The source must be
+/// rereadable.
+LabelledCloud build_semantic_map(FrameSource& source, const std::vector<Pose>& lidar_poses,
+                                 const SemanticMapOptions& options, std::size_t frame_step,
                                  bool show_progress = true);
 
 /// The scans of a streamed run that go into its map, kept as it goes by:

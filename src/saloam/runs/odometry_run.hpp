@@ -1,8 +1,8 @@
 #pragma once
-// Runs the odometry over a sequence folder and writes its results as it goes:
+// Runs the odometry over a frame source and writes its results as it goes:
 //   poses.txt      KITTI format, camera-frame convention of the ground truth
 //                  (P_i = Tr Q_i Tr^-1), so `saloam eval`, the KITTI devkit and evo read it;
-//                  LiDAR-frame poses when the sequence has no calib.txt
+//                  LiDAR-frame poses when the source has no Tr (--no-calib)
 //   poses_tum.txt  LiDAR-frame poses Q_i = T_L0<-Li with timestamps (TUM)
 //   timing.json    per-stage timings
 // Each pose line is flushed as soon as it is computed: an interrupted run
@@ -10,24 +10,21 @@
 
 #include <cstddef>
 #include <filesystem>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
-#include "saloam/io/sequence.hpp"
+#include "saloam/io/frame_source.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
+#include "saloam/runs/trajectory_writer.hpp"
 
 namespace saloam {
 
 struct OdometryRunOptions {
-  std::size_t first_frame = 0;
-  std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the sequence
   bool show_progress = true;
   std::string progress_label = "odom";
-  bool no_calib = false;  ///< LiDAR-frame poses.txt, calib.txt not needed (output_velo_to_cam)
 };
 
 struct OdometryRunResult {
@@ -43,10 +40,29 @@ struct OdometryRunResult {
   [[nodiscard]] double worst_frame_ms() const;
 };
 
-/// Runs SemanticOdometry over frames [first_frame, end_frame) of `reader`,
-/// writing into `out_dir` (created).
-OdometryRunResult run_odometry(const SequenceReader& reader, const OdometryConfig& config,
-                               const std::filesystem::path& out_dir, const OdometryRunOptions& options = {});
+/// An odometry run fed scan by scan: registers each scan and writes its pose
+/// to poses.txt / poses_tum.txt in `out_dir` (which must exist) as it goes.
+/// run_odometry() feeds it a source; a run that consumes a source itself
+/// feeds it the same scans (the demo's label-agnostic baseline beside its SLAM).
+class OdometryRun {
+ public:
+  OdometryRun(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> velo_to_cam);
+  /// Registers the next scan and writes its pose; false when the
+  /// registration failed (too few correspondences: the prediction was kept).
+  bool add(const LabelledCloud& scan, double time);
+  [[nodiscard]] const SemanticOdometry& odometry() const { return odometry_; }
+  [[nodiscard]] const OdometryRunResult& result() const { return result_; }
+
+ private:
+  SemanticOdometry odometry_;
+  TrajectoryWriter writer_;
+  OdometryRunResult result_;
+};
+
+/// Runs SemanticOdometry over every frame of `source`, writing into `out_dir`
+/// (created; never the source's folder) and `out_dir`/timing.json at the end.
+OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config, const std::filesystem::path& out_dir,
+                               const OdometryRunOptions& options = {});
 
 /// timing.json: frames, Hz (median, worst frame) and mean/median/max per stage.
 void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings);

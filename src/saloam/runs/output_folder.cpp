@@ -20,15 +20,11 @@ void prepare_output_folder(const std::filesystem::path& out_dir, const std::opti
   create_folder(out_dir);
 }
 
-std::optional<Pose> output_velo_to_cam(const FrameSource& source, bool lidar_frame) {
-  if (lidar_frame) {
-    spdlog::info("--no-calib: pose files hold LiDAR-frame poses, not the KITTI camera convention");
-    return std::nullopt;
+std::optional<Pose> output_velo_to_cam(const SourceInfo& source) {
+  if (!source.velo_to_cam) {
+    spdlog::info("{}: no calibration: pose files hold LiDAR-frame poses, not the KITTI camera convention", source.name);
   }
-  if (auto tr = source.velo_to_cam()) return tr;
-  throw InputError(source.folder().value_or(std::filesystem::path(source.name())) / "calib.txt",
-                   "not found: needed to write poses.txt in KITTI's camera frame, comparable with the ground "
-                   "truth; pass --no-calib to write LiDAR-frame poses instead");
+  return source.velo_to_cam;
 }
 
 }  // namespace saloam

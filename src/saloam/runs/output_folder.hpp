@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "saloam/core/types.hpp"
-#include "saloam/runs/frame_source.hpp"
+#include "saloam/io/frame_source.hpp"
 
 namespace saloam {
 
@@ -16,10 +16,10 @@ namespace saloam {
 /// and what would be lost.
 void prepare_output_folder(const std::filesystem::path& out_dir, const std::optional<std::filesystem::path>& sequence);
 
-/// The velodyne-to-camera Tr for a run's KITTI pose file: the source's
-/// (calib.txt), so that poses.txt compares with the ground truth. InputError
-/// when it has none, unless `lidar_frame` (--no-calib): then no Tr (calib.txt
-/// is ignored) and the KITTI file holds LiDAR-frame poses.
-std::optional<Pose> output_velo_to_cam(const FrameSource& source, bool lidar_frame);
+/// The velodyne-to-camera Tr for a run's KITTI pose files: the source's, so
+/// that poses.txt compares with the ground truth. A source without one (a
+/// folder opened with --no-calib) gives none: the pose files then hold
+/// LiDAR-frame poses, which the log says.
+std::optional<Pose> output_velo_to_cam(const SourceInfo& source);
 
 }  // namespace saloam

@@ -1,11 +1,7 @@
 #include "saloam/runs/slam_run.hpp"
 
-#include <sys/resource.h>
-
 #include <algorithm>
-#include <chrono>
 #include <fstream>
-#include <numeric>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -23,19 +19,13 @@
 #include "saloam/runs/map_building.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
-#include "saloam/runs/timing_stats.hpp"
+#include "saloam/runs/timing_report.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam {
 
 namespace {
-
-double peak_rss_mib() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
 
 std::string pose_numbers(const Pose& T) {
   double v[12];
@@ -88,34 +78,25 @@ void write_graph_map(const std::filesystem::path& file, const SlamSystem& slam) 
 }
 
 void write_timing(const std::filesystem::path& file, const SlamSystem& slam, double seconds, double rss_mib) {
-  std::vector<double> odometry, place, search, verification, optimization, loop, total;
-  for (const auto& t : slam.timings()) {
-    odometry.push_back(t.odometry_ms);
-    place.push_back(t.place_ms);
-    search.push_back(t.search_ms);
-    verification.push_back(t.verification_ms);
-    optimization.push_back(t.optimization_ms);
-    loop.push_back(t.loop_ms());
-    total.push_back(t.total_ms());
-  }
-  const double median = median_of(total);
-  const double mean = mean_of(total);
+  const auto& t = slam.timings();
+  const std::vector<double> total = column(t, &SlamFrameTimings::total_ms);
+  const Summary frame = summarize(total);
   const nlohmann::json j{
       {"frames", total.size()},
       {"keyframes", slam.keyframes().size()},
       {"optimizations", slam.optimizations()},
       {"wall_s", seconds},
-      {"hz_median", median > 0 ? 1000.0 / median : 0.0},
-      {"hz_mean", mean > 0 ? 1000.0 / mean : 0.0},
+      {"hz_median", hz(frame.median)},
+      {"hz_mean", hz(frame.mean)},
       {"peak_rss_mib", rss_mib},
       {"keyframe_store_mib", static_cast<double>(slam.keyframe_bytes()) / (1024.0 * 1024.0)},
       {"stages",
-       {{"odometry", stage_stats(odometry)},
-        {"place_descriptor", stage_stats(place)},
-        {"candidates_and_scoring", stage_stats(search)},
-        {"verification", stage_stats(verification)},
-        {"pose_graph", stage_stats(optimization)},
-        {"loop_closure_total", stage_stats(loop)},
+       {{"odometry", stage_stats(column(t, &SlamFrameTimings::odometry_ms))},
+        {"place_descriptor", stage_stats(column(t, &SlamFrameTimings::place_ms))},
+        {"candidates_and_scoring", stage_stats(column(t, &SlamFrameTimings::search_ms))},
+        {"verification", stage_stats(column(t, &SlamFrameTimings::verification_ms))},
+        {"pose_graph", stage_stats(column(t, &SlamFrameTimings::optimization_ms))},
+        {"loop_closure_total", stage_stats(column(t, &SlamFrameTimings::loop_ms))},
         {"total", stage_stats(total)}}}};
   std::ofstream out(file);
   if (!out) throw InputError(file, "cannot write timing file");
@@ -183,13 +164,12 @@ struct RunTruth {
 // its ground has sensor poses (poses_sensor.txt), where the scans were really
 // taken: loops are judged against them (poses.txt is wrong in height there,
 // as KITTI's).
-RunTruth run_truth(const FrameSource& source, const std::optional<Pose>& tr, std::size_t first, std::size_t frames) {
+RunTruth run_truth(const SourceInfo& source, const std::optional<Pose>& tr, std::size_t frames) {
   RunTruth truth;
-  const auto camera = source.camera_poses();
+  const auto& camera = source.camera_poses;
   if (!camera || frames == 0) return truth;
   const auto slice_of = [&](const std::vector<Pose>& all) {
-    std::vector<Pose> slice(all.begin() + static_cast<std::ptrdiff_t>(first),
-                            all.begin() + static_cast<std::ptrdiff_t>(first + frames));
+    std::vector<Pose> slice(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(frames));
     const Pose rebase = slice.front().inverse();  // world = first processed frame, as the estimates
     for (auto& p : slice) p = orthonormalized(rebase * p);
     return slice;
@@ -202,7 +182,7 @@ RunTruth run_truth(const FrameSource& source, const std::optional<Pose>& tr, std
   truth.camera = slice_of(*camera);
   if (!tr) return truth;
   truth.lidar = to_lidar(*truth.camera);
-  if (const auto sensor = source.sensor_camera_poses()) truth.sensor_lidar = to_lidar(slice_of(*sensor));
+  if (const auto& sensor = source.sensor_camera_poses) truth.sensor_lidar = to_lidar(slice_of(*sensor));
   return truth;
 }
 
@@ -218,17 +198,12 @@ nlohmann::json loop_summary_json(const LoopSummary& s) {
           {"missed_reverse_stretches", s.missed_reverse_stretches}};
 }
 
-// Where the frames came from, for `saloam view` (summary.json).
-struct RunOrigin {
-  std::optional<std::filesystem::path> sequence;  ///< the sequence folder; none for a stream
-  std::size_t first_frame = 0;
-};
-
 // Evaluates both trajectories and the loops against the ground truth (when
-// known) and writes eval_{odometry,slam}.{json,png} and summary.json.
+// known) and writes eval_{odometry,slam}.{json,png} and summary.json, with
+// where the frames came from for `saloam view` (the source's folder and first frame).
 void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunTruth& truth,
                   const std::vector<Pose>& odometry_out, const std::vector<Pose>& slam_out,
-                  const std::filesystem::path& out_dir, SlamRunResult& result, const RunOrigin& origin) {
+                  const std::filesystem::path& out_dir, SlamRunResult& result, const SourceInfo& origin) {
   nlohmann::json summary{{"first_frame", origin.first_frame},
                          {"frames", result.frames},
                          {"keyframes", result.keyframes},
@@ -250,8 +225,7 @@ void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunT
     summary["slam"] = evaluation_to_json(*result.slam_evaluation, slam_labels, false);
   }
   if (const std::vector<Pose>* reference = truth.loop_reference()) {
-    LoopTruthOptions truth_options;
-    truth_options.exclude_recent_distance = config.loop.exclude_recent_distance;
+    const LoopTruthOptions truth_options = LoopTruthOptions::from_config(config.loop);
     result.loop_summary = summarize_loops(slam, *reference, truth_options);
     result.loop_reference = truth.sensor_lidar ? "poses_sensor.txt" : "poses.txt";
     if (truth.sensor_lidar) result.loop_summary_poses_txt = summarize_loops(slam, *truth.lidar, truth_options);
@@ -262,7 +236,7 @@ void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunT
     }
     summary["loops"] = loop_summary_json(*result.loop_summary);
   }
-  if (origin.sequence) summary["sequence"] = std::filesystem::absolute(*origin.sequence).lexically_normal().string();
+  if (origin.folder) summary["sequence"] = std::filesystem::absolute(*origin.folder).lexically_normal().string();
   std::ofstream out(out_dir / "summary.json");
   if (!out) throw InputError(out_dir / "summary.json", "cannot write the run summary");
   out << summary.dump(2) << '\n';
@@ -288,78 +262,83 @@ SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
   result.loops_accepted = slam.accepted_loops();
   result.loops_verified = slam.loops().size();
   result.peak_rss_mib = peak_rss_mib();
-  std::vector<double> totals, loops;
-  for (const auto& t : slam.timings()) {
-    totals.push_back(t.total_ms());
-    loops.push_back(t.loop_ms());
-  }
-  result.median_frame_ms = median_of(totals);
-  result.mean_loop_ms = mean_of(loops);
+  result.median_frame_ms = summarize(column(slam.timings(), &SlamFrameTimings::total_ms)).median;
+  result.mean_loop_ms = summarize(column(slam.timings(), &SlamFrameTimings::loop_ms)).mean;
   return result;
 }
 
 }  // namespace
 
-SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
-                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
-  const std::size_t first = options.first_frame;
-  const std::size_t end = std::min(options.end_frame, source.size());
-  if (first >= end) throw ConfigError(fmt::format("empty frame range {}:{} ({} frames)", first, end, source.size()));
-  if (config.odometry.use_semantics && !source.has_labels()) {
-    spdlog::warn("{}: no labels found; running with every point in one class", source.name());
-  }
-  const std::optional<Pose> tr = output_velo_to_cam(source, options.no_calib);
-  prepare_output_folder(out_dir, source.folder());
+namespace {
 
-  // A stream cannot be read again for the map: keep what the map needs as it goes by.
-  SemanticMapOptions map_options;
-  map_options.voxel_size = config.slam.map_voxel_size;
-  const auto map_step = static_cast<std::size_t>(std::max(1, config.slam.map_frame_step));
-  std::optional<MapScanStore> map_scans;
-  if (options.write_map && !source.rereadable()) map_scans.emplace(map_options, map_step);
-
-  SlamSystem slam(config, std::move(network));
-  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
-  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
-  ProgressBar progress(end - first, "slam", options.show_progress);
-  const auto start = std::chrono::steady_clock::now();
-  for (std::size_t i = first; i < end && !stop_requested(); ++i) {
+// The frame loop: every frame of `source` through the SLAM, the odometry's
+// poses written as they come, and a stream's scans kept for the map.
+double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& odometry_writer,
+                      std::optional<MapScanStore>& map_scans, const SlamRunOptions& options) {
+  const SourceInfo& info = source.info();
+  ProgressBar progress(info.size(), "slam", options.show_progress);
+  const StageTimer timer;
+  for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
     const LabelledCloud scan = source.scan(i);
-    const double t = source.times().at(i);
+    const double t = info.times.at(i);
     odometry_writer.write(t, slam.process(scan, t));
     if (options.on_scan) options.on_scan(i, scan, t);
-    if (map_scans) map_scans->offer(i - first, scan);
+    if (map_scans) map_scans->offer(i, scan);
     progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
     progress.advance();
   }
   progress.finish();
-  SlamRunResult result = summarize_run(slam, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  return timer.elapsed_s();
+}
 
-  const std::vector<Pose> optimized = slam.optimized_poses();
+// Everything written after the frame loop: loop-closed poses, timing, loops,
+// graph map, trajectories and their evaluation.
+void write_results(const SlamSystem& slam, const std::vector<Pose>& optimized, TrajectoryWriter& slam_writer,
+                   const SaloamConfig& config, const SourceInfo& info, const std::optional<Pose>& tr,
+                   const std::filesystem::path& out_dir, SlamRunResult& result) {
   for (std::size_t i = 0; i < optimized.size(); ++i) slam_writer.write(slam.timestamps().at(i), optimized[i]);
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
-  const RunTruth truth = run_truth(source, tr, first, result.frames);
+  const RunTruth truth = run_truth(info, tr, result.frames);
   write_loops_csv(out_dir / "loops.csv", slam, truth.loop_reference());
   if (uses_sgpr(parse_place_detector(config.loop.detector))) write_graph_map(out_dir / "graph_map.json", slam);
   const std::vector<Pose> odometry_out = output_poses(slam.odometry_poses(), tr);
   const std::vector<Pose> slam_out = output_poses(optimized, tr);
   plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, truth.camera ? &*truth.camera : nullptr,
                     slam.accepted_loops());
-  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, RunOrigin{source.folder(), first});
+  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, info);
+}
+
+}  // namespace
+
+SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
+  const SourceInfo& info = source.info();
+  if (config.odometry.use_semantics && !info.has_labels) {
+    spdlog::warn("{}: no labels found; running with every point in one class", info.name);
+  }
+  const std::optional<Pose> tr = output_velo_to_cam(info);
+  prepare_output_folder(out_dir, info.folder);
+
+  // A stream cannot be read again for the map: keep what the map needs as it goes by.
+  const SemanticMapOptions map_options = SemanticMapOptions::from_config(config.slam);
+  const auto map_step = static_cast<std::size_t>(std::max(1, config.slam.map_frame_step));
+  std::optional<MapScanStore> map_scans;
+  if (options.write_map && !info.rereadable) map_scans.emplace(map_options, map_step);
+
+  SlamSystem slam(config, std::move(network));
+  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
+  SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options));
+  const std::vector<Pose> optimized = slam.optimized_poses();
+  write_results(slam, optimized, slam_writer, config, info, tr, out_dir, result);
 
   if (options.write_map && !result.interrupted) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)
-                                        : build_semantic_map(source, optimized, first, map_options, map_step,
+                                        : build_semantic_map(source, optimized, map_options, map_step,
                                                              options.show_progress);
     write_map_outputs(slam, map, optimized, out_dir);
   }
   return result;
-}
-
-SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
-                       const std::filesystem::path& out_dir, const SlamRunOptions& options) {
-  SequenceFolderSource source(reader);
-  return run_slam(source, config, std::move(network), out_dir, options);
 }
 
 }  // namespace saloam

@@ -1,5 +1,5 @@
 #pragma once
-// Runs the whole SLAM system over a sequence folder and writes its results:
+// Runs the whole SLAM system over a frame source and writes its results:
 //   poses.txt, poses_tum.txt                    after loop closure (KITTI camera frame / TUM LiDAR frame)
 //   poses_odometry.txt, poses_odometry_tum.txt  odometry only, flushed frame by frame
 //   loops.csv        every verified candidate: scores, fit, decision, relative pose (and its truth with GT)
@@ -15,7 +15,6 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,22 +22,18 @@
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
-#include "saloam/io/sequence.hpp"
-#include "saloam/runs/frame_source.hpp"
+#include "saloam/io/frame_source.hpp"
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/slam/slam_system.hpp"
 
 namespace saloam {
 
 struct SlamRunOptions {
-  std::size_t first_frame = 0;
-  std::size_t end_frame = std::numeric_limits<std::size_t>::max();  ///< exclusive, clipped to the sequence
   bool show_progress = true;
   bool write_map = true;  ///< map.ply / map.png (re-reads the scans, or keeps copies of a stream's)
   /// Called with every scan after the SLAM has processed it (e.g. to run a
   /// second odometry on the same stream).
   std::function<void(std::size_t frame, const LabelledCloud& scan, double time)> on_scan;
-  bool no_calib = false;  ///< LiDAR-frame pose files, calib.txt not needed (output_velo_to_cam)
 };
 
 struct SlamRunResult {
@@ -61,11 +56,9 @@ struct SlamRunResult {
 /// config's loop.sgpr_model; ConfigError when it is not set.
 std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config);
 
-/// Runs SlamSystem over frames [first_frame, end_frame) of `source`, writing into `out_dir` (created).
+/// Runs SlamSystem over every frame of `source`, writing into `out_dir`
+/// (created; never the source's folder).
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
-                       const std::filesystem::path& out_dir, const SlamRunOptions& options = {});
-/// The same over a sequence folder.
-SlamRunResult run_slam(const SequenceReader& reader, const SaloamConfig& config, std::optional<SgprNetwork> network,
                        const std::filesystem::path& out_dir, const SlamRunOptions& options = {});
 
 }  // namespace saloam

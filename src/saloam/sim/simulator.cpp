@@ -1,7 +1,6 @@
 #include "saloam/sim/simulator.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -10,6 +9,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/scan_io.hpp"
@@ -131,7 +131,7 @@ SimulatedFrame SimulatedSequence::render(std::size_t k) const {
 }
 
 SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::path& out_dir) {
-  const auto t0 = std::chrono::steady_clock::now();
+  const StageTimer timer;
   const SimulatedSequence sequence(options);
   SequenceWriter writer(out_dir);
   writer.write_calib(sequence.velo_to_cam());
@@ -176,7 +176,7 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
     summary.miou = summary.score.miou();
     summary.label_accuracy = summary.score.accuracy();
   }
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  summary.seconds = timer.elapsed_s();
   return summary;
 }
 

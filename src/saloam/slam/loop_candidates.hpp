@@ -22,12 +22,14 @@
 
 namespace saloam {
 
+/// Eq. 3's gate, built from the configuration (loop.*), which holds the
+/// defaults; a default-constructed gate is all zeros.
 struct CandidateGate {
-  double sigma = 0.05;       ///< drift rate [m per m travelled]
-  double delta_min = 15.0;   ///< [m]
-  double delta_max = 100.0;  ///< [m]
-  double exclude_recent_distance = 50.0;  ///< [m]
-  std::size_t max_candidates = 64;        ///< N_candi
+  double sigma{};                    ///< drift rate [m per m travelled]
+  double delta_min{};                ///< [m]
+  double delta_max{};                ///< [m]
+  double exclude_recent_distance{};  ///< [m]
+  std::size_t max_candidates{};      ///< N_candi
 
   static CandidateGate from_config(const LoopClosureConfig& config);
 };

@@ -37,16 +37,18 @@
 
 namespace saloam {
 
+/// Built from the configuration (loop.* and odometry.*), which holds the
+/// defaults; a default-constructed value is all zeros.
 struct LoopVerificationSettings {
   RegistrationSettings coarse;  ///< wide radius, loose kernel: converges from metres off
   RegistrationSettings fine;    ///< the odometry's settings, more iterations
   ClassVoxelSizes voxel_size{};
-  bool loss_test = false;       ///< true: the paper's r < delta_r decides; false: the normalized test
-  double delta_r = 100.0;
-  double max_mean_residual = 0.05;
-  double min_inlier_fraction = 0.40;
-  double min_translation_eigenvalue = 0.05;
-  double max_runner_up_ratio = std::numeric_limits<double>::infinity();  ///< .inf: test off
+  bool loss_test{};             ///< true: the paper's r < delta_r decides; false: the normalized test
+  double delta_r{};
+  double max_mean_residual{};
+  double min_inlier_fraction{};
+  double min_translation_eigenvalue{};
+  double max_runner_up_ratio{};  ///< .inf: test off
 
   static LoopVerificationSettings from_config(const SaloamConfig& config);
 };

@@ -1,6 +1,5 @@
 #include "saloam/slam/pose_graph.hpp"
 
-#include <chrono>
 #include <stdexcept>
 
 #include <ceres/ceres.h>
@@ -8,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
 
 namespace saloam {
 
@@ -60,6 +60,10 @@ void PoseGraph::add_edge(const PoseGraphEdge& edge) {
   edges_.push_back(edge);
 }
 
+PoseGraphOptions PoseGraphOptions::from_config(const SlamConfig& config) {
+  return {config.max_iterations, config.loop_robust_scale};
+}
+
 PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
   PoseGraphSummary summary;
   if (nodes_.size() < 2 || edges_.empty()) {
@@ -72,7 +76,7 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
   solver.num_threads = 1;  // deterministic and within the one-core budget
   solver.logging_type = ceres::SILENT;
   solver.minimizer_progress_to_stdout = false;
-  const auto start = std::chrono::steady_clock::now();
+  const StageTimer timer;
   summary.usable = true;
   for (const bool robust : {false, true}) {
     for (auto* loss : loop_losses_) {
@@ -85,7 +89,7 @@ PoseGraphSummary PoseGraph::optimize(const PoseGraphOptions& options) {
     if (!robust) summary.initial_cost = result.initial_cost;
     summary.final_cost = result.final_cost;
   }
-  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  summary.seconds = timer.elapsed_s();
   for (auto& node : nodes_) {  // back onto the unit sphere exactly
     Eigen::Map<Eigen::Quaterniond> q(node.q);
     q.normalize();

@@ -25,6 +25,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
 
 namespace ceres {
@@ -61,9 +62,12 @@ struct PoseGraphEdge {
   EdgeKind kind = EdgeKind::kOdometry;
 };
 
+/// Built from the configuration (slam.*), which holds the defaults.
 struct PoseGraphOptions {
-  int max_iterations = 30;
-  double loop_robust_scale = 10.0;  ///< Cauchy scale of loop edges (whitened units)
+  int max_iterations{};        ///< Levenberg-Marquardt iterations per phase
+  double loop_robust_scale{};  ///< Cauchy scale of loop edges (whitened units)
+
+  static PoseGraphOptions from_config(const SlamConfig& config);
 };
 
 struct PoseGraphSummary {
@@ -88,7 +92,7 @@ class PoseGraph {
 
   /// Optimises every pose (Levenberg-Marquardt, sparse Cholesky) from the
   /// current estimates: plain least squares, then robust loop edges.
-  PoseGraphSummary optimize(const PoseGraphOptions& options = {});
+  PoseGraphSummary optimize(const PoseGraphOptions& options);
 
   /// Current estimate of node i (rotation re-orthonormalised).
   [[nodiscard]] Pose pose(std::size_t i) const;

@@ -1,20 +1,14 @@
 #include "saloam/slam/slam_system.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
 
 namespace saloam {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 // Guesses closer than this to each other converge to the same fit: one is enough.
 constexpr double kSameGuessTranslation = 1.0;         // [m]
 constexpr double kSameGuessRotation = 5.0 * M_PI / 180;  // [rad]
@@ -59,9 +53,8 @@ SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> ne
               config.loop.ssc),
       gate_(CandidateGate::from_config(config.loop)),
       verification_(LoopVerificationSettings::from_config(config)),
+      graph_options_(PoseGraphOptions::from_config(config.slam)),
       rng_(config.loop.seed) {
-  graph_options_.max_iterations = config.slam.max_iterations;
-  graph_options_.loop_robust_scale = config.slam.loop_robust_scale;
   switch (places_.detector()) {
     case PlaceDetector::kSgpr: score_threshold_ = config.loop.zeta; break;
     case PlaceDetector::kSsc: score_threshold_ = config.loop.ssc_zeta; break;
@@ -73,10 +66,10 @@ SlamSystem::~SlamSystem() = default;
 
 Pose SlamSystem::process(const LabelledCloud& scan, double timestamp) {
   SlamFrameTimings timing;
-  const auto start = Clock::now();
+  const StageTimer timer;
   const std::size_t previous = odometry_.poses().size();
   const Pose odometry_pose = odometry_.register_frame(scan, timestamp);
-  timing.odometry_ms = ms_since(start);
+  timing.odometry_ms = timer.elapsed_ms();
   if (previous > 0) travelled_ += (odometry_.poses()[previous - 1].translation() - odometry_pose.translation()).norm();
   if (previous == 1 && odometry_.revised_first_features() && !keyframes_.empty()) {
     keyframes_.front().features = StoredFeatures::from(*odometry_.revised_first_features());
@@ -101,7 +94,7 @@ bool SlamSystem::keyframe_due(const Pose& odometry_pose) const {
 
 void SlamSystem::add_keyframe(const LabelledCloud& scan, const Pose& odometry_pose, double timestamp,
                               SlamFrameTimings& timing) {
-  const auto start = Clock::now();
+  const StageTimer timer;
   Keyframe kf;
   kf.frame = odometry_.poses().size() - 1;
   kf.timestamp = timestamp;
@@ -124,7 +117,7 @@ void SlamSystem::add_keyframe(const LabelledCloud& scan, const Pose& odometry_po
   }
   keyframe_places_.push_back({graph_.pose(keyframes_.size()).translation(), travelled_});
   keyframes_.push_back(std::move(kf));
-  timing.place_ms = ms_since(start);
+  timing.place_ms = timer.elapsed_ms();
 }
 
 bool SlamSystem::search_due() const {
@@ -132,13 +125,12 @@ bool SlamSystem::search_due() const {
 }
 
 void SlamSystem::close_loops(SlamFrameTimings& timing) {
-  auto start = Clock::now();
+  StageTimer timer;
   const std::size_t query = keyframes_.size() - 1;
   const std::vector<std::size_t> candidates = select_candidates(query);
   const std::vector<Proposal> proposals = score_candidates(query, candidates);
-  timing.search_ms = ms_since(start);
+  timing.search_ms = timer.lap().wall_ms;
 
-  start = Clock::now();
   bool closed = false;
   // Best score first; the first accepted loop ends the search: the others
   // would constrain the same stretch again.
@@ -152,11 +144,10 @@ void SlamSystem::close_loops(SlamFrameTimings& timing) {
       break;
     }
   }
-  timing.verification_ms = ms_since(start);
+  timing.verification_ms = timer.lap().wall_ms;
   if (closed) {
-    start = Clock::now();
     optimize();
-    timing.optimization_ms = ms_since(start);
+    timing.optimization_ms = timer.lap().wall_ms;
   }
 }
 

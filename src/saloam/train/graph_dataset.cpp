@@ -28,20 +28,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Tr from a calib.txt (`Tr:` line) or, failing that, from a per-sequence
-/// list (`NN: ...`) picked by the pose file's name (00.txt), as `saloam simulate` does.
-Pose velo_to_cam_for(const fs::path& calib, const fs::path& trajectory) {
-  try {
-    return read_velo_to_cam(calib);
-  } catch (const InputError&) {
-    const std::string stem = trajectory.stem().string();
-    const bool numeric =
-        !stem.empty() && std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); });
-    if (!numeric || !fs::is_regular_file(calib)) throw;
-    return read_velo_to_cam(calib, std::stoi(stem));
-  }
-}
-
 std::vector<Eigen::Vector3d> positions_of(const std::vector<Pose>& lidar_poses) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(lidar_poses.size());
@@ -72,25 +58,8 @@ std::vector<SemanticGraph> build_all(std::size_t count, const std::string& label
   return graphs;
 }
 
-GraphSequence simulated_graphs(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config, bool show_progress) {
-  SimulationOptions options;
-  if (!spec.preset.empty()) {
-    options.preset = spec.preset;
-  } else {
-    options.camera_poses = read_kitti_poses(spec.path);
-    if (options.camera_poses.size() < 2) throw InputError(spec.path, "needs at least two poses");
-    if (spec.calib.empty()) throw InputError(spec.path, "a simulated source needs a calib file (calib: FILE)");
-    options.velo_to_cam = velo_to_cam_for(spec.calib, spec.path);
-    options.velo_to_cam_given = true;
-  }
-  const FrameRange range = FrameRange::parse(spec.frames, "frames");
-  options.first_frame = range.first;
-  options.end_frame = range.end;
-  options.stride = spec.frame_step;
-  options.seed = spec.seed;
-  options.labels = spec.noisy_labels ? LabelMode::kNoisy : LabelMode::kGroundTruth;
-  options.show_progress = false;
-  const SimulatedSequence sequence(options);
+GraphSequence simulated_graphs(const SourceSpec& spec, const GraphBuilderConfig& graph_config, bool show_progress) {
+  const SimulatedSequence sequence(simulation_options(spec));
   GraphSequence out;
   out.name = spec.name();
   // The sensor poses are where the scans were really taken (FORMAT of poses_sensor.txt).
@@ -100,7 +69,7 @@ GraphSequence simulated_graphs(const GraphSourceSpec& spec, const GraphBuilderCo
   return out;
 }
 
-GraphSequence folder_graphs(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config, bool show_progress) {
+GraphSequence folder_graphs(const SourceSpec& spec, const GraphBuilderConfig& graph_config, bool show_progress) {
   SequenceOptions options;
   if (!spec.labels.empty()) options.labels_dir = spec.labels;
   const SequenceReader reader(spec.path, options);
@@ -151,152 +120,15 @@ void write_cache(const fs::path& file, const nlohmann::json& key, const GraphSeq
   fs::rename(partial, file);
 }
 
-// ---- recipe ----
-
-fs::path resolve(const fs::path& base, const std::string& text) {
-  const fs::path p(text);
-  return p.is_absolute() ? p : base / p;
-}
-
-GraphSourceSpec read_source(const YAML::Node& node, const GraphSourceSpec& defaults, const fs::path& base,
-                            const fs::path& file, const std::string& where) {
-  if (!node.IsMap()) throw InputError(file, where + ": expected a map with `simulate:` or `folder:`");
-  GraphSourceSpec spec = defaults;
-  try {
-    if (node["simulate"] && node["folder"]) throw InputError(file, where + ": give `simulate:` or `folder:`, not both");
-    if (node["simulate"]) {
-      spec.kind = GraphSourceSpec::Kind::kSimulated;
-      const auto text = node["simulate"].as<std::string>();
-      if (text.rfind("preset:", 0) == 0) {
-        spec.preset = text.substr(7);
-        const auto names = preset_names();
-        if (std::find(names.begin(), names.end(), spec.preset) == names.end())
-          throw InputError(file, where + ": unknown preset '" + spec.preset + "' (" + fmt::format("{}", fmt::join(names, ", ")) + ")");
-      } else {
-        spec.path = resolve(base, text);
-      }
-    } else if (node["folder"]) {
-      spec.kind = GraphSourceSpec::Kind::kFolder;
-      spec.path = resolve(base, node["folder"].as<std::string>());
-    } else {
-      throw InputError(file, where + ": needs `simulate: POSES.txt` or `folder: DIR`");
-    }
-    for (const auto& kv : node) {
-      const auto key = kv.first.as<std::string>();
-      if (key == "simulate" || key == "folder") continue;
-      if (key == "calib") spec.calib = resolve(base, kv.second.as<std::string>());
-      else if (key == "frames") spec.frames = kv.second.as<std::string>();
-      else if (key == "frame_step") spec.frame_step = kv.second.as<std::size_t>();
-      else if (key == "seed") spec.seed = kv.second.as<std::uint64_t>();
-      else if (key == "labels" && spec.kind == GraphSourceSpec::Kind::kSimulated) {
-        const auto v = kv.second.as<std::string>();
-        if (v != "noisy" && v != "gt") throw InputError(file, where + ": labels must be noisy or gt, not '" + v + "'");
-        spec.noisy_labels = v == "noisy";
-      } else if (key == "labels") spec.labels = resolve(base, kv.second.as<std::string>());
-      else throw InputError(file, where + ": unknown key '" + key + "'");
-    }
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, where + ": " + e.what());
-  }
-  if (spec.frame_step == 0) throw InputError(file, where + ": frame_step must be at least 1");
-  if (spec.kind == GraphSourceSpec::Kind::kSimulated && !spec.preset.empty()) {
-    return spec;  // a built-in route needs no files
-  }
-  if (spec.kind == GraphSourceSpec::Kind::kSimulated) {
-    if (!fs::is_regular_file(spec.path))
-      throw InputError(spec.path, "pose file not found (" + where + " of " + file.string() + ")");
-    if (spec.calib.empty()) throw InputError(file, where + ": a simulated source needs `calib:` (here or in defaults)");
-    if (!fs::is_regular_file(spec.calib))
-      throw InputError(spec.calib, "calibration file not found (" + where + " of " + file.string() + ")");
-  } else if (!fs::is_directory(spec.path)) {
-    throw InputError(spec.path, "sequence folder not found (" + where + " of " + file.string() + ")");
-  }
-  return spec;
-}
-
 }  // namespace
 
-std::string GraphSourceSpec::name() const {
-  if (kind == Kind::kSimulated)
-    return fmt::format("sim-{}{}-s{}-k{}-{}", preset.empty() ? path.stem().string() : preset, frames.empty() ? "" : "-f" + frames, seed,
-                       frame_step, noisy_labels ? "noisy" : "gt");
-  std::string n = fmt::format("folder-{}{}-k{}", path.filename().string(), frames.empty() ? "" : "-f" + frames, frame_step);
-  return n;
-}
-
-nlohmann::json GraphSourceSpec::to_json() const {
-  nlohmann::json j;
-  j[kind == Kind::kSimulated ? "simulate" : "folder"] =
-      preset.empty() ? fs::absolute(path).lexically_normal().string() : "preset:" + preset;
-  if (kind == Kind::kSimulated) {
-    if (!calib.empty()) j["calib"] = fs::absolute(calib).lexically_normal().string();
-    j["seed"] = seed;
-    j["labels"] = noisy_labels ? "noisy" : "gt";
-  } else if (!labels.empty()) {
-    j["labels"] = fs::absolute(labels).lexically_normal().string();
-  }
-  j["frames"] = frames;
-  j["frame_step"] = frame_step;
-  return j;
-}
-
-DataRecipe read_data_recipe(const fs::path& file) {
-  require_file(file, "data recipe");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, std::string("not valid YAML: ") + e.what());
-  }
-  if (!root.IsMap()) throw InputError(file, "expected a map with `train:` and `validation:` lists");
-  const fs::path base = file.parent_path();
-  GraphSourceSpec defaults;
-  if (const auto d = root["defaults"]) {
-    if (!d.IsMap()) throw InputError(file, "defaults: expected a map");
-    try {
-      for (const auto& kv : d) {
-        const auto key = kv.first.as<std::string>();
-        if (key == "calib") defaults.calib = resolve(base, kv.second.as<std::string>());
-        else if (key == "frame_step") defaults.frame_step = kv.second.as<std::size_t>();
-        else if (key == "seed") defaults.seed = kv.second.as<std::uint64_t>();
-        else if (key == "labels") defaults.noisy_labels = kv.second.as<std::string>() != "gt";
-        else throw InputError(file, "defaults: unknown key '" + key + "'");
-      }
-    } catch (const YAML::Exception& e) {
-      throw InputError(file, std::string("defaults: ") + e.what());
-    }
-  }
-  DataRecipe recipe;
-  for (const char* section : {"train", "validation"}) {
-    const auto list = root[section];
-    if (!list || !list.IsSequence() || list.size() == 0)
-      throw InputError(file, std::string("needs a non-empty `") + section + ":` list");
-    auto& out = std::string(section) == "train" ? recipe.train : recipe.validation;
-    for (std::size_t i = 0; i < list.size(); ++i)
-      out.push_back(read_source(list[i], defaults, base, file, fmt::format("{}[{}]", section, i)));
-  }
-  for (const auto& key : root)
-    if (const auto k = key.first.as<std::string>(); k != "train" && k != "validation" && k != "defaults")
-      throw InputError(file, "unknown key '" + k + "'");
-  return recipe;
-}
-
-nlohmann::json recipe_to_json(const DataRecipe& recipe) {
-  nlohmann::json j;
-  j["train"] = nlohmann::json::array();
-  j["validation"] = nlohmann::json::array();
-  for (const auto& s : recipe.train) j["train"].push_back(s.to_json());
-  for (const auto& s : recipe.validation) j["validation"].push_back(s.to_json());
-  return j;
-}
-
-GraphSequence build_graph_sequence(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config,
+GraphSequence build_graph_sequence(const SourceSpec& spec, const GraphBuilderConfig& graph_config,
                                    const std::optional<fs::path>& cache_dir, bool show_progress) {
   const nlohmann::json key = {{"source", spec.to_json()}, {"graph", graph_config_json(graph_config)}};
   const fs::path cache = cache_dir ? *cache_dir / (spec.name() + ".json") : fs::path();
   if (cache_dir)
     if (auto cached = read_cache(cache, key)) return std::move(*cached);
-  GraphSequence sequence = spec.kind == GraphSourceSpec::Kind::kSimulated
+  GraphSequence sequence = spec.kind == SourceSpec::Kind::kSimulated
                                ? simulated_graphs(spec, graph_config, show_progress)
                                : folder_graphs(spec, graph_config, show_progress);
   if (cache_dir && !stop_requested()) write_cache(cache, key, sequence);

@@ -24,38 +24,9 @@
 #include "saloam/place/place_recognition.hpp"
 #include "saloam/place/semantic_graph.hpp"
 #include "saloam/place/sgpr_network.hpp"
+#include "saloam/train/data_recipe.hpp"
 
 namespace saloam {
-
-/// One source of graphs (one entry of a data recipe).
-struct GraphSourceSpec {
-  enum class Kind { kSimulated, kFolder };
-  Kind kind = Kind::kSimulated;
-  std::filesystem::path path;   ///< simulated: KITTI pose file (camera frame); folder: the sequence folder
-  std::string preset;           ///< simulated: a built-in route instead of a pose file ("simulate: preset:NAME")
-  std::filesystem::path calib;  ///< simulated: calib.txt with Tr, or a per-sequence list picked by the pose file's name
-  std::string frames;           ///< source frames "A:B" (empty = all)
-  std::size_t frame_step = 5;   ///< every k-th frame
-  std::uint64_t seed = 1;       ///< simulated: world and label-noise seed
-  bool noisy_labels = true;     ///< simulated: emulated network labels (else ground truth)
-  std::filesystem::path labels; ///< folder: .label folder instead of labels/ (e.g. predictions)
-
-  /// A short name for messages and the cache file: "sim-00-s1-k5-noisy", "folder-<dir>-k5".
-  [[nodiscard]] std::string name() const;
-  [[nodiscard]] nlohmann::json to_json() const;
-};
-
-/// What `saloam sgpr-train --data` reads:
-///   defaults: {calib: FILE, frame_step: 5, seed: 1, labels: noisy}   (optional)
-///   train:      [{simulate: POSES.txt, frames: "0:4541"} | {simulate: "preset:urban-loop"} | {folder: DIR, labels: DIR}, ...]
-///   validation: [...]
-/// Relative paths are relative to the recipe file.
-struct DataRecipe {
-  std::vector<GraphSourceSpec> train, validation;
-};
-/// Throws InputError naming the file for a missing file, bad YAML or a bad entry.
-DataRecipe read_data_recipe(const std::filesystem::path& file);
-nlohmann::json recipe_to_json(const DataRecipe& recipe);
 
 /// The graphs of one sequence and where each scan was taken (LiDAR position
 /// in the sequence's world frame).
@@ -69,7 +40,7 @@ struct GraphSequence {
 /// is stored there as <name>.json and reused when the source and the graph
 /// recipe are unchanged. InputError for missing poses, labels or calibration.
 /// Stops early (returning what it has, marked incomplete) on stop_requested().
-GraphSequence build_graph_sequence(const GraphSourceSpec& spec, const GraphBuilderConfig& graph_config,
+GraphSequence build_graph_sequence(const SourceSpec& spec, const GraphBuilderConfig& graph_config,
                                    const std::optional<std::filesystem::path>& cache_dir, bool show_progress);
 
 /// One training pair of graphs of one sequence.

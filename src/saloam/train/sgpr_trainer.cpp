@@ -1,9 +1,7 @@
 #include "saloam/train/sgpr_trainer.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <fstream>
-#include <malloc.h>
 #include <numeric>
 #include <random>
 
@@ -13,9 +11,11 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/place/sgpr_network.hpp"
 #include "saloam/train/sgpr_torch.hpp"
+#include "saloam/train/training_run.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam {
@@ -42,25 +42,6 @@ std::vector<const SemanticGraph*> concat(std::span<const SemanticGraph* const> a
 
 }  // namespace
 
-void set_training_threads(int threads) { torch::set_num_threads(std::max(1, threads)); }
-
-namespace {
-
-/// A training step allocates and frees tens of tensors of several MB. With
-/// glibc's defaults each is a fresh mmap and its pages fault in anew every
-/// step (measured: about half of a step's time). Keeping freed memory in the
-/// heap for reuse halves the step time; it changes no result.
-void keep_freed_memory_for_reuse() {
-  static const bool once = [] {
-    mallopt(M_MMAP_THRESHOLD, 1 << 30);
-    mallopt(M_TRIM_THRESHOLD, 1 << 30);
-    mallopt(M_TOP_PAD, 256 << 20);
-    return true;
-  }();
-  (void)once;
-}
-
-}  // namespace
 
 SgprTrainer::SgprTrainer(std::uint64_t seed, const SgprOptimizerOptions& options) {
   keep_freed_memory_for_reuse();
@@ -169,23 +150,6 @@ EpochRecord record_from_json(const nlohmann::json& j) {
   return r;
 }
 
-void write_json(const fs::path& file, const nlohmann::json& j) {
-  fs::path partial = file;
-  partial += ".partial";
-  {
-    std::ofstream out(partial);
-    if (!out) throw InputError(partial, "cannot create file");
-    out << j.dump(2) << '\n';
-  }
-  fs::rename(partial, file);
-}
-
-/// A generator for epoch `epoch` of a run with `seed`: resuming needs no saved generator state.
-std::mt19937_64 epoch_generator(std::uint64_t seed, int epoch) {
-  std::seed_seq sequence{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                         static_cast<std::uint32_t>(epoch), 0x5a4c4fu};
-  return std::mt19937_64(sequence);
-}
 
 /// One hard negative for `anchor`: uniformly one of its `pool` highest-scoring
 /// negatives under the current model (the very hardest alone would repeat).
@@ -244,7 +208,7 @@ EpochLoss train_epoch(SgprTrainer& trainer, std::span<const GraphSequence> train
   EpochLoss result;
   const std::size_t batch = static_cast<std::size_t>(std::max(1, options.batch));
   ProgressBar progress(pairs.size(), fmt::format("epoch {}/{}", epoch, options.epochs), options.show_progress);
-  const auto start = std::chrono::steady_clock::now();
+  const StageTimer timer;
   double loss_sum = 0;
   for (std::size_t begin = 0; begin < pairs.size(); begin += batch) {
     if (stop_requested()) {
@@ -273,7 +237,7 @@ EpochLoss train_epoch(SgprTrainer& trainer, std::span<const GraphSequence> train
     progress.advance(targets.size());
   }
   progress.finish();
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.seconds = timer.elapsed_s();
   result.loss = result.pairs ? loss_sum / static_cast<double>(result.pairs) : 0.0;
   return result;
 }
@@ -298,25 +262,21 @@ void plot_curves(const fs::path& file, const SgprTrainResult& result) {
   plot.save_png(file);
 }
 
-/// What --resume needs, written into a fresh folder that then replaces
-/// checkpoint/, so an interruption never leaves a half-written checkpoint.
+/// What --resume needs.
 void write_checkpoint(const fs::path& out, const SgprTrainer& trainer, const SgprTrainResult& result,
                       const nlohmann::json& options) {
-  const fs::path partial = out / "checkpoint.partial";
-  fs::remove_all(partial);
-  create_folder(partial);
-  write_sgpr_weights(partial / "model.sgw", trainer.weights());
-  trainer.save_optimizer(partial / "optimizer.pt");
-  nlohmann::json state;
-  state["epochs_done"] = result.history.empty() ? 0 : result.history.back().epoch;
-  state["options"] = options;
-  state["initial_val_max_f1"] = result.initial_val_max_f1;
-  state["best_epoch"] = result.best_epoch;
-  state["history"] = nlohmann::json::array();
-  for (const auto& r : result.history) state["history"].push_back(record_json(r));
-  write_json(partial / "state.json", state);
-  fs::remove_all(out / "checkpoint");
-  fs::rename(partial, out / "checkpoint");
+  replace_checkpoint(out, [&](const fs::path& dir) {
+    write_sgpr_weights(dir / "model.sgw", trainer.weights());
+    trainer.save_optimizer(dir / "optimizer.pt");
+    nlohmann::json state;
+    state["epochs_done"] = result.history.empty() ? 0 : result.history.back().epoch;
+    state["options"] = options;
+    state["initial_val_max_f1"] = result.initial_val_max_f1;
+    state["best_epoch"] = result.best_epoch;
+    state["history"] = nlohmann::json::array();
+    for (const auto& r : result.history) state["history"].push_back(record_json(r));
+    write_json_atomically(dir / "state.json", state);
+  });
 }
 
 struct ResumedRun {
@@ -326,10 +286,7 @@ struct ResumedRun {
 
 ResumedRun resume_run(const fs::path& out, const nlohmann::json& options, const SgprOptimizerOptions& optimizer) {
   const fs::path dir = out / "checkpoint";
-  require_file(dir / "state.json", "checkpoint state (nothing to resume)");
-  std::ifstream in(dir / "state.json");
-  const nlohmann::json state = nlohmann::json::parse(in, nullptr, false);
-  if (state.is_discarded() || !state.contains("options")) throw InputError(dir / "state.json", "not a checkpoint state");
+  const nlohmann::json state = read_checkpoint_state(out);
   // The initial weights matter only for the first epoch: a resumed run need not name them again.
   nlohmann::json before = state["options"], now = options;
   before.erase("init");
@@ -390,7 +347,7 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
 
   const int first_epoch = result.history.empty() ? 1 : result.history.back().epoch + 1;
   for (int epoch = first_epoch; epoch <= options.epochs; ++epoch) {
-    const auto start = std::chrono::steady_clock::now();
+    const StageTimer timer;
     std::mt19937_64 rng = epoch_generator(options.seed, epoch);
     const auto pairs = epoch_pairs(trainer->weights(), train, positives, options, rng);
     const EpochLoss trained = train_epoch(*trainer, train, pairs, options, epoch, rng);
@@ -409,7 +366,7 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
     record.pairs_per_second = trained.seconds > 0 ? static_cast<double>(trained.pairs) / trained.seconds : 0.0;
     record.val_max_f1 = val.max_f1;
     record.val_recall_at_full_precision = val.recall_at_full_precision;
-    record.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    record.seconds = timer.elapsed_s();
     const bool best = val.max_f1 > best_f1(result);
     result.history.push_back(record);
     if (best) {
@@ -428,7 +385,7 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
     log["best_val_max_f1"] = best_f1(result);
     log["epochs"] = nlohmann::json::array();
     for (const auto& r : result.history) log["epochs"].push_back(record_json(r));
-    write_json(options.out / "training.json", log);
+    write_json_atomically(options.out / "training.json", log);
     plot_curves(options.out / "curves.png", result);
     if (on_epoch) on_epoch(record);
   }

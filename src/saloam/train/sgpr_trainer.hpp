@@ -63,9 +63,6 @@ class SgprTrainer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Sets libtorch's intra-op threads (fixed for reproducible results).
-void set_training_threads(int threads);
-
 struct SgprTrainOptions {
   std::filesystem::path out;   ///< output folder (checkpoints, logs, curves, graph cache)
   std::filesystem::path init;  ///< weights to fine-tune; empty = from scratch

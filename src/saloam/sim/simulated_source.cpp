@@ -1,42 +1,48 @@
-#include "saloam/runs/frame_source.hpp"
+#include "saloam/sim/simulated_source.hpp"
 
-#include <chrono>
+#include <algorithm>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
-#include "saloam/core/error.hpp"
 #include "saloam/io/scan_io.hpp"
+#include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
 
 namespace saloam {
+namespace {
 
-// ---- SequenceFolderSource ----
-
-std::optional<Pose> SequenceFolderSource::velo_to_cam() const {
-  if (!reader_.has_calib()) return std::nullopt;
-  return reader_.velo_to_cam();
-}
-
-std::optional<std::vector<Pose>> SequenceFolderSource::camera_poses() const {
-  if (!reader_.has_poses()) return std::nullopt;
-  return reader_.camera_poses();
-}
-
-std::optional<std::vector<Pose>> SequenceFolderSource::sensor_camera_poses() const {
-  const auto file = reader_.root() / "poses_sensor.txt";
-  if (!std::filesystem::exists(file)) return std::nullopt;
-  std::vector<Pose> poses = read_kitti_poses(file);
-  if (poses.size() != reader_.size()) {
-    throw InputError(file, fmt::format("{} poses for {} scans", poses.size(), reader_.size()));
+/// Where the scans were really taken, when that differs from the poses given.
+std::optional<std::vector<Pose>> moved_sensor_poses(const SimulatedSequence& sequence) {
+  const auto& given = sequence.camera_poses();
+  const auto& sensor = sequence.sensor_camera_poses();
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    if ((given[i].translation() - sensor[i].translation()).norm() > 1e-9) return sensor;
   }
-  return poses;
+  return std::nullopt;
 }
 
-// ---- SimulatedSource ----
+SourceInfo simulated_info(const SimulatedSequence& sequence) {
+  const auto& o = sequence.options();
+  SourceInfo info;
+  info.name = o.camera_poses.empty() ? fmt::format("simulated '{}' route", o.preset) : "simulated trajectory";
+  info.times = sequence.times();
+  info.has_labels = true;
+  info.rereadable = false;
+  info.velo_to_cam = sequence.velo_to_cam();
+  info.camera_poses = sequence.camera_poses();
+  info.sensor_camera_poses = moved_sensor_poses(sequence);
+  return info;
+}
+
+}  // namespace
 
 SimulatedSource::SimulatedSource(const SimulatedSequence& sequence, std::size_t lookahead,
                                  std::optional<std::filesystem::path> keep_folder)
-    : sequence_(sequence), lookahead_(std::max<std::size_t>(lookahead, 1)), keep_folder_(std::move(keep_folder)) {
+    : sequence_(sequence),
+      info_(simulated_info(sequence)),
+      lookahead_(std::max<std::size_t>(lookahead, 1)),
+      keep_folder_(std::move(keep_folder)) {
   if (keep_folder_) {
     const SequenceWriter writer(*keep_folder_);
     writer.write_calib(sequence_.velo_to_cam());
@@ -61,20 +67,6 @@ SimulatedSource::~SimulatedSource() {
       // A destructor must not throw; the folder then keeps all poses (still readable).
     }
   }
-}
-
-std::string SimulatedSource::name() const {
-  const auto& o = sequence_.options();
-  return o.camera_poses.empty() ? fmt::format("simulated '{}' route", o.preset) : "simulated trajectory";
-}
-
-std::optional<std::vector<Pose>> SimulatedSource::sensor_camera_poses() const {
-  const auto& given = sequence_.camera_poses();
-  const auto& sensor = sequence_.sensor_camera_poses();
-  for (std::size_t i = 0; i < given.size(); ++i) {
-    if ((given[i].translation() - sensor[i].translation()).norm() > 1e-9) return sensor;
-  }
-  return std::nullopt;
 }
 
 void SimulatedSource::render_ahead() {
@@ -108,12 +100,12 @@ void SimulatedSource::render_ahead() {
 LabelledCloud SimulatedSource::scan(std::size_t i) {
   std::unique_lock lock(mutex_);
   if (i != next_) {
-    throw std::logic_error(fmt::format("{}: frame {} asked for, but a stream serves frame {} next", name(), i, next_));
+    throw std::logic_error(fmt::format("{}: frame {} asked for, but a stream serves frame {} next", info_.name, i, next_));
   }
   frame_ready_.wait(lock, [&] { return !queue_.empty() || stopping_; });
   if (queue_.empty()) {
     if (error_) std::rethrow_exception(error_);
-    throw std::runtime_error(fmt::format("{}: the simulation stopped before frame {}", name(), i));
+    throw std::runtime_error(fmt::format("{}: the simulation stopped before frame {}", info_.name, i));
   }
   LabelledCloud cloud = std::move(queue_.front());
   queue_.pop_front();
@@ -150,7 +142,7 @@ void SimulatedSource::finish_kept_folder(std::size_t frames) const {
     writer.write_camera_poses(first(sequence_.camera_poses()));
     writer.write_times(first(sequence_.times()));
   }
-  if (sensor_camera_poses()) write_kitti_poses(*keep_folder_ / "poses_sensor.txt", first(sequence_.sensor_camera_poses()));
+  if (info_.sensor_camera_poses) write_kitti_poses(*keep_folder_ / "poses_sensor.txt", first(sequence_.sensor_camera_poses()));
 }
 
 }  // namespace saloam

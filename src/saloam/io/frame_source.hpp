@@ -1,0 +1,100 @@
+#pragma once
+// Where a run's frames come from. Every run (odometry, SLAM, place
+// evaluation, bench, demo) reads its frames through one FrameSource: a
+// reader of recorded data (SequenceFolderSource: a SemanticKITTI folder), the
+// simulator rendering in memory (SimulatedSource, sim/), or a stage that
+// wraps another source and changes what it serves (FrameRangeSource below).
+// Runs see only this interface; sources/open_source.hpp picks the reader for
+// a path and puts the stages in front of it.
+//
+// What every source promises:
+//  - info() is known before the first scan and does not change;
+//  - frames are numbered 0 .. size()-1, and info().times holds one
+//    increasing timestamp [s] per frame (the number of frames is its size);
+//  - scan(i) is frame i in its sensor (LiDAR) frame; its points carry classes
+//    (cloud.has_labels) exactly when info().has_labels;
+//  - a rereadable source serves any frame, any number of times, in any
+//    order; a stream (rereadable false) serves frames 0, 1, 2, ... once
+//    each, in that order (std::logic_error otherwise);
+//  - velo_to_cam, camera_poses and sensor_camera_poses are there when known;
+//    pose lists hold one pose per frame, in the KITTI camera convention of
+//    poses.txt (P_i = Tr Q_i Tr^-1), not re-based.
+//
+// A stage (decorator) owns the source it wraps, starts from a copy of its
+// info and changes what it changes: FrameRangeSource the frames, times,
+// poses and first_frame; a segmentation stage would set has_labels and serve
+// scans with predicted labels.
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "saloam/core/frame_range.hpp"
+#include "saloam/core/profiling.hpp"
+#include "saloam/core/types.hpp"
+
+namespace saloam {
+
+/// What a source holds, known before its first scan.
+struct SourceInfo {
+  std::string name;            ///< for messages: the folder, or what is simulated
+  std::vector<double> times;   ///< [s] one per frame, increasing
+  bool has_labels = false;     ///< scans carry per-point classes
+  bool rereadable = true;      ///< false: a stream (see above)
+  std::optional<Pose> velo_to_cam;                ///< Tr, velodyne to camera 0, when known
+  std::optional<std::vector<Pose>> camera_poses;  ///< ground truth (poses.txt), when known
+  /// Where the scans were really taken, when that differs from camera_poses
+  /// (a simulated sequence whose given heights did not fit its ground).
+  std::optional<std::vector<Pose>> sensor_camera_poses;
+  /// The sequence folder the scans are read from, if any: a run never writes
+  /// its results there, and outputs refer back to it (the viewer reads the scans).
+  std::optional<std::filesystem::path> folder;
+  /// Frame i is the folder's (or the recording's) frame first_frame + i (after `--frames A:B`: A).
+  std::size_t first_frame = 0;
+
+  [[nodiscard]] std::size_t size() const { return times.size(); }
+};
+
+/// The time a stage spent on each frame it served (in the order served),
+/// for timing reports.
+struct SourceStageTimes {
+  std::string name;                 ///< e.g. "segmentation"
+  std::vector<StageTime> per_frame;
+};
+
+class FrameSource {
+ public:
+  virtual ~FrameSource() = default;
+  [[nodiscard]] virtual const SourceInfo& info() const = 0;
+  /// Frame i < size(), as promised above.
+  virtual LabelledCloud scan(std::size_t i) = 0;
+  /// The times of the stages that prepared the frames served so far (a
+  /// stage adds its own to those of the source it wraps); none for a reader.
+  [[nodiscard]] virtual std::vector<SourceStageTimes> stage_times() const { return {}; }
+
+  [[nodiscard]] std::size_t size() const { return info().size(); }
+};
+
+/// Frames [first, end) of another source, numbered from 0: the stage behind
+/// `--frames A:B`. Over a stream, the frames before `first` are read and
+/// dropped when the first frame is asked for.
+class FrameRangeSource final : public FrameSource {
+ public:
+  /// ConfigError when the range holds no frame of `inner`.
+  FrameRangeSource(std::unique_ptr<FrameSource> inner, const FrameRange& range);
+
+  [[nodiscard]] const SourceInfo& info() const override { return info_; }
+  LabelledCloud scan(std::size_t i) override;
+  [[nodiscard]] std::vector<SourceStageTimes> stage_times() const override { return inner_->stage_times(); }
+
+ private:
+  std::unique_ptr<FrameSource> inner_;
+  std::size_t first_ = 0;
+  std::size_t dropped_ = 0;  ///< a stream's frames before first_ read so far
+  SourceInfo info_;
+};
+
+}  // namespace saloam

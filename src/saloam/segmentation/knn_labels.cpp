@@ -1,0 +1,137 @@
+#include "saloam/segmentation/knn_labels.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+namespace saloam {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// 1 - g(offset) for every window position, row-major (RangeNet++'s weights:
+/// g is the unnormalised 2D Gaussian density 1 / (2 pi s^2) exp(-d^2 / (2 s^2))).
+std::vector<float> inverse_gaussian(int window, double sigma) {
+  std::vector<float> w(static_cast<std::size_t>(window * window));
+  const double mean = 0.5 * (window - 1), variance = sigma * sigma;
+  for (int dy = 0; dy < window; ++dy)
+    for (int dx = 0; dx < window; ++dx) {
+      const double d2 = (dx - mean) * (dx - mean) + (dy - mean) * (dy - mean);
+      w[static_cast<std::size_t>(dy * window + dx)] =
+          static_cast<float>(1.0 - std::exp(-d2 / (2 * variance)) / (2 * kPi * variance));
+    }
+  return w;
+}
+
+struct Candidate {
+  float distance;
+  std::int16_t label;
+};
+
+}  // namespace
+
+std::vector<float> point_ranges(const LabelledCloud& cloud) {
+  std::vector<float> r(cloud.size());
+  std::transform(cloud.points.begin(), cloud.points.end(), r.begin(), [](const Eigen::Vector3f& p) { return p.norm(); });
+  return r;
+}
+
+namespace {
+
+constexpr int kMaxWindow = 15;
+
+/// The pixels of the window around one point: its rows (clipped to the
+/// image) and its columns (wrapped around in azimuth).
+struct Window {
+  int first_row = 0, last_row = 0;
+  std::array<int, kMaxWindow> cols{};
+  int half = 0;
+};
+
+Window window_at(const RangeImage& image, int row, int col, int half) {
+  Window w;
+  w.half = half;
+  w.first_row = std::max(row - half, 0);
+  w.last_row = std::min(row + half, image.rows - 1);
+  for (int dx = -half; dx <= half; ++dx) w.cols[static_cast<std::size_t>(dx + half)] = (col + dx + image.cols) % image.cols;
+  return w;
+}
+
+/// True when every pixel with a point in the window shows `label`: then
+/// every vote goes to it (the point's own pixel always votes).
+bool uniform_window(const RangeImage& image, const std::vector<std::int16_t>& pixel_class, const Window& w,
+                    std::int16_t label) {
+  for (int y = w.first_row; y <= w.last_row; ++y) {
+    const std::size_t row_start = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.cols);
+    for (int j = 0; j <= 2 * w.half; ++j) {
+      const std::size_t p = row_start + static_cast<std::size_t>(w.cols[static_cast<std::size_t>(j)]);
+      if (pixel_class[p] != label && image.range[p] >= 0) return false;
+    }
+  }
+  return true;
+}
+
+/// The k candidates of smallest distance, kept sorted by insertion (k is small).
+class NearestK {
+ public:
+  explicit NearestK(std::size_t k) : k_(std::min<std::size_t>(k, kMaxWindow * kMaxWindow)) {}
+  void offer(float distance, std::int16_t label) {
+    if (n_ == k_ && !(distance < best_[n_ - 1].distance)) return;
+    std::size_t j = n_ < k_ ? n_++ : n_ - 1;
+    for (; j > 0 && distance < best_[j - 1].distance; --j) best_[j] = best_[j - 1];
+    best_[j] = {distance, label};
+  }
+  [[nodiscard]] std::size_t size() const { return n_; }
+  [[nodiscard]] const Candidate& operator[](std::size_t j) const { return best_[j]; }
+
+ private:
+  std::size_t k_, n_ = 0;
+  std::array<Candidate, kMaxWindow * kMaxWindow> best_{};
+};
+
+}  // namespace
+
+std::vector<std::int16_t> point_classes(const RangeImage& image, const std::vector<std::int16_t>& pixel_class,
+                                        const std::vector<float>& point_range, int classes,
+                                        const KnnOptions& options) {
+  const int half = std::min(options.window, kMaxWindow) / 2;
+  const int side = 2 * half + 1;
+  const std::vector<float> weight = inverse_gaussian(side, options.sigma);
+  const auto cutoff = static_cast<float>(options.cutoff);
+  std::vector<std::int16_t> out(image.point_pixel.size(), 0);
+  std::vector<int> votes(static_cast<std::size_t>(classes));
+
+  for (std::size_t i = 0; i < image.point_pixel.size(); ++i) {
+    const std::int32_t pixel = image.point_pixel[i];
+    if (pixel < 0) continue;
+    const int row = pixel / image.cols;
+    const Window w = window_at(image, row, pixel % image.cols, half);
+    const std::int16_t own = pixel_class[static_cast<std::size_t>(pixel)];
+    if (own > 0 && own < classes && uniform_window(image, pixel_class, w, own)) {
+      out[i] = own;
+      continue;
+    }
+    // The point's own pixel votes at distance 0; every other pixel with a
+    // point at its range difference, weighted by its offset.
+    NearestK nearest(static_cast<std::size_t>(std::max(options.k, 1)));
+    const float r = point_range[i];
+    for (int y = w.first_row; y <= w.last_row; ++y)
+      for (int j = 0; j < side; ++j) {
+        const auto p = static_cast<std::size_t>(y * image.cols + w.cols[static_cast<std::size_t>(j)]);
+        const bool self = static_cast<std::int32_t>(p) == pixel;
+        if (!self && image.range[p] < 0) continue;
+        const float wt = weight[static_cast<std::size_t>((y - row + half) * side + j)];
+        nearest.offer(self ? 0.0f : std::abs(image.range[p] - r) * wt, pixel_class[p]);
+      }
+    std::fill(votes.begin(), votes.end(), 0);
+    for (std::size_t j = 0; j < nearest.size(); ++j)
+      if (nearest[j].distance <= cutoff && nearest[j].label > 0 && nearest[j].label < classes)
+        ++votes[static_cast<std::size_t>(nearest[j].label)];
+    const auto best = std::max_element(votes.begin() + 1, votes.end());
+    out[i] = *best > 0 ? static_cast<std::int16_t>(best - votes.begin()) : own;
+  }
+  return out;
+}
+
+}  // namespace saloam

@@ -1,0 +1,73 @@
+#pragma once
+// The first box of the paper's Fig. 2: raw point cloud P -> semantic cloud S.
+// A Segmenter labels a scan with a range-image network: project the scan
+// (range_projection.hpp), classify every pixel (the network, in the libtorch
+// plugin: network_runner.hpp), carry the classes back to every point with
+// the k-nearest-neighbour vote (knn_labels.hpp), and name them as
+// SemanticKITTI raw class ids.
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "saloam/core/config.hpp"
+#include "saloam/core/types.hpp"
+#include "saloam/segmentation/segmenter_spec.hpp"
+
+namespace saloam {
+
+/// File name of the plugin that runs the networks (built only with libtorch).
+inline constexpr const char* kSegmentationPlugin = "libsaloam_segment_torch.so";
+
+/// Loads the network plugin at `plugin` once per process (later calls reuse
+/// it). InputError naming the file when it is missing (this saloam was built
+/// without libtorch) or cannot be loaded.
+void load_segmentation_plugin(const std::filesystem::path& plugin);
+
+class Segmenter {
+ public:
+  /// Opens the network of `spec` in the plugin at `plugin`. `rings` says how
+  /// rings are recovered for ring projections (the run's feature settings:
+  /// beams, sweep direction). InputError naming the file for a missing or
+  /// corrupt network or one that does not fit the description.
+  Segmenter(SegmenterSpec spec, const std::filesystem::path& plugin, FeatureConfig rings = {});
+  /// With a network already open (the trainer's, in-process).
+  Segmenter(SegmenterSpec spec, std::unique_ptr<NetworkRunner> runner, FeatureConfig rings = {});
+  ~Segmenter();
+  Segmenter(const Segmenter&) = delete;
+  Segmenter& operator=(const Segmenter&) = delete;
+
+  /// Raw SemanticKITTI class id of every point. One call at a time per
+  /// Segmenter; the result does not depend on how many Segmenters run at
+  /// once. InputError naming the model when the scan does not fit it (beam
+  /// count, or a network that rejects the image).
+  [[nodiscard]] std::vector<std::uint16_t> labels(const LabelledCloud& cloud) const;
+  /// The network's class index (0 .. classes - 1, spec().classes names
+  /// them) of every point, with the rings already known (ring projections).
+  [[nodiscard]] std::vector<std::int16_t> output_classes(const LabelledCloud& cloud, const std::vector<std::int16_t>& rings,
+                                                         int beams) const;
+
+  [[nodiscard]] const SegmenterSpec& spec() const { return spec_; }
+
+ private:
+  void check_beams(int beams) const;
+
+  SegmenterSpec spec_;
+  FeatureConfig ring_config_;
+  std::unique_ptr<NetworkRunner> runner_;
+};
+
+/// Ring of every point (-1 for none) and the sensor's number of rings: rings
+/// recovered as the odometry recovers them (odometry/features.hpp:
+/// scan_rings), numbered from the top; when fewer rings returned points than
+/// the sensor has (config.num_beams, else the smallest of 16, 32, 64, 128
+/// that holds them), the empty ones are placed by the elevation gaps between
+/// the rings found, or above the top one.
+struct PointRings {
+  std::vector<std::int16_t> ring;
+  int beams = 0;
+};
+PointRings point_rings(const LabelledCloud& cloud, const FeatureConfig& config);
+
+}  // namespace saloam

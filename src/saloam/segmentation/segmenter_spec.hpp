@@ -1,0 +1,63 @@
+#pragma once
+// The description of a segmentation model (a YAML file beside its weights):
+// which network, the projection it was trained with, its classes and the
+// clean-up of its output. saloam's own models and networks trained
+// elsewhere (RangeNet++, SalsaNext, Cylinder3D exported to TorchScript) are
+// described the same way; docs/segmentation.md explains every key.
+//
+//   format: saloam-segmenter 1
+//   network: {type: segnet | torchscript, file: WEIGHTS,
+//             widths: [16, 32, 64], stem_stride: 4, context_blocks: 2}   # segnet only
+//   projection:
+//     rows: ring | N            # ring: one row per beam; N: rows by elevation
+//     beams: [16, 32, 64]       # rows: ring: the beam counts the model accepts
+//     fov_up_deg: 3.0           # rows: N only (RangeNet++: 3 / -25)
+//     fov_down_deg: -25.0
+//     columns: 2048
+//     channels: [range, x, y, z, remission, mask]
+//     means: [...]              # one per channel
+//     stds: [...]               # one per channel, > 0
+//   classes: semantickitti | [unlabeled, car, ...]   # output index -> class name
+//   knn: {k: 5, window: 5, cutoff: 1.0, sigma: 1.0}
+//
+// Every value is range-checked; an error names the file and the key.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "saloam/segmentation/knn_labels.hpp"
+#include "saloam/segmentation/network_runner.hpp"
+#include "saloam/segmentation/range_projection.hpp"
+
+namespace saloam {
+
+inline constexpr std::string_view kSegmenterFormat = "saloam-segmenter 1";
+
+struct SegmenterSpec {
+  std::filesystem::path file;       ///< the description this came from (for messages)
+  NetworkSpec network;              ///< weights: an absolute path
+  ProjectionSpec projection;
+  std::vector<int> beams;           ///< RowMode::kRing: the beam counts (image rows) the model accepts
+  std::vector<std::uint16_t> classes;  ///< network output index -> raw SemanticKITTI id
+  KnnOptions knn;
+};
+
+/// The 20 SemanticKITTI training classes in their learning order (0 =
+/// unlabeled, 1 = car, ..., 19 = traffic-sign), as RangeNet++ and SalsaNext output them.
+std::vector<std::uint16_t> semantickitti_learning_classes();
+
+/// Reads and checks a model description; relative weight paths are relative
+/// to the file. InputError naming the file and the key for anything wrong.
+/// The weights file itself is not opened here.
+SegmenterSpec read_segmenter_spec(const std::filesystem::path& file);
+/// The same from text (`origin` names it in errors, and relative paths are
+/// relative to origin's folder).
+SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const std::filesystem::path& origin);
+/// The description as YAML; the weights path is written relative to `folder`
+/// when it lies there.
+std::string segmenter_spec_yaml(const SegmenterSpec& spec, const std::filesystem::path& folder);
+
+}  // namespace saloam
