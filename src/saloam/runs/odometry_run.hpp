@@ -65,6 +65,11 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
                                const OdometryRunOptions& options = {});
 
 /// timing.json: frames, Hz (median, worst frame) and mean/median/max per stage.
-void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings);
+/// The warning of a semantic run over a source without labels, naming --segment, --labels and --no-semantics.
+void warn_no_labels(const SourceInfo& info);
+
+/// timing.json, with the source's stages (e.g. segmentation) beside the odometry's.
+void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings,
+                       const std::vector<SourceStageTimes>& source_stages = {});
 
 }  // namespace saloam
