@@ -78,20 +78,19 @@ TEST(SimulatedSequence, DriftStaysSmall) {
 }
 
 // Edge features that move with the sensor (poles' and trunks' near sides,
-// rough ground) shorten every route (issue #25). 300 frames of the urban
-// loop with emulated network labels, measured: forward scale bias -0.005 %,
-// t_err 0.029 % (label-agnostic 0.133 %). With pole and trunk returns as
-// edges and ground edges (ground_edge_alpha 1): -0.043 %; ground edges alone
-// back: -0.038 %; the returns alone back: -0.016 % (within this bound: the
-// axes have their own tests, ThinObjectAxis).
+// rough ground) shorten every route (issue #25). 200 frames of the urban
+// loop with emulated network labels, measured: forward scale bias -0.009 %,
+// t_err 0.032 % (label-agnostic 0.133 %). With pole and trunk returns as
+// edges and ground edges (ground_edge_alpha 1): -0.051 %; ground edges alone
+// back: -0.024 %; the returns alone back: -0.061 %.
 TEST(SimulatedSequence, NoScaleBiasAlongTheUrbanLoop) {
   testing::TempDir dir("saloam_odom_bias");
   SimulationOptions options;
   options.preset = "urban-loop";
-  options.end_frame = 300;
+  options.end_frame = 200;
   options.labels = LabelMode::kNoisy;
   options.show_progress = false;
-  ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 300u);
+  ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 200u);
   const SequenceReader reader(dir.path());
   SemanticOdometry odometry{OdometryConfig{}};
   register_all(odometry, reader);
@@ -100,8 +99,8 @@ TEST(SimulatedSequence, NoScaleBiasAlongTheUrbanLoop) {
   std::printf("semantic: t_err %.4f %%, forward / lateral / vertical bias %+.4f / %+.4f / %+.4f %%\n",
               semantic.kitti.t_err_percent, semantic.bias.forward_percent, semantic.bias.lateral_percent,
               semantic.bias.vertical_percent);
-  ASSERT_GT(semantic.gt_length_m, 300.0);
-  EXPECT_LT(std::abs(semantic.bias.forward_percent), 0.025);
+  ASSERT_GT(semantic.gt_length_m, 200.0);
+  EXPECT_LT(std::abs(semantic.bias.forward_percent), 0.02);
 
   OdometryConfig agnostic_config;
   agnostic_config.use_semantics = false;
