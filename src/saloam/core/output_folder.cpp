@@ -1,0 +1,224 @@
+#include "saloam/core/output_folder.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace saloam {
+namespace {
+
+// A record longer than this is not one of ours: it is not read.
+constexpr std::size_t kMaxRecordBytes = 16u << 20;
+// Temporaries of killed runs are looked for this deep (OUT/slam/x, OUT/sequence/velodyne/x).
+constexpr int kPartialSearchDepth = 2;
+
+std::mutex& registry_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+std::vector<OutputFolder*>& registry() {
+  static std::vector<OutputFolder*> folders;
+  return folders;
+}
+
+// The folder itself, with its links resolved, for comparing paths.
+fs::path resolved(const fs::path& path) {
+  std::error_code ec;
+  fs::path out = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  return ec ? fs::absolute(path, ec).lexically_normal() : out;
+}
+
+// `path` relative to `root` when it lies inside it (both resolved); empty otherwise.
+fs::path inside(const fs::path& path, const fs::path& root) {
+  const auto [r, p] = std::mismatch(root.begin(), root.end(), path.begin(), path.end());
+  if (r != root.end() || p == path.end()) return {};
+  fs::path relative;
+  for (auto it = p; it != path.end(); ++it) relative /= *it;
+  return relative;
+}
+
+std::string read_record(int fd) {
+  std::string text;
+  char buffer[4096];
+  for (off_t offset = 0; text.size() < kMaxRecordBytes;) {
+    const ssize_t n = ::pread(fd, buffer, sizeof buffer, offset);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    text.append(buffer, static_cast<std::size_t>(n));
+    offset += n;
+  }
+  return text;
+}
+
+// The value of the first "KEY value" line of a record, or "".
+std::string record_value(const std::string& record, std::string_view key) {
+  std::istringstream lines(record);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.starts_with(key) && line.size() > key.size() && line[key.size()] == ' ') return line.substr(key.size() + 1);
+  }
+  return "";
+}
+
+// A name a record may list: relative, inside the folder, one line.
+bool listable(const fs::path& name) {
+  if (name.empty() || name.is_absolute()) return false;
+  const std::string text = name.string();
+  if (text.find('\n') != std::string::npos || text == std::string(OutputFolder::kRecordName)) return false;
+  return std::none_of(name.begin(), name.end(), [](const fs::path& part) { return part == ".." || part == "."; });
+}
+
+std::vector<std::string> listed_files(const std::string& record) {
+  std::vector<std::string> files;
+  std::istringstream lines(record);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.starts_with("file ") && listable(line.substr(5))) files.push_back(line.substr(5));
+  }
+  return files;
+}
+
+// Removes `file` (a file or a link, never a folder) when it exists.
+void remove_output(const fs::path& file) {
+  std::error_code ec;
+  const auto type = fs::symlink_status(file, ec).type();
+  if (type != fs::file_type::regular && type != fs::file_type::symlink) return;
+  if (!fs::remove(file, ec) && ec) {
+    throw InputError(file, fmt::format("cannot remove this output of an earlier run: {}", ec.message()));
+  }
+}
+
+void remove_partials(const fs::path& dir) {
+  std::error_code ec;
+  fs::recursive_directory_iterator it(dir, ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    if (it.depth() >= kPartialSearchDepth) it.disable_recursion_pending();
+    if (is_partial_output_name(it->path().filename().string())) remove_output(it->path());
+  }
+}
+
+}  // namespace
+
+OutputFolder::OutputFolder(fs::path dir, std::string command, const std::vector<std::string>& own_names)
+    : OutputFolder(std::move(dir), std::move(command), own_names, Mode::kNewRun) {}
+
+OutputFolder OutputFolder::join(fs::path dir, std::string command) {
+  return OutputFolder(std::move(dir), std::move(command), {}, Mode::kJoin);
+}
+
+OutputFolder::OutputFolder(fs::path dir, std::string command, const std::vector<std::string>& own_names, Mode mode)
+    : dir_(std::move(dir)), command_(std::move(command)), joined_(mode == Mode::kJoin) {
+  create_folder(dir_);
+  absolute_ = resolved(dir_);
+  lock(mode);
+  if (mode == Mode::kNewRun) {
+    std::vector<std::string> earlier = listed_files(read_record(fd_));
+    earlier.insert(earlier.end(), own_names.begin(), own_names.end());
+    try {
+      for (const auto& name : earlier) remove_output(dir_ / name);
+      remove_partials(dir_);
+    } catch (...) {
+      ::close(fd_);
+      throw;
+    }
+    if (::ftruncate(fd_, 0) != 0) {
+      ::close(fd_);
+      throw InputError(dir_ / kRecordName, fmt::format("cannot start the run's record: {}", std::strerror(errno)));
+    }
+    append(fmt::format("saloam-run 1\ncommand {}\npid {}\n", command_, ::getpid()));
+  }
+  const std::lock_guard lock(registry_mutex());
+  registry().push_back(this);
+}
+
+void OutputFolder::lock(Mode mode) {
+  const fs::path record = dir_ / kRecordName;
+  fd_ = ::open(record.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0666);
+  if (fd_ < 0) throw InputError(dir_, fmt::format("cannot write in this folder: {}", std::strerror(errno)));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
+  const std::string other = read_record(fd_);
+  ::close(fd_);
+  fd_ = -1;
+  const std::string who = record_value(other, "command");
+  throw InputError(dir_, fmt::format("another saloam run ({}, process {}) is writing this folder; wait for it to end "
+                                     "or {} another folder",
+                                     who.empty() ? "starting" : who, record_value(other, "pid"),
+                                     mode == Mode::kJoin ? "write to" : "choose"));
+}
+
+OutputFolder::~OutputFolder() {
+  {
+    const std::lock_guard lock(registry_mutex());
+    std::erase(registry(), this);
+  }
+  if (fd_ < 0) return;
+  if (!finished_ && !joined_) {
+    try {
+      append("end failed\n");
+    } catch (...) {  // a destructor does not throw; the record then ends without a state
+    }
+  }
+  ::close(fd_);  // releases the lock
+}
+
+std::vector<std::string> OutputFolder::files() const {
+  const std::lock_guard lock(mutex_);
+  return files_;
+}
+
+bool OutputFolder::wrote(std::string_view name) const {
+  const std::lock_guard lock(mutex_);
+  return std::find(files_.begin(), files_.end(), name) != files_.end();
+}
+
+void OutputFolder::finish(std::string_view state) {
+  append(fmt::format("end {}\n", state));
+  finished_ = true;
+}
+
+void OutputFolder::append(const std::string& line) {
+  std::string_view rest = line;
+  while (!rest.empty()) {
+    const ssize_t n = ::write(fd_, rest.data(), rest.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      throw InputError(dir_ / kRecordName,
+                       fmt::format("cannot write the run's record: {}", n < 0 ? std::strerror(errno) : "short write"));
+    }
+    rest.remove_prefix(static_cast<std::size_t>(n));
+  }
+}
+
+void record_output(const fs::path& file) {
+  const fs::path path = resolved(file.parent_path().empty() ? fs::path(".") : file.parent_path()) / file.filename();
+  const std::lock_guard lock(registry_mutex());
+  for (OutputFolder* folder : registry()) {
+    const fs::path relative = inside(path, folder->absolute_);
+    if (!listable(relative)) continue;
+    const std::lock_guard files_lock(folder->mutex_);
+    if (std::find(folder->files_.begin(), folder->files_.end(), relative.string()) != folder->files_.end()) continue;
+    folder->files_.push_back(relative.string());
+    folder->append(fmt::format("file {}\n", relative.string()));
+  }
+}
+
+std::vector<std::string> recorded_outputs(const fs::path& dir) {
+  const int fd = ::open((dir / OutputFolder::kRecordName).c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return {};
+  const std::string record = read_record(fd);
+  ::close(fd);
+  return listed_files(record);
+}
+
+}  // namespace saloam
