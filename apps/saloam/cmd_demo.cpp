@@ -19,9 +19,11 @@
 #include "saloam/core/files.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_folder.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/runs/odometry_run.hpp"
+#include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
 #include "saloam/sim/simulated_source.hpp"
@@ -50,6 +52,10 @@ struct DemoOptions {
   bool baseline = true;
   ConfigOptions config;
 };
+
+/// What the demo writes into OUT itself (OUT/slam and OUT/sequence keep records of their own).
+const std::vector<std::string> kDemoOutputs{"eval_baseline.json", "eval_baseline.png", "odometry_baseline/poses.txt",
+                                            "odometry_baseline/poses_tum.txt"};
 
 void heading(const std::string& text) { std::cout << "\n== " << text << " ==\n" << std::flush; }
 
@@ -102,10 +108,11 @@ void print_summary(const SlamRunResult& slam, const std::optional<TrajectoryEval
   }
 }
 
-/// The 3D view of the run (as `saloam view OUT/slam`). A streamed sequence
-/// is not on disk: its ground truth comes from the simulation, and the scans
-/// the page embeds are rendered again.
-void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequence* streamed) {
+/// The 3D view of the run (as `saloam view OUT/slam`), added to the run's
+/// summary. A streamed sequence is not on disk: its ground truth comes from
+/// the simulation, and the scans the page embeds are rendered again.
+void write_view_page(OutputFolder& run_folder, const SimulatedSequence* streamed) {
+  const std::filesystem::path& run_dir = run_folder.path();
   ViewerOptions options;
   if (streamed) {
     const Pose tr = streamed->velo_to_cam();
@@ -116,6 +123,7 @@ void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequen
   }
   try {
     const ViewerPageStats s = write_viewer_page(run_dir, run_dir / "view.html", options);
+    update_run_summary(run_folder);
     std::cout << fmt::format("3D view: {} ({:.1f} MB; open it in a browser)\n", (run_dir / "view.html").string(),
                              static_cast<double>(s.bytes) / 1e6);
   } catch (const InputError& e) {
@@ -128,6 +136,7 @@ void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequen
 /// only with --keep-sequence), or with --reuse the sequence kept earlier.
 struct DemoSource {
   std::unique_ptr<SimulatedSequence> simulated;  ///< none when read from disk
+  std::unique_ptr<OutputFolder> kept;            ///< OUT/sequence while --keep-sequence writes it
   std::unique_ptr<FrameSource> frames;           ///< declared last: destroyed first (it streams `simulated`)
 };
 
@@ -140,6 +149,7 @@ DemoSource open_demo_source(const DemoOptions& options, const std::filesystem::p
   std::filesystem::remove_all(sequence_dir);
   source.simulated = std::make_unique<SimulatedSequence>(simulation_options(options));
   const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
+  if (keep) source.kept = std::make_unique<OutputFolder>(sequence_dir, "simulate");
   source.frames = add_stages(std::make_unique<SimulatedSource>(*source.simulated, 16, keep), {});
   return source;
 }
@@ -171,6 +181,7 @@ int run_demo(const DemoOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
   const std::filesystem::path out(options.out);
+  OutputFolder folder(out, "demo", kDemoOutputs);
   const std::filesystem::path sequence_dir = out / "sequence";
   const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
 
@@ -194,16 +205,23 @@ int run_demo(const DemoOptions& options) {
     if (baseline) baseline->add(scan, t);
     if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
   };
-  const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), out / "slam", run_options);
-  if (slam.interrupted) return 130;
+  OutputFolder slam_folder = open_slam_folder(out / "slam", info);
+  const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), slam_folder, run_options);
+  if (baseline) baseline->commit();
+  if (slam.interrupted) {
+    folder.finish("interrupted");
+    return 130;
+  }
   source.frames.reset();  // stops the simulator's thread; finishes the kept sequence folder
+  if (source.kept) source.kept->finish("complete");
 
   std::optional<TrajectoryEvaluation> baseline_eval;
   if (baseline && info.camera_poses) baseline_eval = evaluate_baseline(out, *info.camera_poses, baseline->result().output_poses);
   heading("2/2 summary");
   print_summary(slam, baseline_eval);
   print_outputs(slam, timer.elapsed_s(), out);
-  write_view_page(out / "slam", source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
+  write_view_page(slam_folder, source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
+  folder.finish("complete");
   return 0;
 }
 

@@ -1,11 +1,13 @@
 #include "saloam/core/output_folder.hpp"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <sstream>
 
@@ -80,6 +82,23 @@ bool listable(const fs::path& name) {
   return std::none_of(name.begin(), name.end(), [](const fs::path& part) { return part == ".." || part == "."; });
 }
 
+// "COMMAND, process PID" of the run holding the lock on `fd`. Its record may
+// still be the previous run's for a moment after it took the lock: read
+// again until it names a live process.
+std::string lock_holder(int fd) {
+  std::string command, pid;
+  for (int attempt = 0; attempt < 20; ++attempt) {
+    const std::string record = read_record(fd);
+    command = record_value(record, "command");
+    pid = record_value(record, "pid");
+    const long number = std::strtol(pid.c_str(), nullptr, 10);
+    if (number > 0 && ::kill(static_cast<pid_t>(number), 0) == 0) break;
+    ::usleep(25000);
+  }
+  if (command.empty() || pid.empty()) return "a starting run";
+  return fmt::format("{}, process {}", command, pid);
+}
+
 std::vector<std::string> listed_files(const std::string& record) {
   std::vector<std::string> files;
   std::istringstream lines(record);
@@ -132,11 +151,7 @@ OutputFolder::OutputFolder(fs::path dir, std::string command, const std::vector<
       ::close(fd_);
       throw;
     }
-    if (::ftruncate(fd_, 0) != 0) {
-      ::close(fd_);
-      throw InputError(dir_ / kRecordName, fmt::format("cannot start the run's record: {}", std::strerror(errno)));
-    }
-    append(fmt::format("saloam-run 1\ncommand {}\npid {}\n", command_, ::getpid()));
+    start_record();
   }
   const std::lock_guard lock(registry_mutex());
   registry().push_back(this);
@@ -144,17 +159,31 @@ OutputFolder::OutputFolder(fs::path dir, std::string command, const std::vector<
 
 void OutputFolder::lock(Mode mode) {
   const fs::path record = dir_ / kRecordName;
-  fd_ = ::open(record.c_str(), O_RDWR | O_CREAT | O_APPEND | O_CLOEXEC | O_NOFOLLOW, 0666);
+  fd_ = ::open(record.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0666);
   if (fd_ < 0) throw InputError(dir_, fmt::format("cannot write in this folder: {}", std::strerror(errno)));
-  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) return;
-  const std::string other = read_record(fd_);
+  if (::flock(fd_, LOCK_EX | LOCK_NB) == 0) {
+    offset_ = static_cast<std::size_t>(std::max<off_t>(::lseek(fd_, 0, SEEK_END), 0));
+    return;
+  }
+  const std::string holder = lock_holder(fd_);
   ::close(fd_);
   fd_ = -1;
-  const std::string who = record_value(other, "command");
-  throw InputError(dir_, fmt::format("another saloam run ({}, process {}) is writing this folder; wait for it to end "
-                                     "or {} another folder",
-                                     who.empty() ? "starting" : who, record_value(other, "pid"),
-                                     mode == Mode::kJoin ? "write to" : "choose"));
+  throw InputError(dir_, fmt::format("another saloam run ({}) is writing this folder; wait for it to end or {} "
+                                     "another folder",
+                                     holder, mode == Mode::kJoin ? "write to" : "choose"));
+}
+
+// The record of the previous run is replaced by this run's header in one write.
+void OutputFolder::start_record() {
+  const std::string header = fmt::format("saloam-run 1\ncommand {}\npid {}\n", command_, ::getpid());
+  if (::pwrite(fd_, header.data(), header.size(), 0) != static_cast<ssize_t>(header.size()) ||
+      ::ftruncate(fd_, static_cast<off_t>(header.size())) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    throw InputError(dir_ / kRecordName, fmt::format("cannot start the run's record: {}", std::strerror(error)));
+  }
+  offset_ = header.size();
 }
 
 OutputFolder::~OutputFolder() {
@@ -190,27 +219,34 @@ void OutputFolder::finish(std::string_view state) {
 void OutputFolder::append(const std::string& line) {
   std::string_view rest = line;
   while (!rest.empty()) {
-    const ssize_t n = ::write(fd_, rest.data(), rest.size());
+    const ssize_t n = ::pwrite(fd_, rest.data(), rest.size(), static_cast<off_t>(offset_));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       throw InputError(dir_ / kRecordName,
                        fmt::format("cannot write the run's record: {}", n < 0 ? std::strerror(errno) : "short write"));
     }
     rest.remove_prefix(static_cast<std::size_t>(n));
+    offset_ += static_cast<std::size_t>(n);
   }
 }
 
 void record_output(const fs::path& file) {
   const fs::path path = resolved(file.parent_path().empty() ? fs::path(".") : file.parent_path()) / file.filename();
   const std::lock_guard lock(registry_mutex());
+  OutputFolder* holder = nullptr;  // the innermost folder: a run inside another run's folder keeps its own record
+  fs::path name;
   for (OutputFolder* folder : registry()) {
     const fs::path relative = inside(path, folder->absolute_);
     if (!listable(relative)) continue;
-    const std::lock_guard files_lock(folder->mutex_);
-    if (std::find(folder->files_.begin(), folder->files_.end(), relative.string()) != folder->files_.end()) continue;
-    folder->files_.push_back(relative.string());
-    folder->append(fmt::format("file {}\n", relative.string()));
+    if (holder && std::distance(relative.begin(), relative.end()) >= std::distance(name.begin(), name.end())) continue;
+    holder = folder;
+    name = relative;
   }
+  if (!holder) return;
+  const std::lock_guard files_lock(holder->mutex_);
+  if (std::find(holder->files_.begin(), holder->files_.end(), name.string()) != holder->files_.end()) return;
+  holder->files_.push_back(name.string());
+  holder->append(fmt::format("file {}\n", name.string()));
 }
 
 std::vector<std::string> recorded_outputs(const fs::path& dir) {

@@ -53,6 +53,7 @@ class OutputFolder {
   enum class Mode { kNewRun, kJoin };
   OutputFolder(std::filesystem::path dir, std::string command, const std::vector<std::string>& own_names, Mode mode);
   void lock(Mode mode);
+  void start_record();
   void append(const std::string& line);
   friend void record_output(const std::filesystem::path& file);
 
@@ -60,13 +61,15 @@ class OutputFolder {
   std::string command_;
   bool joined_ = false;
   int fd_ = -1;
+  std::size_t offset_ = 0;  ///< where the record's next line goes
   bool finished_ = false;
   mutable std::mutex mutex_;
   std::vector<std::string> files_;
 };
 
-/// Called by AtomicFile::commit(): adds `file` to the record of every live
-/// OutputFolder that holds it.
+/// Called by AtomicFile::commit(): adds `file` to the record of the innermost
+/// live OutputFolder that holds it (a run writing inside another run's
+/// folder, e.g. the demo's kept sequence, keeps a record of its own).
 void record_output(const std::filesystem::path& file);
 
 /// The files that the record in `dir` lists, relative to `dir` (none without a record).

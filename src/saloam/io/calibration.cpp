@@ -11,6 +11,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/io/text_input.hpp"
 
 namespace saloam {
@@ -71,9 +72,8 @@ Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int s
 }
 
 void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
+  AtomicFile file_out(file);
+  std::ostream& out = file_out.stream();
   // KITTI odometry's rectified camera projections (sequences 00-02), so that
   // tools expecting all five lines can read the file.
   out << "P0: 7.188560000000e+02 0.000000000000e+00 6.071928000000e+02 0.000000000000e+00 0.000000000000e+00 "
@@ -91,7 +91,7 @@ void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam) {
   std::array<double, 12> v{};
   pose_to_3x4(velo_to_cam, v.data());
   out << "Tr: " << fmt::format("{:.12e}", fmt::join(v, " ")) << '\n';
-  if (!out) throw InputError(file, "write failed");
+  file_out.commit();
 }
 
 std::vector<Pose> camera_to_lidar_poses(const std::vector<Pose>& camera_poses, const Pose& velo_to_cam) {

@@ -10,6 +10,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -27,9 +28,8 @@ void put(char*& dst, T value) {
 }  // namespace
 
 void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, const Pose& transform) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
+  AtomicFile file_out(file);
+  std::ostream& out = file_out.stream();
   out << "ply\nformat binary_little_endian 1.0\ncomment saloam labelled point cloud (SemanticKITTI classes)\n"
       << "element vertex " << cloud.size() << '\n'
       << "property float x\nproperty float y\nproperty float z\n"
@@ -52,7 +52,7 @@ void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, co
     put(dst, cloud.remission[i]);
   }
   out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-  if (!out) throw InputError(file, "write failed (disk full?)");
+  file_out.commit();
 }
 
 LabelledCloud read_ply(const std::filesystem::path& file) {

@@ -9,6 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -29,11 +30,7 @@ std::vector<char> read_bytes(const std::filesystem::path& file) {
 }
 
 void write_bytes(const std::filesystem::path& file, const void* data, std::size_t size) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
-  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
-  if (!out) throw InputError(file, "write failed (disk full?)");
+  write_file_atomically(file, std::string_view(static_cast<const char*>(data), size));
 }
 
 constexpr std::size_t kPointBytes = 4 * sizeof(float);

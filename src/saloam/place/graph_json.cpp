@@ -7,6 +7,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
 
@@ -93,11 +94,7 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
 }
 
 void write_graph_json(const std::filesystem::path& file, const SemanticGraph& graph) {
-  create_parent_folder(file);
-  std::ofstream out(file);
-  if (!out) throw InputError(file, "cannot create graph file");
-  out << graph_to_json(graph).dump() << '\n';
-  if (!out) throw InputError(file, "write error");
+  write_file_atomically(file, graph_to_json(graph).dump() + '\n');
 }
 
 SemanticGraph read_graph_json(const std::filesystem::path& file) {

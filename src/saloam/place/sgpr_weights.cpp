@@ -9,6 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
 namespace {
@@ -163,16 +164,7 @@ void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& we
       if (!std::isfinite(v)) throw std::invalid_argument("SGPR tensor '" + name + "' holds a non-finite value");
   }
   const auto bytes = serialize_sgpr_weights(weights);
-  create_parent_folder(file);
-  std::filesystem::path partial = file;
-  partial += ".partial";
-  {
-    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(partial, "cannot create SGPR weights file");
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw InputError(partial, "write error");
-  }
-  std::filesystem::rename(partial, file);
+  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace saloam
