@@ -12,6 +12,7 @@
 #include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
@@ -27,6 +28,7 @@
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
 #include "saloam/sim/simulated_source.hpp"
+#include "saloam/sim/simulation_record.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sources/open_source.hpp"
 #include "saloam/viewer/viewer_page.hpp"
@@ -136,7 +138,6 @@ void write_view_page(OutputFolder& run_folder, const SimulatedSequence* streamed
 /// only with --keep-sequence), or with --reuse the sequence kept earlier.
 struct DemoSource {
   std::unique_ptr<SimulatedSequence> simulated;  ///< none when read from disk
-  std::unique_ptr<OutputFolder> kept;            ///< OUT/sequence while --keep-sequence writes it
   std::unique_ptr<FrameSource> frames;           ///< declared last: destroyed first (it streams `simulated`)
 };
 
@@ -149,9 +150,23 @@ DemoSource open_demo_source(const DemoOptions& options, const std::filesystem::p
   std::filesystem::remove_all(sequence_dir);
   source.simulated = std::make_unique<SimulatedSequence>(simulation_options(options));
   const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
-  if (keep) source.kept = std::make_unique<OutputFolder>(sequence_dir, "simulate");
   source.frames = add_stages(std::make_unique<SimulatedSource>(*source.simulated, 16, keep), {});
   return source;
+}
+
+/// --reuse reads the sequence an earlier --keep-sequence left, when it is
+/// the one these options simulate (its simulation.yaml says how it was made).
+void check_kept_sequence(const DemoOptions& options, const std::filesystem::path& sequence_dir) {
+  if (!path_taken(sequence_dir / "poses.txt")) {
+    throw ConfigError(fmt::format("--reuse: {} holds no kept sequence; run the demo once with --keep-sequence",
+                                  sequence_dir.string()));
+  }
+  const std::vector<std::string> differences = simulation_differences(sequence_dir, simulation_options(options));
+  if (!differences.empty()) {
+    throw ConfigError(fmt::format("--reuse: the sequence kept in {} was simulated otherwise ({}); give the options it "
+                                  "was kept with, or leave out --reuse",
+                                  sequence_dir.string(), fmt::join(differences, "; ")));
+  }
 }
 
 /// eval_baseline.{json,png}: the label-agnostic odometry against the ground truth.
@@ -183,7 +198,8 @@ int run_demo(const DemoOptions& options) {
   const std::filesystem::path out(options.out);
   OutputFolder folder(out, "demo", kDemoOutputs);
   const std::filesystem::path sequence_dir = out / "sequence";
-  const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
+  const bool from_disk = options.reuse;
+  if (from_disk) check_kept_sequence(options, sequence_dir);
 
   heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.sim.preset,
                       options.sim.beams,
@@ -213,7 +229,6 @@ int run_demo(const DemoOptions& options) {
     return 130;
   }
   source.frames.reset();  // stops the simulator's thread; finishes the kept sequence folder
-  if (source.kept) source.kept->finish("complete");
 
   std::optional<TrajectoryEvaluation> baseline_eval;
   if (baseline && info.camera_poses) baseline_eval = evaluate_baseline(out, *info.camera_poses, baseline->result().output_poses);

@@ -13,6 +13,7 @@
 
 #include "command.hpp"
 #include "saloam/core/cancellation.hpp"
+#include "saloam/core/output_folder.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 #include "saloam/viewer/viewer_server.hpp"
 
@@ -34,9 +35,16 @@ ViewerOptions viewer_options(const ViewOptions& options) {
   return viewer;
 }
 
+/// Writes the page while no run writes the run folder (its lock, joined:
+/// the page is added to the run's record when it lies in the folder).
 int write_page(const ViewOptions& options) {
   const std::filesystem::path page =
       options.page.empty() ? std::filesystem::path(options.run_dir) / "view.html" : std::filesystem::path(options.page);
+  std::error_code error;
+  std::unique_ptr<OutputFolder> lock;
+  if (std::filesystem::is_directory(options.run_dir, error)) {
+    lock.reset(new OutputFolder(OutputFolder::join(options.run_dir, "view")));
+  }
   const ViewerPageStats s = write_viewer_page(options.run_dir, page, viewer_options(options));
   std::cout << fmt::format(
       "wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n", page.string(),

@@ -13,6 +13,7 @@
 
 #include "cli/cli_fixture.hpp"
 #include "saloam/core/output_file.hpp"
+#include "saloam/io/trajectory_io.hpp"
 
 namespace saloam {
 namespace {
@@ -171,6 +172,92 @@ TEST(OutputCli, CtrlCIsRecordedAndTheEarlierMapAndPageAreGone) {
   EXPECT_LT(frames, 400u);
   EXPECT_EQ(line_count(tmp / "out/poses.txt"), frames);
   EXPECT_NE(file_text(tmp / "out/.saloam-run").find("end interrupted"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace saloam
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace testing;
+
+TEST(InputsCli, EvalAndViewNeverOverwriteAnInput) {
+  TempDir tmp;
+  const fs::path seq = write_street_sequence(tmp / "seq", 4);
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {}", quoted(seq), quoted(tmp / "run"))), &output), 0)
+      << output;
+  const std::string gt = file_text(seq / "poses.txt"), est = file_text(tmp / "run/poses.txt");
+  const std::string eval = fmt::format("eval --gt {} --est {}", quoted(seq / "poses.txt"), quoted(tmp / "run/poses.txt"));
+  expect_has(failure_of(eval + " --json " + quoted(seq / "poses.txt")), "is the --gt file: eval never overwrites");
+  expect_has(failure_of(eval + " --plot " + quoted(tmp / "run/../run/poses.txt")), "is the --est file");
+  EXPECT_EQ(file_text(seq / "poses.txt"), gt);
+  EXPECT_EQ(file_text(tmp / "run/poses.txt"), est);
+
+  expect_has(failure_of(fmt::format("view {} --out {}", quoted(tmp / "run"), quoted(tmp / "run/poses.txt"))),
+             "poses.txt: exists and is not a viewer page");
+  EXPECT_EQ(file_text(tmp / "run/poses.txt"), est);
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {}", quoted(tmp / "run"))), &output), 0) << output;  // its own page
+
+  // An output folder is never the sequence, nor any folder holding one.
+  expect_has(failure_of(fmt::format("odom {} --out {}", quoted(seq), quoted(seq))), "is the sequence folder");
+  expect_has(failure_of(fmt::format("slam {} --out {}", quoted(seq), quoted(tmp / "run/.." / "seq"))),
+             "is the sequence folder");
+}
+
+TEST(InputsCli, SimulateReplacesAllOfAnEarlierSimulationAndNothingElse) {
+  TempDir tmp;
+  const std::string simulate = "simulate --preset straight --beams 16 --azimuth-steps 180 --out " + quoted(tmp / "sim");
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(simulate + " --frames 0:6 --labels noisy"), &output), 0) << output;
+  ASSERT_TRUE(fs::exists(tmp / "sim/labels_gt/000005.label"));
+  ASSERT_EQ(run_command(saloam_cmd(simulate + " --frames 0:3"), &output), 0) << output;
+  std::size_t scans = 0;
+  for (const auto& entry : fs::directory_iterator(tmp / "sim/velodyne")) scans += entry.path().extension() == ".bin";
+  EXPECT_EQ(scans, 3u);
+  EXPECT_FALSE(fs::exists(tmp / "sim/labels_gt/000000.label")) << "ground truth of the earlier, noisy simulation";
+  EXPECT_EQ(line_count(tmp / "sim/poses.txt"), 3u);
+  expect_has(file_text(tmp / "sim/simulation.yaml"), "frames: 0:3\n");
+
+  // A sequence simulate did not write (real data, a copy) is never replaced.
+  const fs::path real = write_street_sequence(tmp / "real", 4);
+  expect_has(failure_of("simulate --preset straight --beams 16 --frames 0:2 --out " + quoted(real)),
+             "holds a sequence or results that saloam simulate did not write");
+  EXPECT_EQ(line_count(real / "poses.txt"), 4u);
+}
+
+TEST(InputsCli, EvalPairsARunsPosesWithTheGroundTruthOfTheirFrames) {
+  TempDir tmp;
+  std::vector<Pose> truth;
+  double x = 0;
+  for (int i = 0; i < 12; ++i) {
+    Pose pose = Pose::Identity();
+    pose.translation() = Eigen::Vector3d(x, 0.05 * i * i, 0);
+    x += 0.5 + 0.3 * (i % 3);  // uneven steps: shifted pairs do not fit
+    truth.push_back(pose);
+  }
+  write_kitti_poses(tmp / "seq/poses.txt", truth);
+  std::vector<Pose> run(truth.begin() + 5, truth.end());
+  const Pose rebase = run.front().inverse();
+  for (Pose& pose : run) pose = rebase * pose;  // a run's world is its first frame
+  write_kitti_poses(tmp / "run/poses.txt", run);
+  std::ofstream(tmp / "run/summary.json") << R"({"first_frame": 5, "files": ["poses.txt", "summary.json"]})";
+  const std::string eval = fmt::format("eval --gt {} --est {} --align none", quoted(tmp / "seq/poses.txt"),
+                                       quoted(tmp / "run/poses.txt"));
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(eval), &output), 0) << output;
+  expect_has(output, "pairing by frame: the estimate starts at frame 5, the ground truth at frame 0");
+  expect_has(output, "| poses evaluated | 7 (ground truth 7, estimate 7) |");
+  expect_has(output, "| ATE RMSE, unaligned | 0.000000 m |");
+  // A summary that does not list the file does not speak for it.
+  std::ofstream(tmp / "run/summary.json") << R"({"first_frame": 5, "files": ["poses_tum.txt"]})";
+  ASSERT_EQ(run_command(saloam_cmd(eval), &output), 0) << output;
+  EXPECT_EQ(output.find("pairing by frame"), std::string::npos) << output;
+  EXPECT_EQ(output.find("| ATE RMSE, unaligned | 0.000000 m |"), std::string::npos) << output;
+  std::ofstream(tmp / "run/summary.json") << R"({"first_frame": 50, "files": ["poses.txt"]})";
+  expect_has(failure_of(eval), "poses.txt: 12 poses, none of them at frame 50 where the other trajectory starts");
 }
 
 }  // namespace

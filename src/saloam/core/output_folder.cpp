@@ -249,12 +249,18 @@ void record_output(const fs::path& file) {
   holder->append(fmt::format("file {}\n", name.string()));
 }
 
-std::vector<std::string> recorded_outputs(const fs::path& dir) {
-  const int fd = ::open((dir / OutputFolder::kRecordName).c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) return {};
+namespace {
+std::string record_in(const fs::path& dir) {
+  const int fd = ::open((dir / OutputFolder::kRecordName).c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK | O_NOFOLLOW);
+  if (fd < 0) return "";
   const std::string record = read_record(fd);
   ::close(fd);
-  return listed_files(record);
+  return record;
 }
+}  // namespace
+
+std::vector<std::string> recorded_outputs(const fs::path& dir) { return listed_files(record_in(dir)); }
+
+std::string recorded_command(const fs::path& dir) { return record_value(record_in(dir), "command"); }
 
 }  // namespace saloam

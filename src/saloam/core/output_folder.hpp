@@ -74,5 +74,7 @@ void record_output(const std::filesystem::path& file);
 
 /// The files that the record in `dir` lists, relative to `dir` (none without a record).
 std::vector<std::string> recorded_outputs(const std::filesystem::path& dir);
+/// The command of the run recorded in `dir` ("" without a record).
+std::string recorded_command(const std::filesystem::path& dir);
 
 }  // namespace saloam

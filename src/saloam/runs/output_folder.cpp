@@ -57,11 +57,14 @@ void update_run_summary(OutputFolder& folder) {
   folder.finish(stop_requested() ? "interrupted" : "complete");
 }
 
-std::optional<std::size_t> recorded_first_frame(const std::filesystem::path& run_dir) {
-  const std::filesystem::path file = run_dir / "summary.json";
+std::optional<std::size_t> recorded_first_frame(const std::filesystem::path& result_file) {
+  const std::filesystem::path file = result_file.parent_path() / "summary.json";
   if (!path_taken(file)) return std::nullopt;
   const nlohmann::json summary = nlohmann::json::parse(read_file(file, kMaxSummaryBytes, "run summary"), nullptr, false);
-  if (!summary.is_object() || !summary.contains("first_frame")) return std::nullopt;
+  if (!summary.is_object() || !summary.contains("first_frame") || !summary.contains("files")) return std::nullopt;
+  const auto& files = summary["files"];
+  const std::string name = result_file.filename().string();
+  if (!files.is_array() || std::find(files.begin(), files.end(), name) == files.end()) return std::nullopt;
   const auto& first = summary["first_frame"];
   if (!first.is_number_unsigned() || first.get<std::uint64_t>() > (1ull << 40)) {
     throw InputError(file, "'first_frame' is not a frame number");

@@ -35,9 +35,10 @@ void write_run_summary(OutputFolder& folder, nlohmann::json summary);
 /// Rewrites summary.json with the files written since (InputError when there is none).
 void update_run_summary(OutputFolder& folder);
 
-/// The first frame of the results in `run_dir` (summary.json's
-/// "first_frame"), or none when it has no summary naming one.
-std::optional<std::size_t> recorded_first_frame(const std::filesystem::path& run_dir);
+/// The sequence frame of the first pose in `result_file`: "first_frame" of
+/// the summary.json beside it when that summary lists the file among the
+/// run's; none for a file no run summary claims (e.g. a sequence's poses.txt).
+std::optional<std::size_t> recorded_first_frame(const std::filesystem::path& result_file);
 
 /// The velodyne-to-camera Tr for a run's KITTI pose files: the source's, so
 /// that poses.txt compares with the ground truth. A source without one (a
