@@ -68,7 +68,7 @@ void write_view_page(OutputFolder& folder) {
 
 int run_slam_command(const SlamOptions& options) {
   SaloamConfig config = options.config.resolve();
-  if (!options.detector.empty()) config.loop.detector = options.detector;
+  if (!options.detector.empty()) apply_config_option(config, "--detector", "loop.detector", options.detector);
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
