@@ -85,12 +85,15 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--out", options->page, "Page to write (default OUT_DIR/view.html)");
       app.add_option("--max-points", options->viewer.max_map_points, "Map point budget: decimated to at most this many")
           ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+          ->check(non_negative_integer())
+          ->check(positive_number());
       app.add_option("--scan-points", options->viewer.points_per_scan, "Points per scan shown at the slider")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(non_negative_integer());
       app.add_option("--max-scan-points", options->viewer.max_scan_points,
                      "Budget of the scans embedded in the page, all together (0: none)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(non_negative_integer());
       app.add_option("--sequence", options->sequence, "Sequence folder (default: the one recorded in summary.json)");
       app.add_flag("--serve", options->serve, "Serve the page from 127.0.0.1 instead, scans loaded on demand");
       app.add_option("--port", options->port, "Port for --serve (0: any free one)")

@@ -140,5 +140,18 @@ TEST(InputsCli, AnOptionBoundToAConfigurationKeyIsCheckedLikeSet) {
   EXPECT_EQ(rule(by_option), rule(by_set));
 }
 
+// Option values are checked with short messages: no 300-digit range, no -1
+// wrapped to 18446744073709551615.
+TEST(InputsCli, ViewerBudgetsAreCheckedWithShortMessages) {
+  TempDir tmp;
+  for (const std::string option : {"--max-points 0", "--max-points -1", "--scan-points -1", "--max-scan-points -1"}) {
+    std::string output;
+    EXPECT_NE(run_command(saloam_cmd(fmt::format("view {} {}", quoted(tmp / "run"), option)), &output), 0) << option;
+    expect_has(output, option.substr(0, option.find(' ')));
+    EXPECT_LT(output.size(), 300u) << output;
+    EXPECT_EQ(output.find("18446744073709551615"), std::string::npos) << output;
+  }
+}
+
 }  // namespace
 }  // namespace saloam
