@@ -140,6 +140,20 @@ TEST(InputsCli, AnOptionBoundToAConfigurationKeyIsCheckedLikeSet) {
   EXPECT_EQ(rule(by_option), rule(by_set));
 }
 
+// An error quoting the input stays short and plain: a 10 MB line is cut, a
+// NUL byte does not end the message.
+TEST(InputsCli, ErrorsQuotingTheInputAreShortAndPlain) {
+  TempDir tmp;
+  std::ofstream(tmp / "big.txt") << "1 2 3 " << std::string(10'000'000, 'x') << "\n";
+  std::string output = failure_of(fmt::format("eval --gt {} --est {}", quoted(tmp / "big.txt"), quoted(tmp / "big.txt")));
+  expect_has(output, "big.txt: line 1: ");
+  EXPECT_LT(output.size(), 2000u);
+  std::ofstream(tmp / "nul.txt", std::ios::binary)
+      << std::string("1 0 0 0 0 1 0 0 0 0 1 0\n1 0 0 0\0secret 0 1 0 0 0 0 1 0\n", 55);
+  output = failure_of(fmt::format("eval --gt {} --est {}", quoted(tmp / "nul.txt"), quoted(tmp / "nul.txt")));
+  expect_has(output, "\\x00secret");
+}
+
 // Option values are checked with short messages: no 300-digit range, no -1
 // wrapped to 18446744073709551615.
 TEST(InputsCli, ViewerBudgetsAreCheckedWithShortMessages) {

@@ -15,6 +15,15 @@ namespace {
 namespace fs = std::filesystem;
 using testing::input_error_of;
 
+TEST(Errors, TextIsPlainAndShortWhateverTheInputHeld) {
+  const InputError nul("poses.txt", std::string("line 2: '1 0\0secret' is not a number", 36));
+  EXPECT_STREQ(nul.what(), "poses.txt: line 2: '1 0\\x00secret' is not a number");
+  const InputError huge("big.txt", "line 1: '" + std::string(10'000'000, 'x') + "' is not a number");
+  EXPECT_LT(std::string(huge.what()).size(), 700u);
+  EXPECT_NE(std::string(huge.what()).find("... (9999"), std::string::npos) << huge.what();
+  EXPECT_STREQ(ConfigError("a\tb\x1b[31m").what(), "a\tb\\x1b[31m");
+}
+
 TEST(Files, RequireFileNamesWhatIsWrong) {
   testing::TempDir dir;
   std::ofstream(dir / "a.txt") << "x";
