@@ -52,6 +52,7 @@ struct DemoOptions {
   bool keep_sequence = false;
   bool reuse = false;
   bool baseline = true;
+  SegmentOptions segment;  ///< --segment: the network labels the raw simulated scans
   ConfigOptions config;
 };
 
@@ -141,16 +142,19 @@ struct DemoSource {
   std::unique_ptr<FrameSource> frames;           ///< declared last: destroyed first (it streams `simulated`)
 };
 
-DemoSource open_demo_source(const DemoOptions& options, const std::filesystem::path& sequence_dir, bool from_disk) {
+DemoSource open_demo_source(const DemoOptions& options, const SaloamConfig& config,
+                            const std::filesystem::path& sequence_dir, bool from_disk) {
   DemoSource source;
+  SourceOptions stages;
+  stages.segmentation = options.segment.stage(config);
   if (from_disk) {
-    source.frames = open_source(sequence_dir, {});
+    source.frames = open_source(sequence_dir, stages);
     return source;
   }
   std::filesystem::remove_all(sequence_dir);
   source.simulated = std::make_unique<SimulatedSequence>(simulation_options(options));
   const auto keep = options.keep_sequence ? std::optional(sequence_dir) : std::nullopt;
-  source.frames = add_stages(std::make_unique<SimulatedSource>(*source.simulated, 16, keep), {});
+  source.frames = add_stages(std::make_unique<SimulatedSource>(*source.simulated, 16, keep), stages);
   return source;
 }
 
@@ -193,6 +197,8 @@ void print_outputs(const SlamRunResult& slam, double seconds, const std::filesys
 
 int run_demo(const DemoOptions& options) {
   const StageTimer timer;
+  if (options.gt_labels && options.segment.enabled())
+    throw ConfigError("--gt-labels and --segment both choose the labels: give one");
   SaloamConfig config = options.config.resolve();
   if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
   const std::filesystem::path out(options.out);
@@ -205,7 +211,7 @@ int run_demo(const DemoOptions& options) {
                       options.sim.beams,
                       options.gt_labels ? "ground-truth" : "noisy (emulated network)",
                       from_disk ? " (reusing " + sequence_dir.string() + ")" : ""));
-  DemoSource source = open_demo_source(options, sequence_dir, from_disk);
+  DemoSource source = open_demo_source(options, config, sequence_dir, from_disk);
   const SourceInfo info = source.frames->info();
   std::cout << fmt::format("{} frames; the simulator renders them {}\n", info.size(),
                            from_disk ? "from disk" : options.keep_sequence ? "ahead and writes them to " + sequence_dir.string()
@@ -250,6 +256,7 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--beams", options->sim.beams, "LiDAR beams: 64, 32 or 16")->check(CLI::IsMember({64, 32, 16}));
       app.add_option("--seed", options->sim.seed, "Simulation seed");
       app.add_flag("--gt-labels", options->gt_labels, "Use ground-truth labels instead of emulated network output");
+      options->segment.add_to(app);
       app.add_flag("--keep-sequence", options->keep_sequence,
                    "Also write the simulated sequence to OUT/sequence (about 2.4 MB per 64-beam scan)");
       app.add_flag("--reuse", options->reuse, "Read OUT/sequence (kept by an earlier --keep-sequence) instead of simulating");

@@ -112,12 +112,18 @@ std::filesystem::path segmentation_plugin_path() {
 std::filesystem::path segmenter_description_path(const std::string& given, const std::string& projection,
                                                  const SaloamConfig& config) {
   const std::filesystem::path model = !given.empty() ? given : config.segmentation.model;
-  if (model.empty()) return data_dir() / "models" / "segmenter" / "saloam.yaml";
+  std::error_code error;
+  if (model.empty()) {
+    const auto shipped = data_dir() / "models" / "segmenter" / "saloam.yaml";
+    if (std::filesystem::is_regular_file(shipped, error)) return shipped;
+    throw ConfigError(fmt::format("--segment needs a model: pass --segmenter FILE (the shipped model is missing from {}; "
+                                  "set SALOAM_DATA_DIR if saloam was moved)",
+                                  shipped.parent_path().string()));
+  }
   if (!projection.empty()) return projection;
   if (model.extension() != ".pt") return model;
   auto beside = model;
   beside.replace_extension(".yaml");
-  std::error_code error;
   if (std::filesystem::is_regular_file(beside, error)) return beside;
   throw ConfigError(fmt::format("--segmenter {}: a TorchScript model needs a description of its projection and classes: "
                                 "--projection FILE.yaml, or {} beside it (docs/segmentation.md)",

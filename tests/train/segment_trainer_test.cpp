@@ -73,11 +73,11 @@ TEST(SegmentTrainer, TinyRunLowersTheLossDeterministically) {
     SegmentTrainer trainer(shape_of(options), 5, options);
     trainer.set_class_weights(class_weights_from_counts(class_counts({street()})));
     std::vector<double> out;
-    for (int i = 0; i < 30; ++i) out.push_back(trainer.step(samples, 5e-3));
+    for (int i = 0; i < 30; ++i) out.push_back(trainer.step(samples, 1e-2));
     return out;
   };
   const auto first = losses();
-  EXPECT_LT(first.back(), 0.75 * first.front());  // measured: 3.21 -> 2.09
+  EXPECT_LT(first.back(), 0.75 * first.front());  // measured: 3.18 -> 2.06
   EXPECT_EQ(losses(), first) << "same seed, same samples, one thread: the same losses";
 }
 

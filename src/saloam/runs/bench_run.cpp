@@ -33,6 +33,7 @@ BenchResult run_bench(FrameSource& source, const OdometryConfig& config, bool sh
   result.semantics = config.use_semantics && info.has_labels;
   SemanticOdometry odometry(config);
   ProgressBar progress(info.size(), "bench", show_progress);
+  const StageTimer run;
   for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
     const LabelledCloud cloud = source.scan(i);  // I/O outside the timed region
     result.points_per_scan += static_cast<double>(cloud.size());
@@ -45,6 +46,8 @@ BenchResult run_bench(FrameSource& source, const OdometryConfig& config, bool sh
     progress.advance();
   }
   progress.finish();
+  result.run_wall_s = run.elapsed_s();
+  result.source_stages = source.stage_times();
   result.frames = result.frame_wall_ms.size();
   result.stage_wall_ms = odometry.timings();
   result.stage_cpu_ms = odometry.cpu_timings();

@@ -19,6 +19,9 @@ struct BenchResult {
   std::vector<double> frame_wall_ms;  ///< per frame: SemanticOdometry::register_frame
   std::vector<double> frame_cpu_ms;   ///< the same, CPU time of the calling thread
   std::vector<FrameTimings> stage_wall_ms, stage_cpu_ms;  ///< per frame and stage
+  /// The source's stages (e.g. segmentation, on threads of their own) per frame.
+  std::vector<SourceStageTimes> source_stages;
+  double run_wall_s = 0;              ///< the whole run, reading and source stages included
   // Work per frame (means), to explain the timings: features after
   // downsampling, local-map size and association rounds (neighbour queries
   // of every feature).

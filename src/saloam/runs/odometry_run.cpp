@@ -17,10 +17,11 @@ double OdometryRunResult::median_frame_ms() const { return summarize(column(timi
 
 double OdometryRunResult::worst_frame_ms() const { return summarize(column(timings, &FrameTimings::total_ms)).max; }
 
-void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings) {
+void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings,
+                       const std::vector<SourceStageTimes>& source_stages) {
   const std::vector<double> total = column(timings, &FrameTimings::total_ms);
   const Summary frame = summarize(total);
-  const nlohmann::json j{{"frames", total.size()},
+  nlohmann::json j{{"frames", total.size()},
                          {"hz_median", hz(frame.median)},
                          {"hz_worst_frame", hz(frame.max)},
                          {"stages",
@@ -30,7 +31,16 @@ void write_timing_json(const std::filesystem::path& file, const std::vector<Fram
                            {"map_update", stage_stats(column(timings, &FrameTimings::map_update_ms))},
                            {"total", stage_stats(total)}}},
                          {"frame_total_ms", total}};
+  for (const auto& stage : source_stages)
+    j["source_stages"][stage.name] = {{"wall", stage_stats(column(stage.per_frame, &StageTime::wall_ms))},
+                                      {"cpu", stage_stats(column(stage.per_frame, &StageTime::cpu_ms))}};
   write_file_atomically(file, j.dump(2) + "\n");
+}
+
+void warn_no_labels(const SourceInfo& info) {
+  spdlog::warn("{}: no labels (no labels/ folder): every point is one class, as with --no-semantics. Pass --segment to "
+               "label the scans in-process, --labels DIR for labels made elsewhere, or --no-semantics to say so",
+               info.name);
 }
 
 OdometryRun::OdometryRun(const OdometryConfig& config, const std::filesystem::path& out_dir,
@@ -70,9 +80,7 @@ nlohmann::json odometry_summary(const SourceInfo& info, const OdometryConfig& co
 OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config, const std::filesystem::path& out_dir,
                                const OdometryRunOptions& options) {
   const SourceInfo& info = source.info();
-  if (config.use_semantics && !info.has_labels) {
-    spdlog::warn("{}: no labels found; running with every point in one class", info.name);
-  }
+  if (config.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
   OutputFolder folder = open_run_folder(out_dir, info.folder, "odom", kOdometryOutputs);
   OdometryRun run(config, out_dir, tr);
@@ -89,7 +97,7 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
   OdometryRunResult result = run.result();
   result.timings = run.odometry().timings();
   result.interrupted = stop_requested();
-  write_timing_json(out_dir / "timing.json", result.timings);
+  write_timing_json(out_dir / "timing.json", result.timings, source.stage_times());
   write_run_summary(folder, odometry_summary(info, config, result));
   result.files = folder.files();
   return result;

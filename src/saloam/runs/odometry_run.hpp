@@ -74,7 +74,12 @@ inline const std::vector<std::string> kOdometryOutputs{"poses.txt", "poses_tum.t
 OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config, const std::filesystem::path& out_dir,
                                const OdometryRunOptions& options = {});
 
-/// timing.json: frames, Hz (median, worst frame) and mean/median/max per stage.
-void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings);
+/// The warning of a semantic run over a source without labels, naming --segment, --labels and --no-semantics.
+void warn_no_labels(const SourceInfo& info);
+
+/// timing.json: frames, Hz (median, worst frame) and mean/median/max per
+/// stage, with the source's stages (e.g. segmentation) beside the odometry's.
+void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings,
+                       const std::vector<SourceStageTimes>& source_stages = {});
 
 }  // namespace saloam

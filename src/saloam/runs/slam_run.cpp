@@ -76,11 +76,12 @@ void write_graph_map(const std::filesystem::path& file, const SlamSystem& slam) 
   write_file_atomically(file, nlohmann::json{{"frame", "LiDAR, world = first frame"}, {"keyframes", keyframes}}.dump() + '\n');
 }
 
-void write_timing(const std::filesystem::path& file, const SlamSystem& slam, double seconds, double rss_mib) {
+void write_timing(const std::filesystem::path& file, const SlamSystem& slam, double seconds, double rss_mib,
+                  const std::vector<SourceStageTimes>& source_stages) {
   const auto& t = slam.timings();
   const std::vector<double> total = column(t, &SlamFrameTimings::total_ms);
   const Summary frame = summarize(total);
-  const nlohmann::json j{
+  nlohmann::json j{
       {"frames", total.size()},
       {"keyframes", slam.keyframes().size()},
       {"optimizations", slam.optimizations()},
@@ -97,6 +98,9 @@ void write_timing(const std::filesystem::path& file, const SlamSystem& slam, dou
         {"pose_graph", stage_stats(column(t, &SlamFrameTimings::optimization_ms))},
         {"loop_closure_total", stage_stats(column(t, &SlamFrameTimings::loop_ms))},
         {"total", stage_stats(total)}}}};
+  for (const auto& stage : source_stages)
+    j["source_stages"][stage.name] = {{"wall", stage_stats(column(stage.per_frame, &StageTime::wall_ms))},
+                                      {"cpu", stage_stats(column(stage.per_frame, &StageTime::cpu_ms))}};
   write_file_atomically(file, j.dump(2) + '\n');
 }
 
@@ -290,11 +294,12 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
 // Everything written after the frame loop: loop-closed poses, timing, loops,
 // graph map, trajectories and their evaluation; returns the run's summary.
 nlohmann::json write_results(const SlamSystem& slam, const std::vector<Pose>& optimized, TrajectoryWriter& slam_writer,
-                             const SaloamConfig& config, const SourceInfo& info, const std::optional<Pose>& tr,
+                             const SaloamConfig& config, const FrameSource& source, const std::optional<Pose>& tr,
                              const std::filesystem::path& out_dir, SlamRunResult& result) {
+  const SourceInfo& info = source.info();
   for (std::size_t i = 0; i < optimized.size(); ++i) slam_writer.write(slam.timestamps().at(i), optimized[i]);
   slam_writer.commit();
-  write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib);
+  write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib, source.stage_times());
   const RunTruth truth = run_truth(info, tr, result.frames);
   write_loops_csv(out_dir / "loops.csv", slam, truth.loop_reference());
   if (uses_sgpr(parse_place_detector(config.loop.detector))) write_graph_map(out_dir / "graph_map.json", slam);
@@ -320,9 +325,7 @@ OutputFolder open_slam_folder(const std::filesystem::path& out_dir, const Source
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
                        OutputFolder& folder, const SlamRunOptions& options) {
   const SourceInfo& info = source.info();
-  if (config.odometry.use_semantics && !info.has_labels) {
-    spdlog::warn("{}: no labels found; running with every point in one class", info.name);
-  }
+  if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
   const std::filesystem::path& out_dir = folder.path();
 
@@ -338,7 +341,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options));
   odometry_writer.commit();
   const std::vector<Pose> optimized = slam.optimized_poses();
-  nlohmann::json summary = write_results(slam, optimized, slam_writer, config, info, tr, out_dir, result);
+  nlohmann::json summary = write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);
 
   if (options.write_map && !stop_requested()) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)

@@ -58,18 +58,46 @@ Window window_at(const RangeImage& image, int row, int col, int half) {
   return w;
 }
 
-/// True when every pixel with a point in the window shows `label`: then
-/// every vote goes to it (the point's own pixel always votes).
-bool uniform_window(const RangeImage& image, const std::vector<std::int16_t>& pixel_class, const Window& w,
-                    std::int16_t label) {
-  for (int y = w.first_row; y <= w.last_row; ++y) {
-    const std::size_t row_start = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.cols);
-    for (int j = 0; j <= 2 * w.half; ++j) {
-      const std::size_t p = row_start + static_cast<std::size_t>(w.cols[static_cast<std::size_t>(j)]);
-      if (pixel_class[p] != label && image.range[p] >= 0) return false;
+constexpr std::int16_t kNoPoint = -1, kMixed = -2;
+
+/// For every pixel: the class all points within `half` columns of it (same
+/// row, wrapping around in azimuth) show, kMixed when they differ, kNoPoint
+/// when there is none.
+std::vector<std::int16_t> row_classes(const RangeImage& image, const std::vector<std::int16_t>& pixel_class, int half) {
+  std::vector<std::int16_t> out(image.pixels(), kNoPoint);
+  for (int y = 0; y < image.rows; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(image.cols);
+    for (int x = 0; x < image.cols; ++x) {
+      std::int16_t c = kNoPoint;
+      for (int dx = -half; dx <= half && c != kMixed; ++dx) {
+        const std::size_t p = row + static_cast<std::size_t>((x + dx + image.cols) % image.cols);
+        if (image.range[p] < 0) continue;
+        c = c == kNoPoint || c == pixel_class[p] ? pixel_class[p] : kMixed;
+      }
+      out[row + static_cast<std::size_t>(x)] = c;
     }
   }
-  return true;
+  return out;
+}
+
+/// For every pixel: 1 when every point in the window around it shows its
+/// class (then every vote of a point in it goes to that class: the point's
+/// own pixel always votes).
+std::vector<std::uint8_t> uniform_windows(const RangeImage& image, const std::vector<std::int16_t>& pixel_class, int half) {
+  const std::vector<std::int16_t> rows = row_classes(image, pixel_class, half);
+  std::vector<std::uint8_t> out(image.pixels(), 0);
+  for (int y = 0; y < image.rows; ++y)
+    for (int x = 0; x < image.cols; ++x) {
+      const auto p = static_cast<std::size_t>(y * image.cols + x);
+      if (image.range[p] < 0) continue;
+      bool uniform = true;
+      for (int yy = std::max(y - half, 0); yy <= std::min(y + half, image.rows - 1) && uniform; ++yy) {
+        const std::int16_t c = rows[static_cast<std::size_t>(yy * image.cols + x)];
+        uniform = c == kNoPoint || c == pixel_class[p];
+      }
+      out[p] = uniform;
+    }
+  return out;
 }
 
 /// The k candidates of smallest distance, kept sorted by insertion (k is small).
@@ -101,17 +129,18 @@ std::vector<std::int16_t> point_classes(const RangeImage& image, const std::vect
   const auto cutoff = static_cast<float>(options.cutoff);
   std::vector<std::int16_t> out(image.point_pixel.size(), 0);
   std::vector<int> votes(static_cast<std::size_t>(classes));
+  const std::vector<std::uint8_t> uniform = uniform_windows(image, pixel_class, half);
 
   for (std::size_t i = 0; i < image.point_pixel.size(); ++i) {
     const std::int32_t pixel = image.point_pixel[i];
     if (pixel < 0) continue;
-    const int row = pixel / image.cols;
-    const Window w = window_at(image, row, pixel % image.cols, half);
     const std::int16_t own = pixel_class[static_cast<std::size_t>(pixel)];
-    if (own > 0 && own < classes && uniform_window(image, pixel_class, w, own)) {
+    if (own > 0 && own < classes && uniform[static_cast<std::size_t>(pixel)]) {
       out[i] = own;
       continue;
     }
+    const int row = pixel / image.cols;
+    const Window w = window_at(image, row, pixel % image.cols, half);
     // The point's own pixel votes at distance 0; every other pixel with a
     // point at its range difference, weighted by its offset.
     NearestK nearest(static_cast<std::size_t>(std::max(options.k, 1)));

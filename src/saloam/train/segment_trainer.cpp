@@ -25,7 +25,6 @@
 namespace saloam {
 
 namespace fs = std::filesystem;
-namespace F = torch::nn::functional;
 
 // ---------------------------------------------------------------- losses
 
@@ -42,13 +41,24 @@ torch::Tensor lovasz_gradient(const torch::Tensor& foreground_sorted) {
   return jaccard;
 }
 
+/// Class-weighted cross-entropy of pixel logits [N, H, W, K] against targets
+/// [N, H, W], class 0 ignored: PyTorch's cross_entropy(weight, ignore_index
+/// 0), over the class axis that lies last in memory here.
+torch::Tensor weighted_cross_entropy(const torch::Tensor& logits, const torch::Tensor& target,
+                                     const torch::Tensor& class_weights) {
+  const auto log_p = torch::log_softmax(logits, -1);
+  const auto picked = log_p.gather(-1, target.unsqueeze(-1)).squeeze(-1);
+  const auto weight = class_weights.index({target}) * (target > 0).to(torch::kFloat32);
+  return -(picked * weight).sum() / weight.sum().clamp_min(1e-12);
+}
+
 /// Lovasz-softmax loss over the pixels with a class (target > 0), averaged
-/// over the classes present in the batch.
+/// over the classes present in the batch. Logits [N, H, W, K], targets [N, H, W].
 torch::Tensor lovasz_softmax(const torch::Tensor& logits, const torch::Tensor& target) {
-  const int64_t classes = logits.size(1);
+  const int64_t classes = logits.size(-1);
   const auto labels = target.reshape({-1});
   const auto valid = labels > 0;
-  const auto probabilities = torch::softmax(logits, 1).permute({0, 2, 3, 1}).reshape({-1, classes}).index({valid});
+  const auto probabilities = torch::softmax(logits, -1).reshape({-1, classes}).index({valid});
   const auto kept = labels.index({valid});
   std::vector<torch::Tensor> losses;
   for (int64_t c = 1; c < classes; ++c) {
@@ -69,7 +79,7 @@ class TrainerRunner final : public NetworkRunner {
   std::vector<std::int16_t> classify(const std::vector<float>& image, int channels, int rows, int cols) override {
     torch::NoGradGuard no_grad;
     net_->eval();
-    return best_classes(net_->forward(image_tensor(image, channels, rows, cols)));
+    return best_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)));
   }
 
  private:
@@ -120,8 +130,8 @@ double SegmentTrainer::step(std::span<const TrainingSample> batch, double learni
   }
   auto& net = impl_->net;
   net->train();
-  const auto logits = net->forward(images.contiguous(torch::MemoryFormat::ChannelsLast));
-  auto loss = F::cross_entropy(logits, targets, F::CrossEntropyFuncOptions().weight(impl_->class_weights).ignore_index(0));
+  const auto logits = net->pixel_logits(images.contiguous(torch::MemoryFormat::ChannelsLast));
+  auto loss = weighted_cross_entropy(logits, targets, impl_->class_weights);
   if (impl_->lovasz_weight > 0) loss = loss + impl_->lovasz_weight * lovasz_softmax(logits, targets);
   for (auto& group : impl_->adam->param_groups())
     static_cast<torch::optim::AdamOptions&>(group.options()).lr(learning_rate);

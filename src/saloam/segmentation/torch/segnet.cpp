@@ -75,18 +75,31 @@ SegNetImpl::SegNetImpl(const SegNetShape& shape) : shape_(shape) {
   for (int i = 0; i < shape.context_blocks; ++i) context_->push_back(ResidualBlock(w2, int64_t{1} << std::min(i, 3)));
   up2_ = register_module("up2", ConvBn(ConvSpec{w2 + w1, w1, {3, 3}, {1, 1}, {1, 1}}));
   up1_ = register_module("up1", ConvBn(ConvSpec{w1 + w0, w0, {3, 3}, {1, 1}, {1, 1}}));
-  head_ = register_module("head", torch::nn::Conv2d(torch::nn::Conv2dOptions(w0, shape.classes, 1)));
+  // One logit per class and column phase: the stem's stride is undone by
+  // giving every working-resolution column s columns of output.
+  head_ = register_module("head", torch::nn::Conv2d(torch::nn::Conv2dOptions(w0, shape.classes * s, 1)));
 }
 
-torch::Tensor SegNetImpl::forward(const torch::Tensor& x) {
+torch::Tensor SegNetImpl::pixel_logits(const torch::Tensor& x) {
   const auto l0 = level0_->forward(stem_->forward(x));
   const auto l1 = level1_->forward(down1_->forward(l0));
   auto l2 = down2_->forward(l1);
   for (const auto& block : *context_) l2 = block->as<ResidualBlock>()->forward(l2);
   const auto u1 = up2_->forward(torch::cat({resized(l2, l1.size(2), l1.size(3)), l1}, 1));
   const auto u0 = up1_->forward(torch::cat({resized(u1, l0.size(2), l0.size(3)), l0}, 1));
-  return resized(head_(u0), x.size(2), x.size(3));
+  // libtorch 1.13 runs a 1x1 convolution of a small batch on one thread
+  // with its slow reference kernel (five times oneDNN's time here, forward
+  // and backward); a dilation, which changes nothing for a 1x1 kernel, sends
+  // it to oneDNN.
+  const auto logits = torch::conv2d(u0, head_->weight, head_->bias, /*stride=*/at::IntArrayRef{1, 1},
+                                    /*padding=*/at::IntArrayRef{0, 0}, /*dilation=*/at::IntArrayRef{2, 2});
+  // Channel j * K + k is class k at column phase j: channels-last, the
+  // output is [N, H, W/s, s, K] in memory, which is [N, H, W, K] (no copy).
+  const int64_t n = logits.size(0), h = logits.size(2), w = logits.size(3);
+  return logits.permute({0, 2, 3, 1}).reshape({n, h, w * shape_.stem_stride, shape_.classes});
 }
+
+torch::Tensor SegNetImpl::forward(const torch::Tensor& x) { return pixel_logits(x).permute({0, 3, 1, 2}); }
 
 void SegNetImpl::fold_batch_norm() {
   for (auto* block : {&stem_, &down1_, &down2_, &up2_, &up1_}) (*block)->fold_batch_norm();
@@ -131,9 +144,8 @@ torch::Tensor image_tensor(const std::vector<float>& image, int channels, int ro
       .contiguous(torch::MemoryFormat::ChannelsLast);
 }
 
-std::vector<std::int16_t> best_classes(torch::Tensor logits) {
-  logits = logits.squeeze(0).slice(0, 1);
-  const auto best = (logits.argmax(0) + 1).to(torch::kInt16).contiguous();
+std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits) {
+  const auto best = (pixel_logits.squeeze(0).slice(2, 1).argmax(2) + 1).to(torch::kInt16).contiguous();
   const auto* p = best.data_ptr<std::int16_t>();
   return {p, p + best.numel()};
 }

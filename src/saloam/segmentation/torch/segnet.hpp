@@ -50,9 +50,13 @@ TORCH_MODULE(ResidualBlock);
 class SegNetImpl : public torch::nn::Module {
  public:
   explicit SegNetImpl(const SegNetShape& shape);
-  /// Logits [N, classes, H, W] of images [N, in_channels, H, W]; H a
-  /// multiple of 4, W of 4 * stem_stride.
+  /// Logits [N, classes, H, W] of images [N, in_channels, H, W] (a view of
+  /// pixel_logits()); H a multiple of 4, W of 4 * stem_stride.
   torch::Tensor forward(const torch::Tensor& x);
+  /// The same logits pixel by pixel, [N, H, W, classes], contiguous for
+  /// channels-last images: what the head computes, what the loss and the
+  /// argmax read.
+  torch::Tensor pixel_logits(const torch::Tensor& x);
   /// For inference in eval mode: folds every batch norm into its convolution.
   void fold_batch_norm();
   [[nodiscard]] const SegNetShape& shape() const { return shape_; }
@@ -75,9 +79,9 @@ void load_segnet(SegNet& net, const std::string& file);
 /// A C x rows x cols image (channel-major floats) as a [1, C, rows, cols]
 /// tensor in channels-last layout (the fast one for CPU convolutions).
 torch::Tensor image_tensor(const std::vector<float>& image, int channels, int rows, int cols);
-/// Class of every pixel of logits [1, K, H, W], row-major: the argmax over
+/// Class of every pixel, row-major, of logits [1, H, W, K]: the argmax over
 /// classes 1..K-1 (class 0, unlabeled, is never predicted).
-std::vector<std::int16_t> best_classes(torch::Tensor logits);
+std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits);
 
 /// "rows must be a multiple of 4 ..." when an image of rows x cols does not
 /// fit `shape`; empty when it does.

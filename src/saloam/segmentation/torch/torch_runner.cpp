@@ -58,7 +58,7 @@ class SegNetRunner final : public NetworkRunner {
                                std::to_string(channels));
     if (const auto problem = segnet_size_problem(shape, rows, cols); !problem.empty()) throw std::runtime_error(problem);
     torch::NoGradGuard no_grad;
-    return best_classes(net_->forward(image_tensor(image, channels, rows, cols)));
+    return best_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)));
   }
 
  private:
@@ -79,7 +79,7 @@ class TorchScriptRunner final : public NetworkRunner {
     if (!out.isTensor()) throw std::runtime_error("the network's forward() returns no tensor");
     const torch::Tensor logits = out.toTensor().to(torch::kFloat32);
     check_output(logits, classes_, rows, cols);
-    return best_classes(logits);
+    return best_classes(logits.permute({0, 2, 3, 1}));
   }
 
  private:
