@@ -76,6 +76,7 @@ TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
   expected.odometry.match_class_groups = false;
   expected.odometry.adaptive_class_weights = false;
   expected.odometry.features.ground_edge_alpha = 0.1;
+  expected.odometry.features.thin_object_axes = false;
   expected.loop.acceptance = "loss";
   expected.loop.sigma = 0.05;
   EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));

@@ -72,6 +72,14 @@ TEST(EvaluationJson, HoldsTheDocumentedKeys) {
   EXPECT_EQ(j.at("rpe").at("per_frame_trans_m").size(), 1199u);
   EXPECT_EQ(j.at("rpe").at("per_frame_rot_deg").size(), 1199u);
   EXPECT_TRUE(j.at("warnings").empty());
+  const auto& bias = j.at("scale_bias");
+  EXPECT_EQ(bias.at("delta"), 10);
+  EXPECT_EQ(bias.at("windows"), ev.bias.windows);
+  EXPECT_DOUBLE_EQ(bias.at("length_m").get<double>(), ev.bias.length_m);
+  EXPECT_DOUBLE_EQ(bias.at("forward_percent").get<double>(), ev.bias.forward_percent);
+  EXPECT_DOUBLE_EQ(bias.at("lateral_percent").get<double>(), ev.bias.lateral_percent);
+  EXPECT_DOUBLE_EQ(bias.at("vertical_percent").get<double>(), ev.bias.vertical_percent);
+  EXPECT_EQ(bias.at("body_up").size(), 3u);
 
   const auto compact = evaluation_to_json(ev, {}, false);
   EXPECT_FALSE(compact.at("ate").contains("per_pose_aligned_m"));
@@ -117,6 +125,10 @@ TEST(EvaluationMarkdown, ShowsHeadlineAndPerLengthTables) {
   EXPECT_NE(text.find("| ATE RMSE, se3-aligned | "), std::string::npos);
   EXPECT_NE(text.find("| ATE RMSE, unaligned | "), std::string::npos);
   EXPECT_NE(text.find("| RPE (1-frame) translation RMSE | "), std::string::npos);
+  EXPECT_NE(text.find(fmt::format("| scale bias forward / lateral / vertical (10-frame) | {:.4f} / ",
+                                  ev.bias.forward_percent)),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find("| segment length [m] | t_err [%] | r_err [deg/100 m] | segments |"), std::string::npos);
   EXPECT_NE(text.find("| 800 | "), std::string::npos);
   EXPECT_NE(text.find(fmt::format("{:.6f}", ev.ate.aligned.rmse)), std::string::npos);

@@ -285,6 +285,104 @@ TEST(Rpe, LargerDelta) {
   EXPECT_THROW(compute_rpe(gt, gt, 0), std::invalid_argument);
 }
 
+/// `gt` re-integrated with every frame's motion t (body frame) changed to
+/// t + |t| (forward f + lateral l + vertical u), the axes of the LiDAR frame
+/// (x forward, y left, z up): relative errors of known share.
+std::vector<Pose> biased(const std::vector<Pose>& gt, double forward, double lateral, double vertical) {
+  std::vector<Pose> est{gt.front()};
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    Pose motion = gt[i - 1].inverse() * gt[i];
+    const double length = motion.translation().norm();
+    motion.translation() += length * Eigen::Vector3d(forward, lateral, vertical);
+    est.push_back(est.back() * motion);
+  }
+  return est;
+}
+
+/// Poses of a LiDAR-frame trajectory in a KITTI camera frame (x right, y down,
+/// z forward): P = C Q C^-1, C the camera-from-LiDAR rotation.
+std::vector<Pose> in_camera_frame(const std::vector<Pose>& lidar) {
+  Eigen::Matrix3d R;
+  R << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  const Pose C = make_pose(R, Eigen::Vector3d::Zero());
+  std::vector<Pose> out;
+  for (const auto& Q : lidar) out.push_back(C * Q * C.inverse());
+  return out;
+}
+
+TEST(ScaleBias, StraightDriveGivesTheShareOfEachAxis) {
+  const auto gt = straight_path(501, 1.0);
+  const auto est = biased(gt, -0.001, 0.0005, -0.0002);
+  for (const auto& [g, e] : {std::pair{gt, est}, std::pair{in_camera_frame(gt), in_camera_frame(est)}}) {
+    const ScaleBias bias = compute_scale_bias(g, e);
+    EXPECT_EQ(bias.windows, 50u);
+    EXPECT_NEAR(bias.length_m, 500.0, 1e-9);
+    EXPECT_NEAR(bias.forward_percent, -0.1, 1e-9);
+    EXPECT_NEAR(bias.lateral_percent, 0.05, 1e-9);
+    EXPECT_NEAR(bias.vertical_percent, -0.02, 1e-9);
+  }
+  EXPECT_EQ(body_up_axis(gt), Eigen::Vector3d::UnitZ());
+  EXPECT_EQ(body_up_axis(in_camera_frame(gt)), -Eigen::Vector3d::UnitY());
+}
+
+TEST(ScaleBias, WindingDriveResolvesEachWindowInItsMotionFrame) {
+  // Up to 0.2 rad of turn per 10-frame window: a window's chord leans up to
+  // 0.1 rad off each frame's forward axis, which mixes the components by
+  // up to 1 - cos(0.1) of themselves and sin(0.1) of each other (on average
+  // less: the turns go both ways).
+  const auto gt = winding_path(3000, 1.0);
+  const auto est = biased(gt, -0.001, 0.0005, -0.0002);
+  const ScaleBias bias = compute_scale_bias(gt, est);
+  EXPECT_EQ(bias.windows, 299u);
+  EXPECT_NEAR(bias.forward_percent, -0.1, 0.01);
+  EXPECT_NEAR(bias.lateral_percent, 0.05, 0.01);
+  EXPECT_NEAR(bias.vertical_percent, -0.02, 0.005);
+}
+
+TEST(ScaleBias, RandomErrorsAverageOut) {
+  const auto gt = winding_path(3000, 1.0);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.01);  // 1 % of every step, each direction
+  std::vector<Pose> est{gt.front()};
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    Pose motion = gt[i - 1].inverse() * gt[i];
+    motion.translation() += Eigen::Vector3d(noise(rng), noise(rng), noise(rng));
+    est.push_back(est.back() * motion);
+  }
+  const ScaleBias bias = compute_scale_bias(gt, est);
+  // Each sum holds 3000 errors of sigma 0.01 m: sigma 0.55 m over 3000 m,
+  // 0.018 %; the bound is 3.3 sigma.
+  EXPECT_LT(std::abs(bias.forward_percent), 0.06);
+  EXPECT_LT(std::abs(bias.lateral_percent), 0.06);
+  EXPECT_LT(std::abs(bias.vertical_percent), 0.06);
+  // The same errors are about 0.5 % of a 10-frame window (sqrt(30) * 0.01 m over 10 m).
+  EXPECT_GT(compute_rpe(gt, est, 10).trans.mean, 0.04);
+}
+
+TEST(ScaleBias, StandingStillAndUnknownAxes) {
+  const std::vector<Pose> still(30, Pose::Identity());
+  const ScaleBias none = compute_scale_bias(still, still);
+  EXPECT_EQ(none.windows, 0u);
+  EXPECT_TRUE(std::isnan(none.forward_percent));
+  EXPECT_TRUE(std::isnan(none.lateral_percent));
+  EXPECT_EQ(none.body_up, Eigen::Vector3d::Zero());
+  // Standing windows are left out of a drive that stops halfway.
+  auto gt = straight_path(21, 1.0);
+  for (std::size_t i = 11; i < gt.size(); ++i) gt[i] = gt[10];
+  const ScaleBias half = compute_scale_bias(gt, biased(gt, 0.002, 0.0, 0.0));
+  EXPECT_EQ(half.windows, 1u);
+  EXPECT_NEAR(half.forward_percent, 0.2, 1e-9);
+  // Motion along body y fits neither convention: only the forward bias.
+  std::vector<Pose> sideways;
+  for (int i = 0; i < 21; ++i) sideways.push_back(make_pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, i, 0)));
+  const ScaleBias side = compute_scale_bias(sideways, sideways);
+  EXPECT_NEAR(side.forward_percent, 0.0, 1e-12);
+  EXPECT_TRUE(std::isnan(side.lateral_percent));
+  EXPECT_TRUE(std::isnan(side.vertical_percent));
+  EXPECT_THROW(compute_scale_bias(gt, gt, 0), std::invalid_argument);
+  EXPECT_THROW(compute_scale_bias(gt, still), std::invalid_argument);
+}
+
 TEST(EvaluateTrajectories, IdenticalTrajectoriesAreZeroEverywhere) {
   const auto gt = winding_path(1500, 0.9);
   const auto ev = evaluate_trajectories(gt, gt);
@@ -298,6 +396,10 @@ TEST(EvaluateTrajectories, IdenticalTrajectoriesAreZeroEverywhere) {
   EXPECT_NEAR(ev.ate.unaligned.rmse, 0.0, 1e-12);
   EXPECT_NEAR(ev.rpe.trans_rmse_m, 0.0, 1e-9);
   EXPECT_NEAR(ev.rpe.rot_rmse_deg, 0.0, 1e-5);
+  EXPECT_EQ(ev.bias.windows, 149u);
+  EXPECT_NEAR(ev.bias.forward_percent, 0.0, 1e-9);
+  EXPECT_NEAR(ev.bias.lateral_percent, 0.0, 1e-9);
+  EXPECT_NEAR(ev.bias.vertical_percent, 0.0, 1e-9);
 }
 
 TEST(EvaluateTrajectories, ShorterEstimateUsesCommonPrefixWithWarning) {

@@ -70,10 +70,19 @@ struct FeatureConfig {
   /// With labels, the roughness above which a point of a ground class (road,
   /// sidewalk, parking, terrain, other-ground) may be an edge feature; alpha
   /// or less: like any class, .inf: never (the ground gives only planars, as
-  /// in LeGO-LOAM). Range noise alone lifts flat ground above alpha here and
-  /// there, and such "edges" take the sector slots of real ones; 1.0 is the
-  /// value measured best (docs/odometry.md).
-  double ground_edge_alpha = 1.0;
+  /// in LeGO-LOAM; the default). The ground's rough points are range noise
+  /// and the rings' footprints next to other objects: they move with the
+  /// sensor, and as edges they shortened every route (docs/odometry.md,
+  /// "Scale bias").
+  double ground_edge_alpha = kInf;
+  /// With labels, an edge feature of a pole or tree trunk stands for the
+  /// object's axis (ThinObjectAxis): the returns on a round object's near side
+  /// move with the viewpoint and shorten every route (docs/odometry.md,
+  /// "Scale bias").
+  bool thin_object_axes = true;
+  /// [m] a pole or trunk crossing wider than this radius is no thin object
+  /// (it merges with another surface): no edge feature.
+  double thin_object_max_radius = 0.5;
   double min_range = 2.5;       ///< [m] closer returns are ignored (vehicle body)
   double max_range = 120.0;     ///< [m]
   int num_beams = 0;            ///< 0 = detect 64/32/16 from the data
@@ -292,6 +301,8 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
   v("edges_per_sector", c.edges_per_sector, "N_e: edge features per sector", AtLeast{1});
   v("planars_per_sector", c.planars_per_sector, "N_p: planar features per sector", AtLeast{1});
   v("ground_edge_alpha", c.ground_edge_alpha, "with labels, min roughness of a ground edge (.inf: none)", Range{0, kInf});
+  v("thin_object_axes", c.thin_object_axes, "with labels, pole and trunk edges stand for the object's axis");
+  v("thin_object_max_radius", c.thin_object_max_radius, "[m] widest pole or trunk crossing kept as an edge", Range{0.01, 5});
   v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1", AtLeast{1});
   v("min_range", c.min_range, "min range [m]", AtLeast{0});
   v("max_range", c.max_range, "max range [m]", Above{0});

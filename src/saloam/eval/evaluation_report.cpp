@@ -83,6 +83,16 @@ nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const Evaluati
     rpe["per_frame_rot_deg"] = ev.rpe.rot_errors_deg;
   }
   j["rpe"] = rpe;
+
+  json bias;
+  bias["delta"] = ev.bias.delta;
+  bias["windows"] = ev.bias.windows;
+  bias["length_m"] = number(ev.bias.length_m);
+  bias["forward_percent"] = number(ev.bias.forward_percent);
+  bias["lateral_percent"] = number(ev.bias.lateral_percent);
+  bias["vertical_percent"] = number(ev.bias.vertical_percent);
+  bias["body_up"] = {ev.bias.body_up.x(), ev.bias.body_up.y(), ev.bias.body_up.z()};
+  j["scale_bias"] = bias;
   j["warnings"] = ev.warnings;
   return j;
 }
@@ -126,6 +136,9 @@ void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& ev
                      format_metric(ev.ate.unaligned.median, 4), format_metric(ev.ate.unaligned.max, 4));
   out << fmt::format("| RPE ({}-frame) translation RMSE | {} m |\n", ev.rpe.delta, format_metric(ev.rpe.trans_rmse_m, 6));
   out << fmt::format("| RPE ({}-frame) rotation RMSE | {} deg |\n", ev.rpe.delta, format_metric(ev.rpe.rot_rmse_deg, 6));
+  out << fmt::format("| scale bias forward / lateral / vertical ({}-frame) | {} / {} / {} % |\n", ev.bias.delta,
+                     format_metric(ev.bias.forward_percent, 4), format_metric(ev.bias.lateral_percent, 4),
+                     format_metric(ev.bias.vertical_percent, 4));
 
   out << "\n| segment length [m] | t_err [%] | r_err [deg/100 m] | segments |\n|---|---|---|---|\n";
   for (const auto& l : ev.kitti.per_length) {

@@ -39,6 +39,8 @@ struct EvaluationLabels {
 ///   rpe.{delta, trans_rmse_m, trans_mean_m, trans_median_m, trans_max_m,
 ///        rot_rmse_deg, rot_mean_deg, rot_median_deg, rot_max_deg,
 ///        per_frame_trans_m[], per_frame_rot_deg[]},
+///   scale_bias.{delta, windows, length_m, forward_percent, lateral_percent,
+///               vertical_percent, body_up (3)} (ScaleBias),
 ///   warnings[].
 /// Undefined values (e.g. KITTI errors of a path shorter than 100 m) are null.
 /// `per_frame == false` leaves out the per-pose/per-frame arrays.

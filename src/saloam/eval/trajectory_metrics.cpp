@@ -250,6 +250,66 @@ RpeMetrics compute_rpe(const std::vector<Pose>& gt, const std::vector<Pose>& est
 }
 
 // ---------------------------------------------------------------------------
+// Scale bias
+// ---------------------------------------------------------------------------
+
+namespace {
+
+/// Ground-truth motions over consecutive windows of `delta` frames: the
+/// translation of inv(G_i) G_{i+delta} for i = 0, delta, 2 delta, ...
+template <class Visit>
+void for_each_window(const std::vector<Pose>& gt, std::size_t delta, Visit&& visit) {
+  for (std::size_t i = 0; i + delta < gt.size(); i += delta) {
+    visit(i, Eigen::Vector3d(relative(gt[i], gt[i + delta]).block<3, 1>(0, 3)));
+  }
+}
+
+constexpr double kMinWindowLength = 1e-3;  // [m] a window shorter than this has no direction
+
+}  // namespace
+
+Eigen::Vector3d body_up_axis(const std::vector<Pose>& gt, std::size_t delta) {
+  if (delta == 0) throw std::invalid_argument("scale bias: delta must be positive");
+  Eigen::Vector3d along = Eigen::Vector3d::Zero();
+  for_each_window(gt, delta, [&](std::size_t, const Eigen::Vector3d& g) { along += g.cwiseAbs(); });
+  Eigen::Index axis = 0;
+  if (along.maxCoeff(&axis) <= 0.0) return Eigen::Vector3d::Zero();
+  if (axis == 2) return -Eigen::Vector3d::UnitY();  // camera frame: z forward, y down
+  if (axis == 0) return Eigen::Vector3d::UnitZ();   // LiDAR frame: x forward, z up
+  return Eigen::Vector3d::Zero();
+}
+
+ScaleBias compute_scale_bias(const std::vector<Pose>& gt, const std::vector<Pose>& est, std::size_t delta) {
+  require_same_size(gt, est, "scale bias");
+  ScaleBias bias;
+  bias.delta = delta;
+  bias.body_up = body_up_axis(gt, delta);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // forward, lateral, vertical
+  for_each_window(gt, delta, [&](std::size_t i, const Eigen::Vector3d& g) {
+    const double length = g.norm();
+    if (length < kMinWindowLength) return;
+    const Eigen::Vector3d d = Eigen::Vector3d(relative(est[i], est[i + delta]).block<3, 1>(0, 3)) - g;
+    const Eigen::Vector3d forward = g / length;
+    const Eigen::Vector3d up = bias.body_up - bias.body_up.dot(forward) * forward;
+    const double up_norm = up.norm();
+    sum[0] += d.dot(forward);
+    if (up_norm > 1e-6) {
+      const Eigen::Vector3d vertical = up / up_norm;
+      sum[1] += d.dot(vertical.cross(forward));
+      sum[2] += d.dot(vertical);
+    }
+    bias.length_m += length;
+    ++bias.windows;
+  });
+  const bool any = bias.windows > 0;
+  const bool has_up = any && bias.body_up.squaredNorm() > 0.0;
+  bias.forward_percent = any ? 100.0 * sum[0] / bias.length_m : kNaN;
+  bias.lateral_percent = has_up ? 100.0 * sum[1] / bias.length_m : kNaN;
+  bias.vertical_percent = has_up ? 100.0 * sum[2] / bias.length_m : kNaN;
+  return bias;
+}
+
+// ---------------------------------------------------------------------------
 // Everything
 // ---------------------------------------------------------------------------
 
@@ -280,6 +340,7 @@ TrajectoryEvaluation evaluate_trajectories(const std::vector<Pose>& gt, const st
   }
   ev.ate = compute_ate(gt_common, est_common, options.alignment);
   ev.rpe = compute_rpe(gt_common, est_common, options.rpe_delta);
+  ev.bias = compute_scale_bias(gt_common, est_common, options.bias_delta);
   return ev;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Trajectory accuracy metrics: the KITTI odometry benchmark's relative error,
-// the absolute trajectory error (ATE) after Umeyama alignment, and the
-// relative pose error (RPE) between consecutive frames.
+// the absolute trajectory error (ATE) after Umeyama alignment, the relative
+// pose error (RPE) between consecutive frames, and the scale bias (forward,
+// lateral, vertical) of the distance travelled.
 //
 // Pure computation, no I/O: reading files, printing and plotting live in
 // evaluation_report.hpp and in the CLI. Trajectories are matched by index
@@ -155,6 +156,45 @@ struct RpeMetrics {
 RpeMetrics compute_rpe(const std::vector<Pose>& gt, const std::vector<Pose>& est, std::size_t delta = 1);
 
 // ---------------------------------------------------------------------------
+// Scale bias
+// ---------------------------------------------------------------------------
+
+/// Systematic error of the distance travelled, along and across the motion.
+///
+/// The path is cut into consecutive windows of `delta` frames ([0, delta],
+/// [delta, 2 delta], ...). In each, g and e are the translations of the
+/// ground-truth and estimated relative motions inv(G_i) G_{i+delta} and
+/// inv(E_i) E_{i+delta} (in the first pose's body frame) and d = e - g their
+/// error, resolved in the window's motion frame: forward f = g / |g|, vertical
+/// u = the body's up axis made orthogonal to f, lateral l = u x f (to the
+/// left). Each bias is the sum of that component of d over all windows divided
+/// by the sum of |g| (the path length, measured by chords), in percent: the
+/// forward bias is -0.1 % when the estimate makes every stretch 0.1 % short.
+/// Unlike the KITTI relative error, random errors average out and only a
+/// systematic one stays. Windows with |g| < 1 mm (standing still) have no
+/// direction and are left out.
+///
+/// The body's up axis is read from the ground truth's convention: -y when it
+/// moves mostly along its body z axis (a KITTI camera frame: x right, y down,
+/// z forward), +z when mostly along body x (a LiDAR frame: x forward, y left,
+/// z up). With neither (or no motion) the lateral and vertical biases are NaN.
+struct ScaleBias {
+  std::size_t delta = 10;       ///< frames per window
+  std::size_t windows = 0;      ///< windows summed
+  double length_m = 0.0;        ///< sum of the windows' ground-truth lengths |g|
+  double forward_percent = 0.0;   ///< NaN without windows
+  double lateral_percent = 0.0;   ///< positive: the estimate drifts to the left; NaN without an up axis
+  double vertical_percent = 0.0;  ///< positive: the estimate climbs; NaN without an up axis
+  Eigen::Vector3d body_up = Eigen::Vector3d::Zero();  ///< the up axis used; zero when none was found
+};
+
+/// The up axis of the ground truth's body frame (see ScaleBias), or zero.
+Eigen::Vector3d body_up_axis(const std::vector<Pose>& gt, std::size_t delta = 10);
+
+/// ScaleBias of `est` against `gt`. Requires equal sizes and delta > 0.
+ScaleBias compute_scale_bias(const std::vector<Pose>& gt, const std::vector<Pose>& est, std::size_t delta = 10);
+
+// ---------------------------------------------------------------------------
 // Everything at once
 // ---------------------------------------------------------------------------
 
@@ -162,6 +202,7 @@ struct EvaluationOptions {
   Alignment alignment = Alignment::kSE3;
   KittiOptions kitti;
   std::size_t rpe_delta = 1;
+  std::size_t bias_delta = 10;  ///< frames per window of the scale bias
 };
 
 struct TrajectoryEvaluation {
@@ -172,6 +213,7 @@ struct TrajectoryEvaluation {
   KittiMetrics kitti;
   AteMetrics ate;
   RpeMetrics rpe;
+  ScaleBias bias;
   /// Non-fatal problems (e.g. different lengths); the caller decides how to show them.
   std::vector<std::string> warnings;
 };

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <utility>
 
 
@@ -294,6 +295,113 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
   return select_ring_features(squared_gaps(ring), roughness, unreliable, config, not_edge);
 }
 
+bool is_thin_round(std::uint16_t static_class_id) {
+  return static_class_id == cls::kPole || static_class_id == cls::kTrunk;
+}
+
+namespace {
+/// Horizontal angle between two points seen from the sensor [rad].
+double azimuth_between(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::abs(std::atan2(a.x() * b.y() - a.y() * b.x(), a.x() * b.x() + a.y() * b.y()));
+}
+
+/// Mean of sqrt(r^2 - x^2) over x in [s - h, s + h] within [-r, r]: how far
+/// in front of a disc's centre a ray at lateral offset s (known to +-h) meets it.
+double mean_chord_depth(double r, double s, double h) {
+  const double a = std::max(s - h, -r), b = std::min(s + h, r);
+  if (b - a <= 1e-9 * r) return std::sqrt(std::max(0.0, r * r - s * s));
+  const auto antiderivative = [r](double x) {
+    return 0.5 * (x * std::sqrt(std::max(0.0, r * r - x * x)) + r * r * std::asin(std::clamp(x / r, -1.0, 1.0)));
+  };
+  return (antiderivative(b) - antiderivative(a)) / (b - a);
+}
+
+/// The mean distance from the sensor to the axis of a disc of radius r on
+/// the horizontal ray `axis_ray`, estimated by each return of [first, last].
+double axis_distance(const std::vector<Eigen::Vector3d>& ring, int first, int last, const Eigen::Vector2d& axis_ray,
+                     double radius, double half_step_width) {
+  const Eigen::Vector2d across(-axis_ray.y(), axis_ray.x());
+  double sum = 0.0;
+  for (int j = first; j <= last; ++j) {
+    const Eigen::Vector2d p = ring[j].head<2>();
+    sum += p.dot(axis_ray) + mean_chord_depth(radius, p.dot(across), half_step_width);
+  }
+  return sum / (last - first + 1);
+}
+
+double horizontal_range(const Eigen::Vector3d& p) { return p.head<2>().norm(); }
+
+/// Ring neighbours farther apart in azimuth than this many steps have no
+/// return between them.
+constexpr double kMaxStepsBetweenReturns = 2.5;
+
+/// The returns of one object crossing, ring indices [first, last], and the
+/// azimuth step between returns.
+struct Crossing {
+  int first = 0, last = 0;
+  double step = 0.0;
+};
+
+/// The crossing around ring index k: the neighbours whose horizontal ranges
+/// change by less than `max_radius` from one to the next (the near side of
+/// a disc of that radius, its silhouette's grazing returns included), or
+/// nothing when something nearer cuts it at either end.
+std::optional<Crossing> crossing_at(const std::vector<Eigen::Vector3d>& ring, int k, double max_radius) {
+  const int n = static_cast<int>(ring.size());
+  // The step: the smaller azimuth gap to a neighbour (the other may be a hole).
+  const double step = std::min(k > 0 ? azimuth_between(ring[k - 1], ring[k]) : M_PI,
+                               k + 1 < n ? azimuth_between(ring[k], ring[k + 1]) : M_PI);
+  if (!(step > 0.0) || step >= M_PI) return std::nullopt;
+  const auto adjacent = [&](int a, int b) { return azimuth_between(ring[a], ring[b]) <= kMaxStepsBetweenReturns * step; };
+  const auto same_object = [&](int a, int b) {
+    return adjacent(a, b) && std::abs(horizontal_range(ring[a]) - horizontal_range(ring[b])) < max_radius;
+  };
+  Crossing c{k, k, step};
+  while (c.first > 0 && same_object(c.first - 1, c.first)) --c.first;
+  while (c.last + 1 < n && same_object(c.last, c.last + 1)) ++c.last;
+  // Beyond each end: no return, or a farther surface; a nearer one hides part of the object.
+  const auto cut = [&](int end, int beyond) {
+    if (beyond < 0 || beyond >= n) return true;
+    return adjacent(end, beyond) && horizontal_range(ring[beyond]) < horizontal_range(ring[end]);
+  };
+  if (cut(c.first, c.first - 1) || cut(c.last, c.last + 1)) return std::nullopt;
+  if (c.last > c.first) c.step = azimuth_between(ring[c.first], ring[c.last]) / (c.last - c.first);
+  return c;
+}
+}  // namespace
+
+std::optional<ThinObjectAxis> thin_object_axis(const std::vector<Eigen::Vector3d>& ring, int k, double max_radius) {
+  if (k < 0 || k >= static_cast<int>(ring.size()) || ring.size() < 2) return std::nullopt;
+  const auto crossing = crossing_at(ring, k, max_radius);
+  if (!crossing) return std::nullopt;
+  const auto [first, last, step] = *crossing;
+  const int count = last - first + 1;
+  const Eigen::Vector2d towards = ring[first].head<2>().normalized() + ring[last].head<2>().normalized();
+  if (!(towards.squaredNorm() > 0.0)) return std::nullopt;
+  const Eigen::Vector2d axis_ray = towards.normalized();
+  double distance = 0.0, mean_z = 0.0;
+  for (int j = first; j <= last; ++j) {
+    distance += horizontal_range(ring[j]);
+    mean_z += ring[j].z();
+  }
+  distance /= count;
+  mean_z /= count;
+  // The run's angular width is the chord's as seen at the axis's distance:
+  // the radius and that distance are refined once from each other.
+  double radius = 0.0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const double half_step_width = 0.5 * step * distance;
+    radius = count * half_step_width;
+    if (!(radius <= max_radius)) return std::nullopt;
+    distance = axis_distance(ring, first, last, axis_ray, radius, half_step_width);
+  }
+  ThinObjectAxis axis;
+  axis.point << distance * axis_ray, mean_z;
+  axis.central = (first + last) / 2;
+  axis.radius = radius;
+  return axis;
+}
+
 namespace {
 int compute_odometry_class(std::uint16_t raw_label) {
   if (raw_label == cls::kUnlabeled || raw_label == cls::kOutlier || is_dynamic(raw_label)) return -1;
@@ -538,7 +646,9 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
       }
     }
     const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
-    auto emit = [&](const std::vector<int>& indices, FeatureCloud& target) {
+    // An edge of a thin round object stands for its axis (ThinObjectAxis).
+    const bool axes = use_labels && config.thin_object_axes;
+    auto emit = [&](const std::vector<int>& indices, bool edges, FeatureCloud& target) {
       for (const int k : indices) {
         const std::uint32_t i = ring[k];
         int c = 0;
@@ -546,11 +656,17 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
           c = odometry_class(class_table, cloud.label[i]);
           if (c < 0) continue;
         }
+        if (edges && axes && is_thin_round(static_class(cloud.label[i]))) {
+          const auto axis = thin_object_axis(ring_points, k, config.thin_object_max_radius);
+          if (!axis) continue;
+          target.push_back(axis->point, static_cast<ClassIndex>(c), times[ring[static_cast<std::size_t>(axis->central)]]);
+          continue;
+        }
         target.push_back(ring_points[k], static_cast<ClassIndex>(c), times[i]);
       }
     };
-    emit(selection.edges, per_ring[r].edges);
-    emit(selection.planars, per_ring[r].planars);
+    emit(selection.edges, true, per_ring[r].edges);
+    emit(selection.planars, false, per_ring[r].planars);
   };
   for_each_index(rings.size(), parallel, 1, process_ring);
   auto append = [](FeatureCloud& to, const FeatureCloud& from) {

@@ -5,6 +5,7 @@
 // semantic class so that matching can stay within a class.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -113,6 +114,36 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
 /// elevation angle. Points in no ring (outside the layout's field of view,
 /// invalid) are left out.
 std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, const FeatureConfig& config);
+
+/// Poles and tree trunks: objects whose cross-section is a small disc.
+bool is_thin_round(std::uint16_t static_class_id);
+
+/// One ring's crossing of a thin round object, reduced to its axis. The
+/// crossing's returns lie on the side facing the sensor, and which of them
+/// the roughness picks depends on the range (far: any; near: the
+/// silhouette): a pole's or trunk's edge feature moves with the viewpoint,
+/// and matched to map points seen from farther back it pulls each
+/// registration back towards the previous pose (docs/odometry.md, "Scale
+/// bias"). The axis does not move. The crossing is the run of ring
+/// neighbours around the edge feature whose horizontal ranges change by less
+/// than the largest radius from one to the next; the axis's azimuth halves
+/// it; the radius is half its width (returns times azimuth step times the
+/// axis's distance: the expected count of returns on a chord is its angular
+/// width over the step); each return, at lateral offset s from the axis's
+/// ray, lies sqrt(r^2 - s^2) in front of the axis (s is known to half a
+/// step: the depth is averaged over that), and the axis's distance is the
+/// mean of the returns' estimates, free of the selection bias of the nearest
+/// return (the one with the most negative range noise).
+struct ThinObjectAxis {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< on the axis, at the crossing's mean height
+  int central = 0;      ///< ring index of the crossing's middle return
+  double radius = 0.0;  ///< [m] estimated
+};
+/// The axis for the edge feature at ring index k of a ring in azimuth
+/// order, or nothing when the crossing is wider than `max_radius` [m] (it
+/// merges with another surface) or cut by something in front of it (a nearer
+/// return next to either end).
+std::optional<ThinObjectAxis> thin_object_axis(const std::vector<Eigen::Vector3d>& ring, int k, double max_radius);
 
 /// The class index of a raw label for the odometry, or -1 when the point must
 /// not be used (dynamic classes, unlabeled, outlier).
