@@ -1,7 +1,6 @@
 #include "saloam/io/ply.hpp"
 
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -10,6 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -17,6 +17,8 @@ namespace {
 
 // One vertex record as written: 12 + 3 + 2 + 2 + 4 = 23 bytes, packed.
 constexpr std::size_t kRecordBytes = 23;
+// A map of 100 million points; larger files are not read.
+constexpr std::size_t kMaxPlyBytes = std::size_t{4} << 30;
 
 template <class T>
 void put(char*& dst, T value) {
@@ -27,9 +29,8 @@ void put(char*& dst, T value) {
 }  // namespace
 
 void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, const Pose& transform) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
+  AtomicFile file_out(file);
+  std::ostream& out = file_out.stream();
   out << "ply\nformat binary_little_endian 1.0\ncomment saloam labelled point cloud (SemanticKITTI classes)\n"
       << "element vertex " << cloud.size() << '\n'
       << "property float x\nproperty float y\nproperty float z\n"
@@ -52,12 +53,12 @@ void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, co
     put(dst, cloud.remission[i]);
   }
   out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-  if (!out) throw InputError(file, "write failed (disk full?)");
+  file_out.commit();
 }
 
 LabelledCloud read_ply(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file, "cannot open PLY file");
+  const std::string bytes = read_file(file, kMaxPlyBytes, "PLY file");
+  std::istringstream in(bytes);
   std::string line;
   std::getline(in, line);
   if (line != "ply") throw InputError(file, "not a PLY file (missing 'ply' magic)");
@@ -110,10 +111,12 @@ LabelledCloud read_ply(const std::filesystem::path& file) {
   const Property* pinst = find("instance");
   const Property* prem = find("remission");
 
-  std::vector<char> data(count * stride);
-  if (!in.read(data.data(), static_cast<std::streamsize>(data.size()))) {
+  const std::streamoff position = in.tellg();  // -1 when the header ends the file
+  const std::size_t header_end = position < 0 ? bytes.size() : static_cast<std::size_t>(position);
+  if (stride == 0 || count > (bytes.size() - header_end) / stride) {
     throw InputError(file, fmt::format("truncated PLY: expected {} vertices of {} bytes", count, stride));
   }
+  const std::string_view data(bytes.data() + header_end, count * stride);
   LabelledCloud cloud;
   cloud.has_labels = plabel != nullptr;
   cloud.reserve(count);
