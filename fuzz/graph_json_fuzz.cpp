@@ -17,9 +17,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     SALOAM_FUZZ_CHECK(graph.weights.size() == graph.edges.size());
     const int n = static_cast<int>(graph.nodes.size());
     for (const int label : graph.nodes) SALOAM_FUZZ_CHECK(label >= 0 && label < kNumNodeClasses);
-    for (const auto& c : graph.centers) SALOAM_FUZZ_CHECK(c.allFinite());
+    for (const auto& c : graph.centers) SALOAM_FUZZ_CHECK(c.allFinite() && c.cwiseAbs().maxCoeff() <= kMaxGraphCoordinate);
     for (const auto& e : graph.edges) SALOAM_FUZZ_CHECK(e[0] >= 0 && e[1] >= 0 && e[0] < n && e[1] < n);
-    for (const double w : graph.weights) SALOAM_FUZZ_CHECK(std::isfinite(w));
+    for (const double w : graph.weights) SALOAM_FUZZ_CHECK(std::isfinite(w) && std::abs(w) <= kMaxGraphEdgeWeight);
     if (graph.pose)
       for (const double v : *graph.pose) SALOAM_FUZZ_CHECK(std::isfinite(v));
     // Every index and class is the number in the file, not a wrapped one.

@@ -30,12 +30,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const LabelledCloud cloud = parse_scan(bin, bin_file, labels, label_file, &stats);
     SALOAM_FUZZ_CHECK(!cloud.empty());
     SALOAM_FUZZ_CHECK(stats.points_in_file * 16 == bin.size());
-    SALOAM_FUZZ_CHECK(cloud.size() + stats.dropped_nonfinite == stats.points_in_file);
+    SALOAM_FUZZ_CHECK(cloud.size() + stats.dropped_nonfinite + stats.dropped_out_of_range == stats.points_in_file);
     SALOAM_FUZZ_CHECK(cloud.has_labels == labels.has_value());
     SALOAM_FUZZ_CHECK(cloud.label.size() == cloud.size() && cloud.instance.size() == cloud.size() &&
                       cloud.remission.size() == cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       SALOAM_FUZZ_CHECK(cloud.points[i].allFinite());
+      SALOAM_FUZZ_CHECK(cloud.points[i].cwiseAbs().maxCoeff() <= kMaxScanCoordinate);
       SALOAM_FUZZ_CHECK(std::isfinite(cloud.remission[i]));
     }
   } catch (const InputError& e) {

@@ -19,7 +19,7 @@ namespace {
 
 struct BenchOptions {
   SourceArgs source;
-  std::optional<int> threads;  ///< --threads; else the config's odometry.threads
+  std::optional<std::string> threads;  ///< --threads; else the config's odometry.threads (checked there)
   bool no_semantics = false;
   ConfigOptions config;
 };
@@ -66,7 +66,7 @@ void print_source_stages(const BenchResult& r) {
 
 int run_bench_command(BenchOptions options) {
   SaloamConfig config = options.config.resolve();
-  if (options.threads) config.odometry.threads = *options.threads;
+  if (options.threads) apply_config_option(config, "--threads", "odometry.threads", *options.threads);
   const int threads = config.odometry.threads;
   if (options.no_semantics) config.odometry.use_semantics = false;
   options.source.no_calib = true;  // the bench writes no poses: calib.txt is not needed

@@ -12,6 +12,7 @@
 #include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
@@ -19,12 +20,15 @@
 #include "saloam/core/files.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_folder.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/runs/odometry_run.hpp"
+#include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/sim/render.hpp"
 #include "saloam/sim/simulated_source.hpp"
+#include "saloam/sim/simulation_record.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sources/open_source.hpp"
 #include "saloam/viewer/viewer_page.hpp"
@@ -51,6 +55,10 @@ struct DemoOptions {
   SegmentOptions segment;  ///< --segment: the network labels the raw simulated scans
   ConfigOptions config;
 };
+
+/// What the demo writes into OUT itself (OUT/slam and OUT/sequence keep records of their own).
+const std::vector<std::string> kDemoOutputs{"eval_baseline.json", "eval_baseline.png", "odometry_baseline/poses.txt",
+                                            "odometry_baseline/poses_tum.txt"};
 
 void heading(const std::string& text) { std::cout << "\n== " << text << " ==\n" << std::flush; }
 
@@ -103,10 +111,11 @@ void print_summary(const SlamRunResult& slam, const std::optional<TrajectoryEval
   }
 }
 
-/// The 3D view of the run (as `saloam view OUT/slam`). A streamed sequence
-/// is not on disk: its ground truth comes from the simulation, and the scans
-/// the page embeds are rendered again.
-void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequence* streamed) {
+/// The 3D view of the run (as `saloam view OUT/slam`), added to the run's
+/// summary. A streamed sequence is not on disk: its ground truth comes from
+/// the simulation, and the scans the page embeds are rendered again.
+void write_view_page(OutputFolder& run_folder, const SimulatedSequence* streamed) {
+  const std::filesystem::path& run_dir = run_folder.path();
   ViewerOptions options;
   if (streamed) {
     const Pose tr = streamed->velo_to_cam();
@@ -117,6 +126,7 @@ void write_view_page(const std::filesystem::path& run_dir, const SimulatedSequen
   }
   try {
     const ViewerPageStats s = write_viewer_page(run_dir, run_dir / "view.html", options);
+    update_run_summary(run_folder);
     std::cout << fmt::format("3D view: {} ({:.1f} MB; open it in a browser)\n", (run_dir / "view.html").string(),
                              static_cast<double>(s.bytes) / 1e6);
   } catch (const InputError& e) {
@@ -148,6 +158,21 @@ DemoSource open_demo_source(const DemoOptions& options, const SaloamConfig& conf
   return source;
 }
 
+/// --reuse reads the sequence an earlier --keep-sequence left, when it is
+/// the one these options simulate (its simulation.yaml says how it was made).
+void check_kept_sequence(const DemoOptions& options, const std::filesystem::path& sequence_dir) {
+  if (!path_taken(sequence_dir / "poses.txt")) {
+    throw ConfigError(fmt::format("--reuse: {} holds no kept sequence; run the demo once with --keep-sequence",
+                                  sequence_dir.string()));
+  }
+  const std::vector<std::string> differences = simulation_differences(sequence_dir, simulation_options(options));
+  if (!differences.empty()) {
+    throw ConfigError(fmt::format("--reuse: the sequence kept in {} was simulated otherwise ({}); give the options it "
+                                  "was kept with, or leave out --reuse",
+                                  sequence_dir.string(), fmt::join(differences, "; ")));
+  }
+}
+
 /// eval_baseline.{json,png}: the label-agnostic odometry against the ground truth.
 TrajectoryEvaluation evaluate_baseline(const std::filesystem::path& out, const std::vector<Pose>& ground_truth,
                                        const std::vector<Pose>& baseline) {
@@ -177,8 +202,10 @@ int run_demo(const DemoOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (uses_sgpr(parse_place_detector(config.loop.detector))) config.loop.sgpr_model = sgpr_model_path({}, config).string();
   const std::filesystem::path out(options.out);
+  OutputFolder folder(out, "demo", kDemoOutputs);
   const std::filesystem::path sequence_dir = out / "sequence";
-  const bool from_disk = options.reuse && std::filesystem::exists(sequence_dir / "poses.txt");
+  const bool from_disk = options.reuse;
+  if (from_disk) check_kept_sequence(options, sequence_dir);
 
   heading(fmt::format("1/2 SLAM on a simulated sequence: route '{}', {} beams, {} labels{}", options.sim.preset,
                       options.sim.beams,
@@ -200,8 +227,13 @@ int run_demo(const DemoOptions& options) {
     if (baseline) baseline->add(scan, t);
     if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
   };
-  const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), out / "slam", run_options);
-  if (slam.interrupted) return 130;
+  OutputFolder slam_folder = open_slam_folder(out / "slam", info);
+  const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), slam_folder, run_options);
+  if (baseline) baseline->commit();
+  if (slam.interrupted) {
+    folder.finish("interrupted");
+    return 130;
+  }
   source.frames.reset();  // stops the simulator's thread; finishes the kept sequence folder
 
   std::optional<TrajectoryEvaluation> baseline_eval;
@@ -209,7 +241,8 @@ int run_demo(const DemoOptions& options) {
   heading("2/2 summary");
   print_summary(slam, baseline_eval);
   print_outputs(slam, timer.elapsed_s(), out);
-  write_view_page(out / "slam", source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
+  write_view_page(slam_folder, source.simulated && !options.keep_sequence ? source.simulated.get() : nullptr);
+  folder.finish("complete");
   return 0;
 }
 

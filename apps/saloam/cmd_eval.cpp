@@ -11,10 +11,12 @@
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/runs/output_folder.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -65,12 +67,65 @@ void warn_if_scans_were_taken_elsewhere(const std::filesystem::path& gt_file) {
                gt_file.string(), sensor.filename().string(), sensor.string());
 }
 
+/// eval's outputs never replace its inputs, nor each other.
+void check_outputs(const EvalOptions& options) {
+  const std::pair<const char*, const std::string*> inputs[] = {
+      {"--gt", &options.gt_file}, {"--est", &options.est_file}, {"--calib", &options.calib_file}};
+  const std::pair<const char*, const std::string*> outputs[] = {{"--json", &options.json_file},
+                                                                {"--plot", &options.plot_file}};
+  for (const auto& [option, output] : outputs) {
+    for (const auto& [input_option, input] : inputs) {
+      std::error_code error;
+      if (output->empty() || input->empty() || !std::filesystem::equivalent(*output, *input, error)) continue;
+      throw ConfigError(fmt::format("{} {} is the {} file: eval never overwrites its inputs", option, *output,
+                                    input_option));
+    }
+  }
+  if (!options.json_file.empty() && std::filesystem::path(options.json_file).lexically_normal() ==
+                                        std::filesystem::path(options.plot_file).lexically_normal()) {
+    throw ConfigError(fmt::format("--json and --plot name the same file {}", options.json_file));
+  }
+}
+
+/// `trajectory` from its `skip`-th pose on, re-based on that pose (world =
+/// the first pose kept, as a run's results are).
+void drop_first(Trajectory& trajectory, std::size_t skip, const std::string& file, std::size_t first_frame) {
+  if (skip >= trajectory.size()) {
+    throw InputError(file, fmt::format("{} poses, none of them at frame {} where the other trajectory starts",
+                                       trajectory.size(), first_frame));
+  }
+  const auto begin = static_cast<std::ptrdiff_t>(skip);
+  trajectory.poses.erase(trajectory.poses.begin(), trajectory.poses.begin() + begin);
+  trajectory.timestamps.erase(trajectory.timestamps.begin(), trajectory.timestamps.begin() + begin);
+  const Pose rebase = trajectory.poses.front().inverse();
+  for (Pose& pose : trajectory.poses) pose = orthonormalized(rebase * pose);
+}
+
+/// Pairs the poses by frame: a run's result starts at the first frame its
+/// summary.json records (`odom SEQ --frames 5:` writes frames 5, 6, ...),
+/// a sequence's poses.txt at frame 0.
+void pair_by_frame(const EvalOptions& options, Trajectory& gt, Trajectory& est) {
+  const std::size_t gt_first = recorded_first_frame(options.gt_file).value_or(0);
+  const std::size_t est_first = recorded_first_frame(options.est_file).value_or(0);
+  if (gt_first == est_first) return;
+  if (est_first > gt_first) {
+    drop_first(gt, est_first - gt_first, options.gt_file, est_first);
+  } else {
+    drop_first(est, gt_first - est_first, options.est_file, gt_first);
+  }
+  spdlog::info("pairing by frame: the estimate starts at frame {}, the ground truth at frame {} (from the runs' "
+               "summary.json)",
+               est_first, gt_first);
+}
+
 int run_eval(const EvalOptions& options) {
+  check_outputs(options);
   warn_if_scans_were_taken_elsewhere(options.gt_file);
   TrajectoryFormat gt_format{}, est_format{};
   Trajectory gt = read_trajectory(options.gt_file, &gt_format);
   Trajectory est = read_trajectory(options.est_file, &est_format);
   make_frames_consistent(options, gt, gt_format, est, est_format);
+  pair_by_frame(options, gt, est);
 
   EvaluationOptions eval_options;
   eval_options.alignment = parse_alignment(options.alignment);  // validated by CLI11 already
@@ -103,7 +158,9 @@ const CommandRegistration kRegistration{Command{
       auto options = std::make_shared<EvalOptions>();
       app.add_option("--gt", options->gt_file, "Ground-truth trajectory (KITTI 12 columns or TUM 8 columns)")
           ->required();
-      app.add_option("--est", options->est_file, "Estimated trajectory, same format rules, matched by line index")
+      app.add_option("--est", options->est_file,
+                     "Estimated trajectory, same format rules, matched by frame (a run's result starts at the first "
+                     "frame its summary.json records, anything else at frame 0)")
           ->required();
       app.add_option("--json", options->json_file, "Write all metrics (and per-frame errors) to this JSON file");
       app.add_option("--plot", options->plot_file, "Write a top-down PNG of ground truth vs aligned estimate");

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
@@ -32,8 +33,7 @@ int run_odom(const OdomOptions& options) {
   const double median_ms = result.median_frame_ms();
   std::cout << fmt::format("{} frames, {} registration failures, median {:.1f} ms/frame ({:.1f} Hz)\n", result.frames,
                            result.registration_failures, median_ms, median_ms > 0 ? 1000.0 / median_ms : 0.0);
-  std::cout << fmt::format("wrote {}, {}, {}\n", (out_dir / "poses.txt").string(),
-                           (out_dir / "poses_tum.txt").string(), (out_dir / "timing.json").string());
+  std::cout << fmt::format("wrote {} ({})\n", out_dir.string(), fmt::join(result.files, ", "));
   if (result.interrupted) {
     spdlog::warn("interrupted: {} frames written", result.frames);
     return 130;

@@ -6,11 +6,13 @@
 #include <memory>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/eval/evaluation_report.hpp"
+#include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 
@@ -51,11 +53,13 @@ void print_summary(const SlamRunResult& r) {
   }
 }
 
-/// view.html beside the results (as `saloam view OUT_DIR`); a warning when it cannot be written.
-void write_view_page(const std::filesystem::path& out_dir) {
+/// view.html beside the results (as `saloam view OUT_DIR`), added to the
+/// summary's files; a warning when it cannot be written.
+void write_view_page(OutputFolder& folder) {
   try {
-    const ViewerPageStats s = write_viewer_page(out_dir, out_dir / "view.html");
-    std::cout << fmt::format("3D view: {} ({:.1f} MB, opens in a browser)\n", (out_dir / "view.html").string(),
+    const ViewerPageStats s = write_viewer_page(folder.path(), folder / "view.html");
+    update_run_summary(folder);
+    std::cout << fmt::format("3D view: {} ({:.1f} MB, opens in a browser)\n", (folder / "view.html").string(),
                              static_cast<double>(s.bytes) / 1e6);
   } catch (const InputError& e) {
     spdlog::warn("no view.html: {}", e.what());
@@ -64,7 +68,7 @@ void write_view_page(const std::filesystem::path& out_dir) {
 
 int run_slam_command(const SlamOptions& options) {
   SaloamConfig config = options.config.resolve();
-  if (!options.detector.empty()) config.loop.detector = options.detector;
+  if (!options.detector.empty()) apply_config_option(config, "--detector", "loop.detector", options.detector);
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
@@ -73,13 +77,11 @@ int run_slam_command(const SlamOptions& options) {
   SlamRunOptions run_options;
   run_options.write_map = !options.no_map;
 
-  const std::filesystem::path out_dir(options.out);
-  const SlamRunResult result = run_slam(*source, config, load_loop_network(config), out_dir, run_options);
+  OutputFolder folder = open_slam_folder(options.out, source->info());
+  const SlamRunResult result = run_slam(*source, config, load_loop_network(config), folder, run_options);
   print_summary(result);
-  std::cout << fmt::format("wrote {} (poses.txt, poses_odometry.txt, loops.csv, map.ply, map.png, trajectories.png, "
-                           "timing.json)\n",
-                           out_dir.string());
-  if (run_options.write_map && !result.interrupted) write_view_page(out_dir);
+  if (run_options.write_map && !result.interrupted) write_view_page(folder);
+  std::cout << fmt::format("wrote {} ({})\n", folder.path().string(), fmt::join(folder.files(), ", "));
   if (result.interrupted) {
     spdlog::warn("interrupted: results of the {} frames processed were written", result.frames);
     return 130;

@@ -13,6 +13,7 @@
 
 #include "command.hpp"
 #include "saloam/core/cancellation.hpp"
+#include "saloam/core/output_folder.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 #include "saloam/viewer/viewer_server.hpp"
 
@@ -34,9 +35,16 @@ ViewerOptions viewer_options(const ViewOptions& options) {
   return viewer;
 }
 
+/// Writes the page while no run writes the run folder (its lock, joined:
+/// the page is added to the run's record when it lies in the folder).
 int write_page(const ViewOptions& options) {
   const std::filesystem::path page =
       options.page.empty() ? std::filesystem::path(options.run_dir) / "view.html" : std::filesystem::path(options.page);
+  std::error_code error;
+  std::unique_ptr<OutputFolder> lock;
+  if (std::filesystem::is_directory(options.run_dir, error)) {
+    lock.reset(new OutputFolder(OutputFolder::join(options.run_dir, "view")));
+  }
   const ViewerPageStats s = write_viewer_page(options.run_dir, page, viewer_options(options));
   std::cout << fmt::format(
       "wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n", page.string(),
@@ -77,12 +85,15 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--out", options->page, "Page to write (default OUT_DIR/view.html)");
       app.add_option("--max-points", options->viewer.max_map_points, "Map point budget: decimated to at most this many")
           ->capture_default_str()
-          ->check(CLI::PositiveNumber);
+          ->check(non_negative_integer())
+          ->check(positive_number());
       app.add_option("--scan-points", options->viewer.points_per_scan, "Points per scan shown at the slider")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(non_negative_integer());
       app.add_option("--max-scan-points", options->viewer.max_scan_points,
                      "Budget of the scans embedded in the page, all together (0: none)")
-          ->capture_default_str();
+          ->capture_default_str()
+          ->check(non_negative_integer());
       app.add_option("--sequence", options->sequence, "Sequence folder (default: the one recorded in summary.json)");
       app.add_flag("--serve", options->serve, "Serve the page from 127.0.0.1 instead, scans loaded on demand");
       app.add_option("--port", options->port, "Port for --serve (0: any free one)")

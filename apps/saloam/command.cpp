@@ -164,7 +164,9 @@ int forward_to_program(const std::string& name, const std::vector<std::string>& 
 std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig& config) const {
   if (!enabled()) return std::nullopt;
   SegmentationStageOptions stage;
-  stage.model = read_segmenter_spec(segmenter_description_path(segmenter, projection, config));
+  const std::filesystem::path description = segmenter_description_path(segmenter, projection, config);
+  spdlog::info("segmenting with {}", description.string());
+  stage.model = read_segmenter_spec(description);
   stage.plugin = segmentation_plugin_path();
   stage.rings = config.odometry.features;
   stage.workers = config.segmentation.workers;

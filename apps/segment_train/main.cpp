@@ -21,6 +21,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/train/data_recipe.hpp"
 #include "saloam/train/segment_trainer.hpp"
 
@@ -49,10 +50,7 @@ std::array<int, 3> parse_widths(const std::string& text) {
 /// The recipe of a run, with absolute paths, kept in the output folder so
 /// that --resume needs nothing else (JSON is YAML).
 void keep_recipe(const fs::path& out, const DataRecipe& recipe) {
-  create_folder(out);
-  std::ofstream file(out / "recipe.yaml");
-  file << recipe_to_json(recipe).dump(2) << '\n';
-  if (!file) throw InputError(out / "recipe.yaml", "cannot be written");
+  write_file_atomically(out / "recipe.yaml", recipe_to_json(recipe).dump(2) + '\n');
 }
 
 std::vector<TrainingScanSet> build_sequences(const std::vector<SourceSpec>& specs, const fs::path& out, bool cache) {

@@ -22,6 +22,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/train/graph_dataset.hpp"
 #include "saloam/train/sgpr_trainer.hpp"
@@ -50,10 +51,7 @@ namespace fs = std::filesystem;
 /// The recipe of a run, with absolute paths, kept in the output folder so
 /// that --resume needs nothing else (JSON is YAML: read_data_recipe reads it).
 void keep_recipe(const fs::path& out, const DataRecipe& recipe) {
-  create_folder(out);
-  std::ofstream file(out / "recipe.yaml");
-  if (!file) throw InputError(out / "recipe.yaml", "cannot create file");
-  file << recipe_to_json(recipe).dump(2) << '\n';
+  write_file_atomically(out / "recipe.yaml", recipe_to_json(recipe).dump(2) + '\n');
 }
 
 std::vector<GraphSequence> build_sequences(const std::vector<SourceSpec>& specs, const fs::path& out, bool cache) {

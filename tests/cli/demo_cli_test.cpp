@@ -65,6 +65,17 @@ TEST(DemoCli, KeepsTheSequenceWhenAskedAndReusesIt) {
   ASSERT_EQ(run_command(demo + " --reuse", &output), 0) << output;
   EXPECT_NE(output.find("reusing"), std::string::npos) << output;
   EXPECT_EQ(lines(read_text(out / "slam/poses.txt")), 6);
+
+  // The kept sequence is reused only for the options it was simulated with.
+  EXPECT_EQ(run_command(quoted(cli_path()) + " demo --out " + quoted(out) + " --frames 0:6 --beams 32 --seed 5 --reuse",
+                        &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("was simulated otherwise (beams: 16, asked for 32; seed: 1, asked for 5)"), std::string::npos)
+      << output;
+  EXPECT_EQ(run_command(quoted(cli_path()) + " demo --reuse --out " + quoted(dir / "none"), &output), 2) << output;
+  EXPECT_NE(output.find("holds no kept sequence; run the demo once with --keep-sequence"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "none/slam")) << output;
 }
 
 }  // namespace

@@ -43,6 +43,23 @@ TEST(InstallCli, InstalledProgramFindsItsConfigurationsUnderThePrefix) {
     ASSERT_EQ(run_command(quoted(program) + " sgpr-train --help", &output), 0) << output;
     EXPECT_NE(output.find("--pairs-per-epoch"), std::string::npos) << output;
   }
+
+  // With libtorch, the segmentation plugin and the shipped model install
+  // too, and the installed program segments with them (not the build tree's).
+  if (fs::exists(fs::path(SALOAM_TEST_BUILD_DIR) / "libsaloam_segment_torch.so")) {
+    EXPECT_TRUE(fs::is_regular_file(prefix / "share/saloam/models/segmenter/saloam.yaml"));
+    const fs::path seq = prefix / "seq";
+    ASSERT_EQ(run_command(quoted(program) + " -q simulate --preset urban-loop --frames 0:2 --beams 16 --out " + quoted(seq),
+                          &output),
+              0)
+        << output;
+    ASSERT_EQ(run_command("env -u SALOAM_DATA_DIR " + quoted(program) + " segment " + quoted(seq) + " --out " +
+                              quoted(prefix / "labels"),
+                          &output),
+              0)
+        << output;
+    EXPECT_NE(output.find((prefix / "share/saloam/models/segmenter/saloam.yaml").string()), std::string::npos) << output;
+  }
 }
 
 }  // namespace

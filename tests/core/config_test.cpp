@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -136,6 +138,52 @@ TEST(Config, ErrorsNameTheProblem) {
   EXPECT_THROW(load_config("/nonexistent/saloam.yaml"), InputError);
 }
 
+// yaml-cpp keeps both entries of a repeated key; which one wins is not what
+// the user meant, so a repeated key, a repeated section and a second document
+// are errors naming the file, the key and both lines.
+TEST(Config, RepeatedKeysSectionsAndDocumentsAreErrors) {
+  auto yaml_error = [](const std::string& text) -> std::string {
+    SaloamConfig c;
+    try {
+      apply_config_yaml(c, text, "twice.yaml");
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(c.odometry.threads, SaloamConfig{}.odometry.threads) << "the config changed on an error";
+      return e.what();
+    }
+    return "no error";
+  };
+  EXPECT_EQ(yaml_error("odometry:\n  threads: 2\n  threads: 3\n"),
+            "twice.yaml: 'odometry.threads' is given twice (lines 2 and 3): give each key once");
+  EXPECT_EQ(yaml_error("odometry:\n  threads: 2\nloop:\n  sigma: 0.02\nodometry:\n  deskew: false\n"),
+            "twice.yaml: 'odometry' is given twice (lines 1 and 5): give each key once");
+  EXPECT_EQ(yaml_error("odometry:\n  class_weight:\n    pole: 2\n    pole: 3\n"),
+            "twice.yaml: 'odometry.class_weight.pole' is given twice (lines 3 and 4): give each key once");
+  EXPECT_EQ(yaml_error("odometry:\n  threads: 2\n---\nodometry:\n  threads: 3\n"),
+            "twice.yaml: holds 2 YAML documents (separated by '---'); a configuration is one");
+  // One document, with or without its markers, and an empty file are fine.
+  EXPECT_EQ(yaml_error("---\nodometry:\n  threads: 2\n...\n"), "no error");
+  EXPECT_EQ(yaml_error(""), "no error");
+}
+
+// A configuration is read only from a regular file of bounded size: a device
+// or a FIFO in its place is refused at once, never read without end or waited on.
+TEST(Config, OnlyRegularFilesAreRead) {
+  EXPECT_NE(testing::input_error_of([] { (void)load_config("/dev/zero"); }).find("/dev/zero: is not a regular file"),
+            std::string::npos);
+  testing::TempDir dir;
+  const auto fifo = dir / "fifo.yaml";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_NE(testing::input_error_of([&] { (void)load_config(fifo); }).find("fifo.yaml: is not a regular file"),
+            std::string::npos);
+  EXPECT_NE(testing::input_error_of([&] { (void)load_config(dir.path()); }).find("is a directory"), std::string::npos);
+  {
+    std::ofstream big(dir / "big.yaml");
+    big << "# " << std::string(kMaxConfigBytes, 'x') << "\n";
+  }
+  EXPECT_NE(testing::input_error_of([&] { (void)load_config(dir / "big.yaml"); }).find("more than a configuration file"),
+            std::string::npos);
+}
+
 // ---- Valid ranges (issue 13: no silently wrong results) ----
 
 // The message of the ConfigError that `apply` throws; fails the test when none is thrown.
@@ -153,6 +201,19 @@ std::string config_error(Apply&& apply) {
 std::string override_error(const std::string& assignment) {
   SaloamConfig c;
   return config_error([&] { apply_config_override(c, assignment); });
+}
+
+// A command-line option bound to a key goes through the same checks as --set.
+TEST(Config, BoundOptionsAreCheckedLikeSet) {
+  SaloamConfig c;
+  const std::string error = config_error([&] { apply_config_option(c, "--threads", "odometry.threads", "-1"); });
+  EXPECT_EQ(error.rfind("--threads -1: ", 0), 0U) << error;
+  EXPECT_NE(error.find("odometry.threads"), std::string::npos) << error;
+  EXPECT_EQ(c.odometry.threads, SaloamConfig{}.odometry.threads);
+  EXPECT_NE(config_error([&] { apply_config_option(c, "--threads", "odometry.threads", "two"); }).find("wrong type"),
+            std::string::npos);
+  apply_config_option(c, "--threads", "odometry.threads", "3");
+  EXPECT_EQ(c.odometry.threads, 3);
 }
 
 // Finite values just outside a declared range, as --set text.

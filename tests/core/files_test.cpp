@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <fstream>
 
 #include "saloam/core/error.hpp"
@@ -13,6 +15,15 @@ namespace {
 namespace fs = std::filesystem;
 using testing::input_error_of;
 
+TEST(Errors, TextIsPlainAndShortWhateverTheInputHeld) {
+  const InputError nul("poses.txt", std::string("line 2: '1 0\0secret' is not a number", 36));
+  EXPECT_STREQ(nul.what(), "poses.txt: line 2: '1 0\\x00secret' is not a number");
+  const InputError huge("big.txt", "line 1: '" + std::string(10'000'000, 'x') + "' is not a number");
+  EXPECT_LT(std::string(huge.what()).size(), 700u);
+  EXPECT_NE(std::string(huge.what()).find("... (9999"), std::string::npos) << huge.what();
+  EXPECT_STREQ(ConfigError("a\tb\x1b[31m").what(), "a\tb\\x1b[31m");
+}
+
 TEST(Files, RequireFileNamesWhatIsWrong) {
   testing::TempDir dir;
   std::ofstream(dir / "a.txt") << "x";
@@ -22,6 +33,30 @@ TEST(Files, RequireFileNamesWhatIsWrong) {
   fs::create_directories(dir / "folder.txt");
   EXPECT_EQ(input_error_of([&] { require_file(dir / "folder.txt"); }),
             (dir / "folder.txt").string() + ": is a directory, not a file");
+}
+
+TEST(Files, ReadFileReadsOnlyRegularFilesWithinTheLimit) {
+  testing::TempDir dir;
+  std::ofstream(dir / "a.txt") << "12345";
+  EXPECT_EQ(read_file(dir / "a.txt", 5), "12345");
+  EXPECT_EQ(input_error_of([&] { read_file(dir / "a.txt", 4, "pose file"); }),
+            (dir / "a.txt").string() + ": is 5 bytes, more than a pose file may have (4 bytes)");
+  EXPECT_EQ(input_error_of([&] { read_file(dir / "none.txt", 10, "pose file"); }),
+            (dir / "none.txt").string() + ": pose file not found");
+  fs::create_directories(dir / "poses.txt");
+  EXPECT_EQ(input_error_of([&] { read_file(dir / "poses.txt", 10, "pose file"); }),
+            (dir / "poses.txt").string() + ": is a directory, not a pose file");
+  // A link to /dev/zero is never read without end, a FIFO never waited on.
+  fs::create_symlink("/dev/zero", dir / "zero.yaml");
+  EXPECT_EQ(input_error_of([&] { read_file(dir / "zero.yaml", 1 << 20, "configuration file"); }),
+            (dir / "zero.yaml").string() + ": is not a regular file (expected a configuration file)");
+  ASSERT_EQ(::mkfifo((dir / "fifo.yaml").c_str(), 0600), 0);
+  EXPECT_EQ(input_error_of([&] { read_file(dir / "fifo.yaml", 1 << 20, "configuration file"); }),
+            (dir / "fifo.yaml").string() + ": is not a regular file (expected a configuration file)");
+  EXPECT_TRUE(path_taken(dir / "fifo.yaml"));
+  fs::create_symlink(dir / "nowhere", dir / "dangling");
+  EXPECT_TRUE(path_taken(dir / "dangling"));
+  EXPECT_FALSE(path_taken(dir / "nowhere"));
 }
 
 TEST(Files, CreateFolderReportsThePathAndReason) {

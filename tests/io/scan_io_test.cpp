@@ -125,6 +125,20 @@ TEST(ScanIo, NonFinitePointsAreDroppedAndCounted) {
   for (const auto& p : back.points) EXPECT_TRUE(p.allFinite());
 }
 
+TEST(ScanIo, AbsurdlyDistantPointsAreDroppedAndCounted) {
+  testing::TempDir dir;
+  auto cloud = make_cloud(6);
+  cloud.points[1].y() = 1e30F;   // a broken file, not a measurement
+  cloud.points[4].x() = -2e4F;   // beyond any LiDAR's range
+  write_scan_bin(dir / "far.bin", cloud);
+  ScanReadStats stats;
+  const auto back = read_scan(dir / "far.bin", std::nullopt, &stats);
+  EXPECT_EQ(stats.dropped_out_of_range, 2u);
+  EXPECT_EQ(stats.dropped_nonfinite, 0u);
+  ASSERT_EQ(back.size(), 4u);
+  for (const auto& p : back.points) EXPECT_LE(p.cwiseAbs().maxCoeff(), kMaxScanCoordinate);
+}
+
 TEST(ScanIo, AllNonFiniteIsAnError) {
   testing::TempDir dir;
   auto cloud = make_cloud(3);

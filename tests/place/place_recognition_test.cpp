@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "saloam/place/place_recognition.hpp"
 
 namespace saloam {
@@ -49,6 +51,17 @@ TEST(PrecisionRecall, PerfectSeparationAndNoPositives) {
   EXPECT_DOUBLE_EQ(none.max_f1, 0.0);
   EXPECT_TRUE(none.curve.empty());
   EXPECT_THROW((void)precision_recall(std::vector<double>{0.9}, std::vector<std::uint8_t>{}), std::invalid_argument);
+}
+
+TEST(PrecisionRecall, ANaNScoreIsRefusedNotLoopedOn) {
+  // A NaN once made the threshold loop spin for ever, allocating curve points.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)precision_recall(std::vector<double>{0.9, nan, 0.1}, std::vector<std::uint8_t>{1, 0, 1}),
+               std::invalid_argument);
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto s = precision_recall(std::vector<double>{inf, -inf, 0.5}, std::vector<std::uint8_t>{1, 0, 1});
+  EXPECT_EQ(s.curve.size(), 3U);
+  EXPECT_DOUBLE_EQ(s.max_f1, 1.0);
 }
 
 TEST(PrecisionRecall, ThinnedCurveKeepsEndsAndBestPoint) {

@@ -304,6 +304,12 @@ TEST(GraphJson, MalformedGraphsAreClearErrors) {
                 .find("edges[0] refers to a node that does not exist"),
             std::string::npos);
   EXPECT_NE(std::string(error_of("")).find("not valid JSON"), std::string::npos);
+  // Finite but absurd numbers would overflow every distance the network computes.
+  EXPECT_NE(error_of(R"({"nodes": [1], "centers": [[0,1e308,0]]})").find("centers[0] = 1e+308 is beyond +-100000"),
+            std::string::npos);
+  EXPECT_NE(error_of(R"({"nodes": [1, 2], "centers": [[0,0,0], [1,1,1]], "edges": [[0, 1]], "weights": [3e38]})")
+                .find("weights[0] = 3e+38 is beyond"),
+            std::string::npos);
   try {
     (void)read_graph_json(dir / "missing.json");
     FAIL();

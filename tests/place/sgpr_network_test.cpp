@@ -7,6 +7,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <limits>
 #include <set>
 
 #include <nlohmann/json.hpp>
@@ -197,6 +198,37 @@ TEST(SgprNetwork, GraphsWithMoreThan100NodesUseTheFirst100) {
   first.nodes.resize(100);
   first.centers.resize(100);
   EXPECT_EQ(net.embed(g), net.embed(first));
+}
+
+}  // namespace
+}  // namespace saloam
+
+namespace saloam {
+namespace {
+
+// Weights within the reader's bounds can still overflow float32 on their way
+// through the layers: the network names the model instead of returning NaN.
+TEST(SgprNetwork, AnOverflowingModelIsAnErrorNamingItNeverANaN) {
+  SgprWeights weights = read_sgpr_weights(testing::source_dir() / "models/sgpr/saloam.sgw");
+  for (auto& [name, tensor] : weights.tensors) {
+    for (float& v : tensor.values) v = 0.9F * kMaxSgprWeight;
+  }
+  weights.source = "huge.sgw";
+  const SgprNetwork network(weights);
+  SemanticGraph graph;
+  for (int i = 0; i < 30; ++i) {
+    graph.nodes.push_back(i % kNumNodeClasses);
+    graph.centers.emplace_back(2.0 * i, 40.0 - i, 0.5);
+  }
+  const std::string error = testing::input_error_of([&] { (void)network.embed(graph); });
+  EXPECT_NE(error.find("huge.sgw: the SGPR network overflows"), std::string::npos) << error;
+
+  // Centres the readers refuse are refused here too, before any arithmetic.
+  const SgprNetwork shipped = SgprNetwork::load(testing::source_dir() / "models/sgpr/saloam.sgw");
+  graph.centers[3].y() = 1e308;
+  EXPECT_THROW((void)shipped.embed(graph), std::invalid_argument);
+  graph.centers[3].y() = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW((void)shipped.embed(graph), std::invalid_argument);
 }
 
 }  // namespace

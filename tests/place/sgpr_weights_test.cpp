@@ -129,6 +129,12 @@ TEST(SgprWeights, MalformedFilesAreClearErrors) {
   weights.tensors["scoring_layer.bias"].values[0] = std::numeric_limits<float>::quiet_NaN();
   EXPECT_NE(error_of(serialize_sgpr_weights(weights)).find("non-finite"), std::string::npos);
 
+  // A finite but absurd value (3e38 makes every score NaN): not trained weights.
+  weights = parse_sgpr_weights(good, "bad.sgw");
+  weights.tensors["dgcnn_s_conv1.0.weight"].values[5] = 3e38F;
+  EXPECT_NE(error_of(serialize_sgpr_weights(weights)).find("tensor 'dgcnn_s_conv1.0.weight' holds 3e+38 at element 5"),
+            std::string::npos);
+
   // An absurd dimension (larger than the file).
   auto huge = good;
   // First record: magic(8) + count(4) + name length(4) + name + ndim(4) + dims.

@@ -130,7 +130,16 @@ TEST(SegmenterSpec, ReadsOnlySmallRegularFiles) {
     std::ofstream big(dir / "big.yaml");
     big << "format: saloam-segmenter 1\n# " << std::string(2 << 20, 'x') << '\n';
   }
-  EXPECT_NE(testing::input_error_of([&] { (void)read_segmenter_spec(dir / "big.yaml"); }).find("too large"),
+  EXPECT_NE(testing::input_error_of([&] { (void)read_segmenter_spec(dir / "big.yaml"); })
+                .find("more than a segmentation model description may have"),
+            std::string::npos);
+  EXPECT_NE(testing::input_error_of([&] { (void)read_segmenter_spec("/dev/zero"); }).find("not a regular file"),
+            std::string::npos);
+  {
+    std::ofstream two(dir / "two.yaml");
+    two << kSegNet << "\n---\n" << kSegNet;
+  }
+  EXPECT_NE(testing::input_error_of([&] { (void)read_segmenter_spec(dir / "two.yaml"); }).find("holds 2 YAML documents"),
             std::string::npos);
   {
     std::ofstream ok(dir / "ok.yaml");

@@ -1,9 +1,9 @@
 #include "saloam/core/config.hpp"
 
-#include <fstream>
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <sstream>
 #include <type_traits>
 
@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -100,12 +101,28 @@ void check_member(const T& member, const R& range, const std::string& key, const
   }
 }
 
+// yaml-cpp keeps both entries of a key given twice in one map (two
+// `odometry:` blocks, a key repeated): which one wins is not what the user
+// meant to say, so a repeated key is an error naming both lines.
+void check_unique_keys(const YAML::Node& map, const std::string& prefix, const std::string& origin) {
+  std::map<std::string, int> first_line;
+  for (const auto& entry : map) {
+    const std::string name = entry.first.Scalar();
+    const int line = entry.first.Mark().line + 1;
+    const auto [it, inserted] = first_line.emplace(name, line);
+    if (inserted) continue;
+    throw ConfigError(fmt::format("{}: '{}' is given twice (lines {} and {}): give each key once", origin,
+                                  prefix.empty() ? name : prefix + "." + name, it->second, line));
+  }
+}
+
 template <class T>
 void assign(T& member, const YAML::Node& node, const std::string& key, const std::string& origin) {
   if constexpr (std::is_same_v<T, ClassValueMap>) {
     if (!node.IsMap()) {
       throw ConfigError(fmt::format("{}: '{}' must be a map of class name to number", origin, key));
     }
+    check_unique_keys(node, key, origin);
     for (const auto& entry : node) {
       const auto name = entry.first.as<std::string>();
       if (name != "default" && !semantic_class_id(name)) {
@@ -189,6 +206,7 @@ void apply_node(SaloamConfig& config, const YAML::Node& node, const std::string&
   if (!node.IsMap()) {
     throw ConfigError(fmt::format("{}: '{}' must be a map", origin, prefix.empty() ? "<root>" : prefix));
   }
+  check_unique_keys(node, prefix, origin);
   const auto sections = section_names(config);
   for (const auto& entry : node) {
     const auto name = entry.first.as<std::string>();
@@ -281,12 +299,18 @@ void validate_config(const SaloamConfig& config_in, std::string_view origin_in) 
 }
 
 void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(std::string(yaml_text));
+    documents = YAML::LoadAll(std::string(yaml_text));
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}: invalid YAML: {}", origin, e.what()));
   }
+  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
+  if (documents.size() > 1) {
+    throw ConfigError(fmt::format("{}: holds {} YAML documents (separated by '---'); a configuration is one", origin,
+                                  documents.size()));
+  }
+  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
   SaloamConfig updated = config;  // `config` stays as it was when anything is wrong
   if (!root.IsNull()) apply_node(updated, root, "", std::string(origin), collect_fields(updated));  // null: empty file
   validate_config(updated, origin);
@@ -294,12 +318,8 @@ void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::st
 }
 
 SaloamConfig load_config(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path, "cannot open configuration file");
-  std::stringstream text;
-  text << in.rdbuf();
   SaloamConfig config;
-  apply_config_yaml(config, text.str(), path.string());
+  apply_config_yaml(config, read_file(path, kMaxConfigBytes, "configuration file"), path.string());
   return config;
 }
 
@@ -307,12 +327,12 @@ namespace {
 
 // Sets one key=value in `config`, checking every field's range (the
 // cross-field rules are the caller's, once all values are set).
-void set_override(SaloamConfig& config, std::string_view assignment) {
+void set_override(SaloamConfig& config, std::string_view assignment, std::string origin = "") {
   const auto eq = assignment.find('=');
   if (eq == std::string_view::npos || eq == 0) {
     throw ConfigError(fmt::format("--set '{}': expected key=value", assignment));
   }
-  const std::string origin = fmt::format("--set {}", assignment);
+  if (origin.empty()) origin = fmt::format("--set {}", assignment);
   YAML::Node value;
   try {
     value = YAML::Load(std::string(assignment.substr(eq + 1)));
@@ -325,6 +345,14 @@ void set_override(SaloamConfig& config, std::string_view assignment) {
 }
 
 }  // namespace
+
+void apply_config_option(SaloamConfig& config, std::string_view option, std::string_view key, std::string_view value) {
+  const std::string origin = fmt::format("{} {}", option, value);
+  SaloamConfig updated = config;
+  set_override(updated, fmt::format("{}={}", key, value), origin);
+  validate_config(updated, origin);
+  config = std::move(updated);
+}
 
 void apply_config_override(SaloamConfig& config, std::string_view assignment) {
   apply_config_overrides(config, {std::string(assignment)});

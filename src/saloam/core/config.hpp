@@ -422,8 +422,13 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
 /// odometry.features.pose_time_in_sweep <= sweep_duration,
 /// loop.ssc.inner_radius < outer_radius.
 void validate_config(const SaloamConfig& config, std::string_view origin = "configuration");
+/// A configuration file may have at most this many bytes (config/saloam.yaml,
+/// every key with its comment: about 20 KB).
+inline constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
 /// Loads a YAML file over the defaults. Unknown keys, wrong types and
-/// invalid values (validate_config) are errors naming the file and the key.
+/// invalid values (validate_config) are errors naming the file and the key;
+/// a file that is not a regular file of at most kMaxConfigBytes (a FIFO,
+/// /dev/zero) is an InputError, never waited on or read without end.
 SaloamConfig load_config(const std::filesystem::path& path);
 /// Applies YAML text over `config` (used by load_config; `origin` names the
 /// source in errors). The result must pass validate_config; on any error
@@ -438,6 +443,10 @@ void apply_config_override(SaloamConfig& config, std::string_view assignment);
 /// value is range-checked as it is set, the cross-field rules once at the
 /// end, so their order does not matter.
 void apply_config_overrides(SaloamConfig& config, const std::vector<std::string>& assignments);
+/// Sets `key` to `value` for a command-line option bound to it (e.g. bench's
+/// --threads to odometry.threads): the same checks as --set, errors naming
+/// "OPTION VALUE". One validation for every way a value comes in.
+void apply_config_option(SaloamConfig& config, std::string_view option, std::string_view key, std::string_view value);
 /// The full configuration as commented YAML (every key, its value, meaning and range).
 std::string config_to_yaml(const SaloamConfig& config);
 

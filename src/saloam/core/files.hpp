@@ -13,6 +13,15 @@ namespace saloam {
 /// "<what> not found", "is a directory, not a <what>", or "is not a regular file".
 void require_file(const std::filesystem::path& file, std::string_view what = "file");
 
+/// The bytes of `file`, which must be a regular file (links followed) of at
+/// most `max_bytes`. It is opened without blocking and checked before it is
+/// read: a folder, a FIFO or a device (a link to /dev/zero) in its place is
+/// refused with an InputError naming it, never waited on or read without end.
+std::string read_file(const std::filesystem::path& file, std::size_t max_bytes, std::string_view what = "file");
+
+/// Whether something (a file, folder, link, even a dangling one) exists at `path`.
+bool path_taken(const std::filesystem::path& path);
+
 /// Creates `folder` and its parents; InputError naming the folder and the
 /// system's reason (e.g. a file of that name exists, permission denied).
 void create_folder(const std::filesystem::path& folder);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace saloam {
@@ -99,15 +100,10 @@ nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const Evaluati
 
 void write_evaluation_json(const std::filesystem::path& file, const TrajectoryEvaluation& evaluation,
                            const EvaluationLabels& labels) {
-  if (file.has_parent_path()) {
-    std::error_code ec;
-    std::filesystem::create_directories(file.parent_path(), ec);
-    if (ec) throw InputError(file, "cannot create its folder: " + ec.message());
-  }
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
-  out << evaluation_to_json(evaluation, labels).dump(2) << '\n';
-  if (!out) throw InputError(file, "write failed");
+  AtomicFile out(file);
+  out.stream() << evaluation_to_json(evaluation, labels).dump(2, ' ', false, nlohmann::json::error_handler_t::replace)
+               << '\n';
+  out.commit();
 }
 
 void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& ev, const EvaluationLabels& labels) {

@@ -6,6 +6,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
 
@@ -26,11 +27,7 @@ std::vector<std::byte> read_file_bytes(const std::filesystem::path& file, std::s
 }
 
 void write_file_bytes(const std::filesystem::path& file, std::span<const std::byte> bytes) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
-  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!out) throw InputError(file, "write failed (disk full?)");
+  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace saloam

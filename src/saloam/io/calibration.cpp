@@ -11,6 +11,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/io/text_input.hpp"
 
 namespace saloam {
@@ -48,6 +49,7 @@ Pose read_velo_to_cam(const std::filesystem::path& file, int sequence) {
 Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int sequence) {
   std::optional<Pose> keyed;  // the wanted "KEY:" line
   std::optional<Pose> bare;   // the first line with 12 numbers and no key
+  std::size_t bare_lines = 0;  // more than one: a pose file, not a calibration
   const std::string wanted = sequence >= 0 ? fmt::format("{:02d}", sequence) : std::string("Tr");
   for_each_text_line(in, file, [&](const std::string& line, std::size_t line_no) {
     if (keyed) return;
@@ -55,6 +57,7 @@ Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int s
     const std::string key = colon == std::string::npos ? "" : trimmed(line.substr(0, colon));
     const auto values = parse_values(colon == std::string::npos ? line : line.substr(colon + 1));
     const bool relevant = key == wanted || (key.empty() && values && values->size() == 12);
+    if (relevant && key.empty()) ++bare_lines;
     if (!relevant || (key.empty() && bare)) return;
     if (!values || values->size() != 12) {
       throw InputError(file, fmt::format("line {}: '{}' needs 12 numbers (3x4 row-major)", line_no,
@@ -65,15 +68,18 @@ Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int s
     (key.empty() ? bare : keyed) = T;
   });
   if (keyed) return *keyed;
+  if (bare_lines > 1) {
+    throw InputError(file, fmt::format("no '{}:' line, and {} lines of 12 numbers: a pose file, not a calibration",
+                                       wanted, bare_lines));
+  }
   if (bare) return *bare;
   throw InputError(file, sequence >= 0 ? fmt::format("no line for sequence {}", wanted)
                                        : std::string("no 'Tr:' line (velodyne to camera 0 transform)"));
 }
 
 void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
+  AtomicFile file_out(file);
+  std::ostream& out = file_out.stream();
   // KITTI odometry's rectified camera projections (sequences 00-02), so that
   // tools expecting all five lines can read the file.
   out << "P0: 7.188560000000e+02 0.000000000000e+00 6.071928000000e+02 0.000000000000e+00 0.000000000000e+00 "
@@ -91,7 +97,7 @@ void write_calib(const std::filesystem::path& file, const Pose& velo_to_cam) {
   std::array<double, 12> v{};
   pose_to_3x4(velo_to_cam, v.data());
   out << "Tr: " << fmt::format("{:.12e}", fmt::join(v, " ")) << '\n';
-  if (!out) throw InputError(file, "write failed");
+  file_out.commit();
 }
 
 std::vector<Pose> camera_to_lidar_poses(const std::vector<Pose>& camera_poses, const Pose& velo_to_cam) {

@@ -13,7 +13,8 @@
 namespace saloam {
 
 /// Reads the `Tr:` line of a KITTI calib.txt. Also accepts a file holding only
-/// 12 numbers, or lines "NN: 12 numbers" (the per-sequence list in
+/// 12 numbers on one line (several such lines are a pose file: an
+/// InputError), or lines "NN: 12 numbers" (the per-sequence list in
 /// ../shared/data/kitti/calib_velo_to_cam.txt; pass `sequence` to pick one).
 Pose read_velo_to_cam(const std::filesystem::path& file, int sequence = -1);
 /// The same over an open stream; `file` names it in errors.

@@ -1,7 +1,6 @@
 #include "saloam/io/ply.hpp"
 
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
@@ -10,6 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/binary_file.hpp"
 #include "saloam/io/text_records.hpp"
@@ -215,9 +215,8 @@ DecodedCloud read_ply_cloud(const std::filesystem::path& file, std::optional<dou
 LabelledCloud read_ply(const std::filesystem::path& file) { return read_ply_cloud(file).cloud; }
 
 void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, const Pose& transform) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
+  AtomicFile file_out(file);
+  std::ostream& out = file_out.stream();
   out << "ply\nformat binary_little_endian 1.0\ncomment saloam labelled point cloud (SemanticKITTI classes)\n"
       << "element vertex " << cloud.size() << '\n'
       << "property float x\nproperty float y\nproperty float z\n"
@@ -240,7 +239,7 @@ void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, co
     put(dst, cloud.remission[i]);
   }
   out.write(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-  if (!out) throw InputError(file, "write failed (disk full?)");
+  file_out.commit();
 }
 
 void write_ply_scan(const std::filesystem::path& file, const LabelledCloud& cloud, PlyEncoding encoding) {

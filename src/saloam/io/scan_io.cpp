@@ -2,38 +2,25 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
 namespace {
 
-std::vector<char> read_bytes(const std::filesystem::path& file) {
-  require_file(file);
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file, "cannot open for reading");
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(file, ec);
-  if (ec) throw InputError(file, fmt::format("cannot read size: {}", ec.message()));
-  std::vector<char> bytes(size);
-  if (size > 0 && !in.read(bytes.data(), static_cast<std::streamsize>(size))) {
-    throw InputError(file, "read failed");
-  }
-  return bytes;
-}
+// A scan or label file may have at most this many bytes (a 64-beam KITTI scan: 2 MB).
+constexpr std::size_t kMaxScanFileBytes = std::size_t{1} << 30;
+
+std::string read_bytes(const std::filesystem::path& file) { return read_file(file, kMaxScanFileBytes); }
 
 void write_bytes(const std::filesystem::path& file, const void* data, std::size_t size) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::binary | std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
-  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size));
-  if (!out) throw InputError(file, "write failed (disk full?)");
+  write_file_atomically(file, std::string_view(static_cast<const char*>(data), size));
 }
 
 constexpr std::size_t kPointBytes = 4 * sizeof(float);
@@ -93,6 +80,11 @@ LabelledCloud parse_scan(std::span<const std::byte> bin, const std::filesystem::
       ++local.dropped_nonfinite;
       continue;
     }
+    if (std::abs(p[0]) > kMaxScanCoordinate || std::abs(p[1]) > kMaxScanCoordinate ||
+        std::abs(p[2]) > kMaxScanCoordinate) {
+      ++local.dropped_out_of_range;
+      continue;
+    }
     const float remission = std::isfinite(p[3]) ? p[3] : 0.0f;
     std::uint16_t cls = 0, inst = 0;
     if (!labels.empty()) {
@@ -102,10 +94,16 @@ LabelledCloud parse_scan(std::span<const std::byte> bin, const std::filesystem::
     }
     cloud.push_back({p[0], p[1], p[2]}, remission, cls, inst);
   }
-  if (cloud.empty()) throw InputError(bin_file, fmt::format("no finite point among {} points", n));
+  if (cloud.empty()) {
+    throw InputError(bin_file, fmt::format("no finite point within {:g} m among {} points", kMaxScanCoordinate, n));
+  }
   if (local.dropped_nonfinite > 0) {
     spdlog::warn("{}: dropped {} of {} points with NaN/Inf coordinates", bin_file.string(),
                  local.dropped_nonfinite, n);
+  }
+  if (local.dropped_out_of_range > 0) {
+    spdlog::warn("{}: dropped {} of {} points with a coordinate beyond {:g} m", bin_file.string(),
+                 local.dropped_out_of_range, n, kMaxScanCoordinate);
   }
   if (local.unknown_labels > 0) {
     spdlog::warn("{}: {} points carry class ids unknown to SemanticKITTI", label_file.string(),
@@ -119,7 +117,7 @@ LabelledCloud read_scan(const std::filesystem::path& bin_file,
                         const std::optional<std::filesystem::path>& label_file, ScanReadStats* stats) {
   const auto bin = read_bytes(bin_file);
   check_scan_size(bin.size(), bin_file);  // the .bin file's problems first, then the .label file's
-  std::optional<std::vector<char>> labels;
+  std::optional<std::string> labels;
   if (label_file) labels = read_bytes(*label_file);
   std::optional<std::span<const std::byte>> label_bytes;
   if (labels) label_bytes = std::as_bytes(std::span<const char>(*labels));

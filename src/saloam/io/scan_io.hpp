@@ -13,14 +13,21 @@
 
 namespace saloam {
 
+/// A scan's coordinates are in the sensor frame: a point farther than this
+/// along any axis (metres; no LiDAR sees 10 km) is not a measurement.
+inline constexpr float kMaxScanCoordinate = 1.0e4F;
+
 struct ScanReadStats {
   std::size_t points_in_file = 0;
-  std::size_t dropped_nonfinite = 0;  ///< points with NaN/Inf coordinates, dropped
+  std::size_t dropped_nonfinite = 0;     ///< points with NaN/Inf coordinates, dropped
+  std::size_t dropped_out_of_range = 0;  ///< points with a coordinate beyond kMaxScanCoordinate, dropped
   std::size_t unknown_labels = 0;     ///< class ids outside the SemanticKITTI table (kept)
 };
 
 /// Reads a .bin scan and, if given, its .label file. Points with non-finite
-/// coordinates are dropped (counted in `stats`, warned once per file).
+/// coordinates or a coordinate beyond kMaxScanCoordinate (1e30 in a broken
+/// file) are dropped (counted in `stats`, warned once per file); a
+/// non-finite remission reads as 0.
 /// Throws InputError for a missing, truncated or odd-sized file, a label
 /// count that differs from the point count, or an empty scan.
 LabelledCloud read_scan(const std::filesystem::path& bin_file,

@@ -104,8 +104,10 @@ SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
   }
   if (!labels_available_) label_files_.assign(scan_files_.size(), std::nullopt);
 
+  // Absent is allowed; anything in their place (a folder, a link to a
+  // device, a FIFO) is read and refused by the reader, never taken for absent.
   const fs::path times_file = root_ / "times.txt";
-  if (fs::is_regular_file(times_file, ec)) {
+  if (path_taken(times_file)) {
     times_ = read_times(times_file);
     if (times_.size() < scan_files_.size()) {
       throw InputError(times_file, fmt::format("{} timestamps for {} scans", times_.size(), scan_files_.size()));
@@ -118,7 +120,7 @@ SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
   }
 
   const fs::path poses_file = root_ / "poses.txt";
-  if (fs::is_regular_file(poses_file, ec)) {
+  if (path_taken(poses_file)) {
     camera_poses_ = read_kitti_poses(poses_file);
     if (camera_poses_.size() < scan_files_.size()) {
       throw InputError(poses_file, fmt::format("{} poses for {} scans", camera_poses_.size(), scan_files_.size()));
@@ -134,10 +136,7 @@ LabelledCloud SequenceReader::load_scan(std::size_t index, ScanReadStats* stats)
   return read_scan(scan_files_[index], label_files_[index], stats);
 }
 
-bool SequenceReader::has_calib() const {
-  std::error_code ec;
-  return fs::is_regular_file(root_ / "calib.txt", ec);
-}
+bool SequenceReader::has_calib() const { return path_taken(root_ / "calib.txt"); }
 
 Pose SequenceReader::velo_to_cam() const {
   const fs::path calib = root_ / "calib.txt";

@@ -1,6 +1,5 @@
 #include "saloam/io/text_input.hpp"
 
-#include <fstream>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -16,11 +15,8 @@ constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
 }  // namespace
 
-std::ifstream open_text_file(const std::filesystem::path& file, std::string_view what) {
-  require_file(file, what);
-  std::ifstream in(file);
-  if (!in) throw InputError(file, "cannot open for reading");
-  return in;
+std::istringstream open_text_file(const std::filesystem::path& file, std::string_view what) {
+  return std::istringstream(read_file(file, kMaxTextFileBytes, what));
 }
 
 void for_each_text_line(const std::filesystem::path& file,

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <functional>
 #include <istream>
-#include <fstream>
+#include <sstream>
 #include <string>
 #include <string_view>
 
@@ -16,16 +16,23 @@
 
 namespace saloam {
 
+/// A text file (pose list, timestamps, calibration) may have at most this
+/// many bytes: far more than any real one (KITTI 00's poses.txt: 0.6 MB).
+inline constexpr std::size_t kMaxTextFileBytes = std::size_t{256} << 20;
+
 /// Calls on_line(line, line_no) for every line (numbered from 1). InputError
-/// when the file is missing, a directory, or unreadable.
+/// when the file is missing, not a regular file, larger than
+/// kMaxTextFileBytes, or unreadable.
 void for_each_text_line(const std::filesystem::path& file,
                         const std::function<void(const std::string& line, std::size_t line_no)>& on_line);
 /// The same over an open stream; `file` names it in errors (a read error).
 void for_each_text_line(std::istream& in, const std::filesystem::path& file,
                         const std::function<void(const std::string& line, std::size_t line_no)>& on_line);
-/// Opens `file` for reading: InputError when it is missing, a directory, or
-/// unreadable (`what` names the kind of file in the message).
-std::ifstream open_text_file(const std::filesystem::path& file, std::string_view what = "file");
+/// The text of `file` as a stream: InputError when it is missing, not a
+/// regular file (a folder, a FIFO, a device), larger than kMaxTextFileBytes
+/// or unreadable (`what` names the kind of file in the message). Nothing
+/// waits: a FIFO in its place is refused, not read.
+std::istringstream open_text_file(const std::filesystem::path& file, std::string_view what = "file");
 
 /// T with its rotation projected back onto SO(3). InputError (file, line)
 /// when the rotation is not one: ||R^T R - I|| > kRotationTolerance (a scale

@@ -10,17 +10,11 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/io/text_input.hpp"
 
 namespace saloam {
 namespace {
-
-std::ofstream create_text(const std::filesystem::path& file) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
-  return out;
-}
 
 bool is_blank_or_comment(const std::string& line) {
   const auto first = line.find_first_not_of(" \t\r");
@@ -99,9 +93,9 @@ std::string kitti_pose_line(const Pose& pose) {
 }
 
 void write_kitti_poses(const std::filesystem::path& file, const std::vector<Pose>& poses) {
-  auto out = create_text(file);
-  for (const auto& T : poses) out << kitti_pose_line(T) << '\n';
-  if (!out) throw InputError(file, "write failed");
+  AtomicFile out(file);
+  for (const auto& T : poses) out.stream() << kitti_pose_line(T) << '\n';
+  out.commit();
 }
 
 Trajectory read_tum_trajectory(const std::filesystem::path& file) {
@@ -135,10 +129,12 @@ void write_tum_trajectory(const std::filesystem::path& file, const Trajectory& t
   if (trajectory.timestamps.size() != trajectory.poses.size()) {
     throw InputError(file, "trajectory has different numbers of timestamps and poses");
   }
-  auto out = create_text(file);
-  out << "# timestamp x y z qx qy qz qw\n";
-  for (std::size_t i = 0; i < trajectory.size(); ++i) out << tum_pose_line(trajectory.timestamps[i], trajectory.poses[i]) << '\n';
-  if (!out) throw InputError(file, "write failed");
+  AtomicFile out(file);
+  out.stream() << "# timestamp x y z qx qy qz qw\n";
+  for (std::size_t i = 0; i < trajectory.size(); ++i) {
+    out.stream() << tum_pose_line(trajectory.timestamps[i], trajectory.poses[i]) << '\n';
+  }
+  out.commit();
 }
 
 Trajectory read_trajectory(const std::filesystem::path& file, TrajectoryFormat* format) {
@@ -192,9 +188,9 @@ std::vector<double> read_times(std::istream& in, const std::filesystem::path& fi
 }
 
 void write_times(const std::filesystem::path& file, const std::vector<double>& times) {
-  auto out = create_text(file);
-  for (double t : times) out << fmt::format("{:.6e}", t) << '\n';
-  if (!out) throw InputError(file, "write failed");
+  AtomicFile out(file);
+  for (double t : times) out.stream() << fmt::format("{:.6e}", t) << '\n';
+  out.commit();
 }
 
 }  // namespace saloam

@@ -2,13 +2,20 @@
 
 #include <cmath>
 #include <cstdint>
-#include <fstream>
+#include <sstream>
 #include <limits>
+
+#include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
+namespace {
+// A scan's graph is a few kB; a file this large is not one.
+constexpr std::size_t kMaxGraphBytes = std::size_t{64} << 20;
+}  // namespace
 
 nlohmann::json graph_to_json(const SemanticGraph& graph) {
   nlohmann::json j;
@@ -27,10 +34,11 @@ nlohmann::json graph_to_json(const SemanticGraph& graph) {
 SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem::path& source) {
   auto fail = [&](const std::string& problem) { throw InputError(source, "semantic graph: " + problem); };
   if (!json.is_object()) fail("top level is not a JSON object");
-  auto number = [&](const nlohmann::json& v, const std::string& what) {
+  auto number = [&](const nlohmann::json& v, const std::string& what, double limit = 0.0) {
     if (!v.is_number()) fail(what + " is not a number");
     const double d = v.get<double>();
     if (!std::isfinite(d)) fail(what + " is not finite");
+    if (limit > 0.0 && std::abs(d) > limit) fail(fmt::format("{} = {:g} is beyond +-{:g}", what, d, limit));
     return d;
   };
   // An integer's value as it is in the file: get<int>() would wrap a large
@@ -58,7 +66,8 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
     const auto& c = json["centers"][i];
     const std::string what = "centers[" + std::to_string(i) + "]";
     if (!c.is_array() || c.size() != 3) fail(what + " is not [x, y, z]");
-    graph.centers.emplace_back(number(c[0], what), number(c[1], what), number(c[2], what));
+    graph.centers.emplace_back(number(c[0], what, kMaxGraphCoordinate), number(c[1], what, kMaxGraphCoordinate),
+                               number(c[2], what, kMaxGraphCoordinate));
   }
   if (graph.centers.size() != graph.nodes.size())
     fail(std::to_string(graph.nodes.size()) + " nodes but " + std::to_string(graph.centers.size()) + " centers");
@@ -78,7 +87,7 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
   if (json.contains("weights")) {
     if (!json["weights"].is_array()) fail("'weights' is not an array");
     for (std::size_t i = 0; i < json["weights"].size(); ++i)
-      graph.weights.push_back(number(json["weights"][i], "weights[" + std::to_string(i) + "]"));
+      graph.weights.push_back(number(json["weights"][i], "weights[" + std::to_string(i) + "]", kMaxGraphEdgeWeight));
   }
   if (graph.weights.size() != graph.edges.size())
     fail(std::to_string(graph.edges.size()) + " edges but " + std::to_string(graph.weights.size()) + " weights");
@@ -93,17 +102,11 @@ SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem:
 }
 
 void write_graph_json(const std::filesystem::path& file, const SemanticGraph& graph) {
-  create_parent_folder(file);
-  std::ofstream out(file);
-  if (!out) throw InputError(file, "cannot create graph file");
-  out << graph_to_json(graph).dump() << '\n';
-  if (!out) throw InputError(file, "write error");
+  write_file_atomically(file, graph_to_json(graph).dump() + '\n');
 }
 
 SemanticGraph read_graph_json(const std::filesystem::path& file) {
-  require_file(file, "graph file");
-  std::ifstream in(file);
-  if (!in) throw InputError(file, "graph file not found or not readable");
+  std::istringstream in(read_file(file, kMaxGraphBytes, "graph file"));
   return parse_graph_json(in, file);
 }
 

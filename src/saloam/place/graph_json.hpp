@@ -16,9 +16,14 @@
 
 namespace saloam {
 
+/// An edge weight (1 - d / edge_distance) beyond this in magnitude is not one.
+inline constexpr double kMaxGraphEdgeWeight = 1.0e3;
+
 nlohmann::json graph_to_json(const SemanticGraph& graph);
 /// Throws InputError(source, ...) for missing fields, wrong types, classes
-/// outside 0..11, non-finite centres, mismatched lengths or bad edge indices.
+/// outside 0..11, non-finite numbers, centres beyond kMaxGraphCoordinate (semantic_graph.hpp),
+/// edge weights beyond kMaxGraphEdgeWeight, mismatched lengths or bad edge
+/// indices.
 SemanticGraph graph_from_json(const nlohmann::json& json, const std::filesystem::path& source);
 
 /// Writes the graph as one-line JSON (doubles printed round-trip exact).

@@ -35,6 +35,9 @@ std::vector<PlacePair> place_pairs(std::span<const Eigen::Vector3d> positions, c
 
 PrSummary precision_recall(std::span<const double> scores, std::span<const std::uint8_t> positive) {
   if (scores.size() != positive.size()) throw std::invalid_argument("precision_recall: sizes differ");
+  for (std::size_t k = 0; k < scores.size(); ++k) {
+    if (std::isnan(scores[k])) throw std::invalid_argument("precision_recall: score " + std::to_string(k) + " is NaN");
+  }
   PrSummary s;
   for (const auto p : positive) (p ? s.positives : s.negatives) += 1;
   if (s.positives == 0) return s;
@@ -46,7 +49,11 @@ PrSummary precision_recall(std::span<const double> scores, std::span<const std::
   for (std::size_t k = 0; k < order.size();) {
     const double threshold = scores[order[k]];
     // All pairs scoring exactly `threshold` are accepted together.
-    for (; k < order.size() && scores[order[k]] == threshold; ++k) (positive[order[k]] ? tp : fp) += 1;
+    // (The first always: k advances whatever the scores are.)
+    do {
+      (positive[order[k]] ? tp : fp) += 1;
+      ++k;
+    } while (k < order.size() && scores[order[k]] == threshold);
     PrPoint point{threshold, static_cast<double>(tp) / static_cast<double>(tp + fp), static_cast<double>(tp) / total_pos};
     s.curve.push_back(point);
     const double f1 = tp > 0 ? 2 * point.precision * point.recall / (point.precision + point.recall) : 0.0;

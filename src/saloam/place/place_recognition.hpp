@@ -56,6 +56,8 @@ struct PrSummary {
 
 /// Precision-recall analysis of scores (higher = more similar) against truth.
 /// Ties are handled as one threshold. With no positives all metrics are 0.
+/// A score that is not a number throws std::invalid_argument (it has no
+/// place in the order; the callers' describers never give one).
 PrSummary precision_recall(std::span<const double> scores, std::span<const std::uint8_t> positive);
 
 /// A thinned curve for plots and CSV: a point is kept when precision or

@@ -34,6 +34,11 @@ std::optional<int> node_class_of(std::uint16_t raw_label);
 /// "car", "truck", ..., "traffic-sign".
 std::string_view node_class_name(int node_class);
 
+/// A node centre coordinate (LiDAR frame, metres) beyond this is not one of a
+/// scan: graph readers refuse it, naming the file, and SGPR does not embed it
+/// (1e308 would overflow every distance the network computes).
+inline constexpr double kMaxGraphCoordinate = 1.0e5;
+
 struct SemanticGraph {
   std::vector<int> nodes;                    ///< node class 0..11 per node
   std::vector<Eigen::Vector3d> centers;      ///< centroid per node, LiDAR frame [m]

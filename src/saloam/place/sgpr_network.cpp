@@ -5,6 +5,11 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "saloam/core/error.hpp"
 
 namespace saloam {
 namespace {
@@ -25,6 +30,10 @@ void fold_batch_norm(const SgprWeights& weights, const std::string& prefix, std:
   scale.resize(channels);
   shift.resize(channels);
   for (std::uint32_t c = 0; c < channels; ++c) {
+    if (var[c] < 0.0F) {
+      throw InputError(weights.source, fmt::format("'{}.running_var' holds the negative variance {:g} at element {}",
+                                                   prefix, var[c], c));
+    }
     const double s = static_cast<double>(gamma[c]) / std::sqrt(static_cast<double>(var[c]) + kBnEpsilon);
     scale[c] = static_cast<float>(s);
     shift[c] = static_cast<float>(static_cast<double>(beta[c]) - static_cast<double>(mean[c]) * s);
@@ -32,6 +41,14 @@ void fold_batch_norm(const SgprWeights& weights, const std::string& prefix, std:
 }
 
 double sigmoid(double x) { return 1.0 / (1.0 + std::exp(-x)); }
+
+/// The error for values the network could not compute: weights within the
+/// reader's bounds can still overflow float32 on their way through the layers.
+[[noreturn]] void overflowed(const std::filesystem::path& source, std::string_view where) {
+  throw InputError(source, fmt::format("the SGPR network overflows ({} is not finite): the model's weights are too "
+                                       "large to be a trained model",
+                                       where));
+}
 
 }  // namespace
 
@@ -54,7 +71,7 @@ SgprNetwork::EdgeConvLayer SgprNetwork::load_edge_conv(const SgprWeights& weight
   return layer;
 }
 
-SgprNetwork::SgprNetwork(const SgprWeights& weights) {
+SgprNetwork::SgprNetwork(const SgprWeights& weights) : source_(weights.source) {
   constexpr std::array<std::uint32_t, 3> kIn{0, 64, 64};  // layer 1 input depends on the branch
   constexpr std::array<std::uint32_t, 3> kOut{64, 64, 32};
   for (int l = 0; l < 3; ++l) {
@@ -148,7 +165,11 @@ SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* ac
     if (label < 0 || label >= kNumNodeClasses)
       throw std::invalid_argument("SGPR: node " + std::to_string(n) + " has class " + std::to_string(label) +
                                   " (expected 0..11)");
-    input.block<3, 1>(0, n) = graph.centers[n].cast<float>();
+    const Eigen::Vector3d& centre = graph.centers[n];
+    if (!centre.allFinite() || centre.cwiseAbs().maxCoeff() > kMaxGraphCoordinate)
+      throw std::invalid_argument("SGPR: node " + std::to_string(n) + " has a centre that is not finite or beyond " +
+                                  std::to_string(static_cast<int>(kMaxGraphCoordinate)) + " m");
+    input.block<3, 1>(0, n) = centre.cast<float>();
     input(3 + label, n) = 1.0F;
   }
 
@@ -159,6 +180,11 @@ SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* ac
     xyz[l] = edge_conv(xyz_layers_[l], l == 0 ? p : xyz[l - 1],
                        (activations && l == 0) ? &activations->knn_xyz1 : nullptr);
     sem[l] = edge_conv(sem_layers_[l], l == 0 ? s : sem[l - 1], nullptr);
+    // A non-finite feature would reach the next layer's neighbour search
+    // (NaN distances break its ordering): stop here.
+    if (!xyz[l].allFinite() || !sem[l].allFinite()) {
+      overflowed(source_, fmt::format("the output of edge convolution {}", l + 1));
+    }
   }
 
   // Fusion: u = [p3, s3] per node, 1x1 conv + BN + LeakyReLU (FORMAT.md 5.3).
@@ -177,6 +203,7 @@ SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* ac
     return 1.0F / (1.0F + std::exp(-v));
   });
   const SgprEmbedding pooled = embedding * attention;
+  if (!pooled.allFinite()) overflowed(source_, "the pooled embedding");
 
   if (activations) {
     activations->input = input;
@@ -205,6 +232,7 @@ double SgprNetwork::score(const SgprEmbedding& first, const SgprEmbedding& secon
       (bilinear + head_.block_first * h1 + head_.block_second * h2 + head_.bias).cwiseMax(0.0);
   const Eigen::Matrix<double, kSgprTensorNeurons, 1> w = (head_.fc_weight * v + head_.fc_bias).cwiseMax(0.0);
   const double logit = head_.score_weight.dot(w.transpose()) + head_.score_bias;
+  if (!std::isfinite(logit)) overflowed(source_, "the score");
   const double result = sigmoid(logit);
   if (activations) {
     activations->tensor_network_out = v;
@@ -240,6 +268,7 @@ std::vector<double> SgprNetwork::logit_batch(const SgprEmbedding& query,
     const Eigen::MatrixXd v = ((q * h2).colwise() + c).cwiseMax(0.0);
     const Eigen::MatrixXd w = ((head_.fc_weight * v).colwise() + head_.fc_bias).cwiseMax(0.0);
     const Eigen::RowVectorXd l = (head_.score_weight * w).array() + head_.score_bias;
+    if (!l.allFinite()) overflowed(source_, "a score");
     for (std::size_t m = 0; m < count; ++m) logits[start + m] = l[static_cast<Eigen::Index>(m)];
   }
   return logits;

@@ -57,15 +57,19 @@ class SgprNetwork {
   /// Reads a `.sgw` file (InputError when missing or malformed).
   static SgprNetwork load(const std::filesystem::path& file);
 
-  /// The pooled embedding of a graph. Node classes must be 0..11 (throws
-  /// std::invalid_argument otherwise). A graph with more than 100 nodes is
+  /// The pooled embedding of a graph. Node classes must be 0..11 and centres
+  /// finite within kMaxGraphCoordinate (throws std::invalid_argument
+  /// otherwise). Values that overflow on the way (weights within the
+  /// reader's bounds can still be too large) are an InputError naming the
+  /// model's file; a NaN never leaves the network. A graph with more than 100 nodes is
   /// cut to its first 100 nodes (build_semantic_graph never makes more);
   /// fewer are padded with all-zero nodes, which take part in everything, as
   /// in the original.
   [[nodiscard]] SgprEmbedding embed(const SemanticGraph& graph, SgprActivations* activations = nullptr) const;
 
   /// Similarity in (0, 1) of the pair (first, second). Not symmetric: the
-  /// original evaluates one given order.
+  /// original evaluates one given order. InputError naming the model's file
+  /// when the score is not finite (as for embed; the same for the batches).
   [[nodiscard]] double score(const SgprEmbedding& first, const SgprEmbedding& second,
                              SgprPairActivations* activations = nullptr) const;
   /// The logit before the sigmoid (better resolved than the score near 0 and 1).
@@ -100,6 +104,7 @@ class SgprNetwork {
   static Eigen::MatrixXf edge_conv(const EdgeConvLayer& layer, const Eigen::MatrixXf& features,
                                    std::vector<std::array<int, kSgprNeighbours>>* knn_out);
 
+  std::filesystem::path source_;  ///< the weights' file, named in errors
   std::array<EdgeConvLayer, 3> xyz_layers_, sem_layers_;
   Eigen::MatrixXf fusion_weight_;  ///< 32 x 64
   Eigen::VectorXf fusion_scale_, fusion_shift_;

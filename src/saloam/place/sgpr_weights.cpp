@@ -2,13 +2,15 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
 namespace {
@@ -16,6 +18,8 @@ namespace {
 constexpr char kMagic[8] = {'S', 'G', 'P', 'R', 'W', '0', '0', '1'};
 // Far more than the 43 tensors of SGPR; guards against garbage counts.
 constexpr std::uint32_t kMaxTensors = 4096;
+// SGPR's weights are 0.3 MB; a file this large is not a model of it.
+constexpr std::size_t kMaxWeightsBytes = std::size_t{256} << 20;
 
 std::string shape_text(const std::vector<std::uint32_t>& dims) {
   std::ostringstream out;
@@ -114,6 +118,10 @@ SgprWeights parse_sgpr_weights(std::span<const std::byte> bytes, const std::file
       std::memcpy(&value, &bits, 4);
       if (!std::isfinite(value))
         throw InputError(source, "tensor '" + name + "' holds a non-finite value at element " + std::to_string(i));
+      if (std::abs(value) > kMaxSgprWeight)
+        throw InputError(source, fmt::format("tensor '{}' holds {:g} at element {}, beyond +-{:g}: not trained "
+                                             "weights (they would overflow the network's arithmetic)",
+                                             name, value, i, kMaxSgprWeight));
       tensor.values[i] = value;
     }
     if (!weights.tensors.emplace(name, std::move(tensor)).second)
@@ -126,11 +134,7 @@ SgprWeights parse_sgpr_weights(std::span<const std::byte> bytes, const std::file
 }
 
 SgprWeights read_sgpr_weights(const std::filesystem::path& file) {
-  require_file(file, "SGPR weights file");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file, "cannot open SGPR weights file");
-  std::vector<char> raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw InputError(file, "read error");
+  const std::string raw = read_file(file, kMaxWeightsBytes, "SGPR weights file");
   return parse_sgpr_weights(std::as_bytes(std::span<const char>(raw)), file);
 }
 
@@ -160,19 +164,11 @@ void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& we
       throw std::invalid_argument("SGPR tensor '" + name + "' of shape " + shape_text(tensor.dims) + " holds " +
                                   std::to_string(tensor.values.size()) + " values");
     for (const float v : tensor.values)
-      if (!std::isfinite(v)) throw std::invalid_argument("SGPR tensor '" + name + "' holds a non-finite value");
+      if (!std::isfinite(v) || std::abs(v) > kMaxSgprWeight)
+        throw std::invalid_argument("SGPR tensor '" + name + "' holds a non-finite or absurd value");
   }
   const auto bytes = serialize_sgpr_weights(weights);
-  create_parent_folder(file);
-  std::filesystem::path partial = file;
-  partial += ".partial";
-  {
-    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(partial, "cannot create SGPR weights file");
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    if (!out) throw InputError(partial, "write error");
-  }
-  std::filesystem::rename(partial, file);
+  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace saloam

@@ -13,6 +13,10 @@
 
 namespace saloam {
 
+/// A weight beyond this in magnitude is not a trained one (SGPR's models hold
+/// values below 20; 3e38 overflows the network's float arithmetic to NaN).
+inline constexpr float kMaxSgprWeight = 1.0e6F;
+
 /// One named tensor: its dimensions (outermost first) and row-major values.
 struct SgprTensor {
   std::vector<std::uint32_t> dims;
@@ -32,7 +36,7 @@ struct SgprWeights {
 
 /// Parses the bytes of a `.sgw` file. Throws InputError(source, ...) for a
 /// wrong magic, truncated records, bad dimensions, duplicate names,
-/// non-finite values or trailing bytes.
+/// non-finite values, values beyond kMaxSgprWeight or trailing bytes.
 SgprWeights parse_sgpr_weights(std::span<const std::byte> bytes, const std::filesystem::path& source);
 
 /// Reads and parses a `.sgw` file; throws InputError when it is missing or malformed.
@@ -45,7 +49,8 @@ std::vector<std::byte> serialize_sgpr_weights(const SgprWeights& weights);
 /// Writes weights as a `.sgw` file: to a temporary file beside `file`, then
 /// renamed over it, so a reader (or an interrupted run) never sees half a
 /// file. Throws std::invalid_argument (writing nothing) when a tensor's value
-/// count does not match its dims or a value is not finite, so that nothing
+/// count does not match its dims or a value is not finite or beyond
+/// kMaxSgprWeight, so that nothing
 /// the reader would refuse is ever written; InputError naming the file when
 /// it cannot be written.
 void write_sgpr_weights(const std::filesystem::path& file, const SgprWeights& weights);

@@ -1,13 +1,12 @@
 #include "saloam/runs/odometry_run.hpp"
 
-#include <fstream>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/timing_report.hpp"
@@ -35,9 +34,7 @@ void write_timing_json(const std::filesystem::path& file, const std::vector<Fram
   for (const auto& stage : source_stages)
     j["source_stages"][stage.name] = {{"wall", stage_stats(column(stage.per_frame, &StageTime::wall_ms))},
                                       {"cpu", stage_stats(column(stage.per_frame, &StageTime::cpu_ms))}};
-  std::ofstream out(file);
-  if (!out) throw InputError(file, "cannot write timing file");
-  out << j.dump(2) << "\n";
+  write_file_atomically(file, j.dump(2) + "\n");
 }
 
 void warn_no_labels(const SourceInfo& info) {
@@ -63,12 +60,29 @@ bool OdometryRun::add(const LabelledCloud& scan, double time) {
   return ok;
 }
 
+void OdometryRun::commit() { writer_.commit(); }
+
+namespace {
+
+nlohmann::json odometry_summary(const SourceInfo& info, const OdometryConfig& config, const OdometryRunResult& result) {
+  nlohmann::json summary{{"command", "odom"},
+                         {"first_frame", info.first_frame},
+                         {"frames", result.frames},
+                         {"semantics", config.use_semantics && info.has_labels},
+                         {"camera_frame", result.camera_frame},
+                         {"registration_failures", result.registration_failures}};
+  if (info.folder) summary["sequence"] = std::filesystem::absolute(*info.folder).lexically_normal().string();
+  return summary;
+}
+
+}  // namespace
+
 OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config, const std::filesystem::path& out_dir,
                                const OdometryRunOptions& options) {
   const SourceInfo& info = source.info();
   if (config.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
-  prepare_output_folder(out_dir, info.folder);
+  OutputFolder folder = open_run_folder(out_dir, info.folder, "odom", kOdometryOutputs);
   OdometryRun run(config, out_dir, tr);
   ProgressBar progress(info.size(), options.progress_label, options.show_progress);
   for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
@@ -79,10 +93,13 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
     progress.advance();
   }
   progress.finish();
+  run.commit();
   OdometryRunResult result = run.result();
   result.timings = run.odometry().timings();
   result.interrupted = stop_requested();
   write_timing_json(out_dir / "timing.json", result.timings, source.stage_times());
+  write_run_summary(folder, odometry_summary(info, config, result));
+  result.files = folder.files();
   return result;
 }
 

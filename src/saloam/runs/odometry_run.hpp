@@ -5,8 +5,11 @@
 //                  LiDAR-frame poses when the source has no Tr (--no-calib)
 //   poses_tum.txt  LiDAR-frame poses Q_i = T_L0<-Li with timestamps (TUM)
 //   timing.json    per-stage timings
-// Each pose line is flushed as soon as it is computed: an interrupted run
-// (Ctrl-C) keeps every frame it finished.
+//   summary.json   where the frames came from (sequence, first_frame), the
+//                  counts, whether the run was interrupted, and the files written
+// Each pose line is flushed as soon as it is computed, under a temporary
+// name; the files are put in place when the frames are done: an interrupted
+// run (Ctrl-C) keeps every frame it finished, a failed one leaves no pose file.
 
 #include <cstddef>
 #include <filesystem>
@@ -36,6 +39,7 @@ struct OdometryRunResult {
   std::size_t registration_failures = 0;
   bool camera_frame = false;         ///< poses.txt uses the camera convention
   bool interrupted = false;
+  std::vector<std::string> files;    ///< written into the output folder, in order
   [[nodiscard]] double median_frame_ms() const;
   [[nodiscard]] double worst_frame_ms() const;
 };
@@ -50,6 +54,8 @@ class OdometryRun {
   /// Registers the next scan and writes its pose; false when the
   /// registration failed (too few correspondences: the prediction was kept).
   bool add(const LabelledCloud& scan, double time);
+  /// Puts the pose files in place (TrajectoryWriter::commit).
+  void commit();
   [[nodiscard]] const SemanticOdometry& odometry() const { return odometry_; }
   [[nodiscard]] const OdometryRunResult& result() const { return result_; }
 
@@ -59,16 +65,20 @@ class OdometryRun {
   OdometryRunResult result_;
 };
 
+/// What run_odometry() may write into its folder.
+inline const std::vector<std::string> kOdometryOutputs{"poses.txt", "poses_tum.txt", "timing.json", "summary.json"};
+
 /// Runs SemanticOdometry over every frame of `source`, writing into `out_dir`
-/// (created; never the source's folder) and `out_dir`/timing.json at the end.
+/// (open_run_folder(): held by this run alone, never the source's folder),
+/// then timing.json and summary.json.
 OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config, const std::filesystem::path& out_dir,
                                const OdometryRunOptions& options = {});
 
-/// timing.json: frames, Hz (median, worst frame) and mean/median/max per stage.
 /// The warning of a semantic run over a source without labels, naming --segment, --labels and --no-semantics.
 void warn_no_labels(const SourceInfo& info);
 
-/// timing.json, with the source's stages (e.g. segmentation) beside the odometry's.
+/// timing.json: frames, Hz (median, worst frame) and mean/median/max per
+/// stage, with the source's stages (e.g. segmentation) beside the odometry's.
 void write_timing_json(const std::filesystem::path& file, const std::vector<FrameTimings>& timings,
                        const std::vector<SourceStageTimes>& source_stages = {});
 

@@ -1,7 +1,6 @@
 #include "saloam/runs/place_eval_run.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <mutex>
 
 #include <fmt/format.h>
@@ -14,6 +13,8 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
+#include "saloam/runs/output_folder.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/calibration.hpp"
@@ -171,20 +172,22 @@ ScoredPairs score_pairs(const std::vector<Eigen::Vector3d>& positions, const Des
 }
 
 void write_pair_scores(const std::filesystem::path& file, const ScoredPairs& s, std::size_t first_frame) {
-  std::ofstream csv(file);
-  if (!csv) throw InputError(file, "cannot create file");
-  csv << "query,candidate,positive,score\n";
+  AtomicFile csv(file);
+  csv.stream() << "query,candidate,positive,score\n";
   for (std::size_t k = 0; k < s.pairs.size(); ++k) {
-    csv << fmt::format("{},{},{},{:.9g}\n", first_frame + s.pairs[k].query, first_frame + s.pairs[k].candidate,
-                       s.truth[k], s.scores[k]);
+    csv.stream() << fmt::format("{},{},{},{:.9g}\n", first_frame + s.pairs[k].query,
+                                first_frame + s.pairs[k].candidate, s.truth[k], s.scores[k]);
   }
+  csv.commit();
 }
 
 void write_curve(const std::filesystem::path& out, const std::string& method, const PrSummary& summary) {
-  std::ofstream csv(out / "pr_curve.csv");
-  if (!csv) throw InputError(out / "pr_curve.csv", "cannot create file");
-  csv << "threshold,precision,recall\n";
-  for (const auto& p : thin_curve(summary, 2000)) csv << fmt::format("{:.9g},{:.6f},{:.6f}\n", p.threshold, p.precision, p.recall);
+  AtomicFile csv(out / "pr_curve.csv");
+  csv.stream() << "threshold,precision,recall\n";
+  for (const auto& p : thin_curve(summary, 2000)) {
+    csv.stream() << fmt::format("{:.9g},{:.6f},{:.6f}\n", p.threshold, p.precision, p.recall);
+  }
+  csv.commit();
   Plot plot(800, 640);
   plot.set_range(0, 1, 0, 1.02, false);
   plot.set_title(fmt::format("{}: max F1 {:.3f}", method, summary.max_f1));
@@ -197,10 +200,12 @@ void write_curve(const std::filesystem::path& out, const std::string& method, co
   plot.save_png(out / "pr_curve.png");
 }
 
-void write_summary(const std::filesystem::path& file, const SourceInfo& info, const PlaceEvalOptions& options,
+void write_summary(OutputFolder& folder, const SourceInfo& info, const PlaceEvalOptions& options,
                    const PlaceEvalResult& r) {
-  nlohmann::json j{{"method", options.method},
+  nlohmann::json j{{"command", "place-eval"},
+                   {"method", options.method},
                    {"sequence", std::filesystem::absolute(info.folder.value_or(info.name)).string()},
+                   {"first_frame", info.first_frame},
                    {"frames", r.frames},
                    {"frames_left_out", r.left_out.size()},
                    {"labels", options.labels},
@@ -225,7 +230,7 @@ void write_summary(const std::filesystem::path& file, const SourceInfo& info, co
     j["mean_nodes"] = r.mean_nodes;
   }
   if (options.graphs) j["graphs"] = std::filesystem::absolute(*options.graphs).string();
-  std::ofstream(file) << j.dump(2) << '\n';
+  write_run_summary(folder, std::move(j));
 }
 
 // LiDAR positions of the ground truth (poses.txt through Tr; as given without Tr).
@@ -238,6 +243,21 @@ std::vector<Eigen::Vector3d> truth_positions(const SourceInfo& info) {
   std::vector<Eigen::Vector3d> positions;
   for (const auto& p : poses) positions.push_back(p.translation());
   return positions;
+}
+
+// An earlier run's graphs read from inside the output folder would be
+// removed by the new run's clean start before they are read.
+void check_graphs_outside(const PlaceEvalOptions& options, const std::filesystem::path& out_dir) {
+  if (!options.graphs) return;
+  std::error_code error;
+  const auto graphs = std::filesystem::weakly_canonical(*options.graphs, error);
+  const auto out = std::filesystem::weakly_canonical(out_dir, error);
+  const auto [o, g] = std::mismatch(out.begin(), out.end(), graphs.begin(), graphs.end());
+  if (o == out.end()) {
+    throw ConfigError(fmt::format("--graphs {} lies in the output folder {}, which a new run clears: copy the graphs "
+                                  "elsewhere or choose another --out",
+                                  options.graphs->string(), out_dir.string()));
+  }
 }
 
 PlaceRecognizer make_recognizer(PlaceDetector detector, const SaloamConfig& config, const PlaceEvalOptions& options) {
@@ -274,8 +294,8 @@ PlaceEvalResult run_place_eval(FrameSource& source, const SaloamConfig& config, 
                      fmt::format("no labels/ folder (give --labels DIR): {} needs semantic labels",
                                  uses_sgpr(detector) ? "SGPR" : "SSC"));
   }
-  create_folder(out_dir);
-  if (options.save_graphs) create_folder(out_dir / "graphs");
+  check_graphs_outside(options, out_dir);
+  OutputFolder folder = open_run_folder(out_dir, info.folder, "place-eval", kPlaceEvalOutputs);
   const PlaceRecognizer recognizer = make_recognizer(detector, config, options);
 
   PlaceEvalResult result;
@@ -284,10 +304,16 @@ PlaceEvalResult run_place_eval(FrameSource& source, const SaloamConfig& config, 
   for (const auto& message : d.left_out) spdlog::warn("frame left out of the evaluation: {}", message);
   result.left_out = d.left_out;
   result.interrupted = stop_requested();
-  if (result.interrupted) return result;
+  if (result.interrupted) {
+    folder.finish("interrupted");
+    return result;
+  }
   const ScoredPairs s = score_pairs(positions, d, recognizer, options);
   result.interrupted = stop_requested();
-  if (result.interrupted) return result;
+  if (result.interrupted) {
+    folder.finish("interrupted");
+    return result;
+  }
 
   if (options.save_scores) write_pair_scores(out_dir / "pair_scores.csv", s, info.first_frame);
   result.summary = precision_recall(s.scores, s.truth);
@@ -303,7 +329,7 @@ PlaceEvalResult run_place_eval(FrameSource& source, const SaloamConfig& config, 
   result.describe_wall_s = d.wall_s;
   result.score_wall_s = s.wall_s;
   write_curve(out_dir, options.method, result.summary);
-  write_summary(out_dir / "summary.json", info, options, result);
+  write_summary(folder, info, options, result);
   return result;
 }
 

@@ -10,6 +10,8 @@
 //   graphs/NNNNNN.json          with save_graphs (SGPR): every frame's graph
 //   pair_scores.csv             with save_scores: every evaluated pair's score
 // Frames are named by their number in the source's folder (first_frame + i).
+// The folder is held by the run alone and cleared of an earlier run's files
+// (runs/output_folder.hpp); summary.json is written last.
 
 #include <cstddef>
 #include <filesystem>
@@ -55,8 +57,12 @@ struct PlaceEvalResult {
   bool interrupted = false;           ///< Ctrl-C: nothing was written
 };
 
+/// What run_place_eval() may write into its folder (besides graphs/).
+inline const std::vector<std::string> kPlaceEvalOutputs{"pr_curve.csv", "pr_curve.png", "summary.json",
+                                                        "pair_scores.csv"};
+
 /// Evaluates `options.method` over every frame of `source`, writing into
-/// `out_dir` (created). Distances are between LiDAR positions (the ground
+/// `out_dir` (open_run_folder(); ConfigError when options.graphs lies in it). Distances are between LiDAR positions (the ground
 /// truth through the source's Tr; as given when it has none). InputError
 /// when the source has no ground truth, or no labels for a method that needs
 /// them; a frame that cannot be read is left out with a warning.

@@ -1,7 +1,6 @@
 #include "saloam/runs/slam_run.hpp"
 
 #include <algorithm>
-#include <fstream>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -10,6 +9,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/ply.hpp"
@@ -34,8 +34,8 @@ std::string pose_numbers(const Pose& T) {
 }
 
 void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, const std::vector<Pose>* gt) {
-  std::ofstream out(file);
-  if (!out) throw InputError(file, "cannot write loop file");
+  AtomicFile out_file(file);
+  std::ostream& out = out_file.stream();
   out << "query_frame,match_frame,query_keyframe,match_keyframe,travelled_m,score,sgpr_score,scancontext_score,"
          "descriptor_yaw_deg,proposed_by,guess,features,correspondences,inliers,inlier_fraction,mean_residual_m,loss_r,"
          "translation_eigenvalue,runner_up_inlier_ratio,converged,passes_loss_test,passes_normalized_test,accepted,reason,"
@@ -59,6 +59,7 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
     }
     out << '\n';
   }
+  out_file.commit();
 }
 
 void write_graph_map(const std::filesystem::path& file, const SlamSystem& slam) {
@@ -72,9 +73,7 @@ void write_graph_map(const std::filesystem::path& file, const SlamSystem& slam) 
     j["pose"] = std::vector<double>(pose, pose + 12);
     keyframes.push_back(std::move(j));
   }
-  std::ofstream out(file);
-  if (!out) throw InputError(file, "cannot write graph map");
-  out << nlohmann::json{{"frame", "LiDAR, world = first frame"}, {"keyframes", keyframes}}.dump() << '\n';
+  write_file_atomically(file, nlohmann::json{{"frame", "LiDAR, world = first frame"}, {"keyframes", keyframes}}.dump() + '\n');
 }
 
 void write_timing(const std::filesystem::path& file, const SlamSystem& slam, double seconds, double rss_mib,
@@ -102,9 +101,7 @@ void write_timing(const std::filesystem::path& file, const SlamSystem& slam, dou
   for (const auto& stage : source_stages)
     j["source_stages"][stage.name] = {{"wall", stage_stats(column(stage.per_frame, &StageTime::wall_ms))},
                                       {"cpu", stage_stats(column(stage.per_frame, &StageTime::cpu_ms))}};
-  std::ofstream out(file);
-  if (!out) throw InputError(file, "cannot write timing file");
-  out << j.dump(2) << '\n';
+  write_file_atomically(file, j.dump(2) + '\n');
 }
 
 std::vector<Eigen::Vector2d> top_down(const std::vector<Pose>& poses, std::pair<int, int> axes) {
@@ -203,18 +200,19 @@ nlohmann::json loop_summary_json(const LoopSummary& s) {
 }
 
 // Evaluates both trajectories and the loops against the ground truth (when
-// known) and writes eval_{odometry,slam}.{json,png} and summary.json, with
-// where the frames came from for `saloam view` (the source's folder and first frame).
-void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunTruth& truth,
+// known), writes eval_{odometry,slam}.{json,png} and returns the run's
+// summary, with where the frames came from for `saloam view` and `saloam
+// eval` (the source's folder and first frame).
+nlohmann::json evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunTruth& truth,
                   const std::vector<Pose>& odometry_out, const std::vector<Pose>& slam_out,
                   const std::filesystem::path& out_dir, SlamRunResult& result, const SourceInfo& origin) {
-  nlohmann::json summary{{"first_frame", origin.first_frame},
+  nlohmann::json summary{{"command", "slam"},
+                         {"first_frame", origin.first_frame},
                          {"frames", result.frames},
                          {"keyframes", result.keyframes},
                          {"detector", config.loop.detector},
                          {"loops_verified", result.loops_verified},
-                         {"loops_accepted", result.loops_accepted},
-                         {"interrupted", result.interrupted}};
+                         {"loops_accepted", result.loops_accepted}};
   if (truth.camera && result.frames >= 2) {
     result.odometry_evaluation = evaluate_trajectories(*truth.camera, odometry_out);
     result.slam_evaluation = evaluate_trajectories(*truth.camera, slam_out);
@@ -241,9 +239,7 @@ void evaluate_run(const SlamSystem& slam, const SaloamConfig& config, const RunT
     summary["loops"] = loop_summary_json(*result.loop_summary);
   }
   if (origin.folder) summary["sequence"] = std::filesystem::absolute(*origin.folder).lexically_normal().string();
-  std::ofstream out(out_dir / "summary.json");
-  if (!out) throw InputError(out_dir / "summary.json", "cannot write the run summary");
-  out << summary.dump(2) << '\n';
+  return summary;
 }
 
 void write_map_outputs(const SlamSystem& slam, const LabelledCloud& map, const std::vector<Pose>& optimized,
@@ -296,12 +292,13 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
 }
 
 // Everything written after the frame loop: loop-closed poses, timing, loops,
-// graph map, trajectories and their evaluation.
-void write_results(const SlamSystem& slam, const std::vector<Pose>& optimized, TrajectoryWriter& slam_writer,
-                   const SaloamConfig& config, const FrameSource& source, const std::optional<Pose>& tr,
-                   const std::filesystem::path& out_dir, SlamRunResult& result) {
+// graph map, trajectories and their evaluation; returns the run's summary.
+nlohmann::json write_results(const SlamSystem& slam, const std::vector<Pose>& optimized, TrajectoryWriter& slam_writer,
+                             const SaloamConfig& config, const FrameSource& source, const std::optional<Pose>& tr,
+                             const std::filesystem::path& out_dir, SlamRunResult& result) {
   const SourceInfo& info = source.info();
   for (std::size_t i = 0; i < optimized.size(); ++i) slam_writer.write(slam.timestamps().at(i), optimized[i]);
+  slam_writer.commit();
   write_timing(out_dir / "timing.json", slam, result.seconds, result.peak_rss_mib, source.stage_times());
   const RunTruth truth = run_truth(info, tr, result.frames);
   write_loops_csv(out_dir / "loops.csv", slam, truth.loop_reference());
@@ -310,17 +307,27 @@ void write_results(const SlamSystem& slam, const std::vector<Pose>& optimized, T
   const std::vector<Pose> slam_out = output_poses(optimized, tr);
   plot_trajectories(out_dir / "trajectories.png", odometry_out, slam_out, truth.camera ? &*truth.camera : nullptr,
                     slam.accepted_loops());
-  evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, info);
+  return evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, info);
 }
 
 }  // namespace
 
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
                        const std::filesystem::path& out_dir, const SlamRunOptions& options) {
+  OutputFolder folder = open_slam_folder(out_dir, source.info());
+  return run_slam(source, config, std::move(network), folder, options);
+}
+
+OutputFolder open_slam_folder(const std::filesystem::path& out_dir, const SourceInfo& source) {
+  return open_run_folder(out_dir, source.folder, "slam", kSlamOutputs);
+}
+
+SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       OutputFolder& folder, const SlamRunOptions& options) {
   const SourceInfo& info = source.info();
   if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
-  prepare_output_folder(out_dir, info.folder);
+  const std::filesystem::path& out_dir = folder.path();
 
   // A stream cannot be read again for the map: keep what the map needs as it goes by.
   const SemanticMapOptions map_options = SemanticMapOptions::from_config(config.slam);
@@ -330,17 +337,21 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
 
   SlamSystem slam(config, std::move(network));
   TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
-  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);  // removes an earlier run's now
+  TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);
   SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options));
+  odometry_writer.commit();
   const std::vector<Pose> optimized = slam.optimized_poses();
-  write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);
+  nlohmann::json summary = write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);
 
-  if (options.write_map && !result.interrupted) {
+  if (options.write_map && !stop_requested()) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)
                                         : build_semantic_map(source, optimized, map_options, map_step,
                                                              options.show_progress);
-    write_map_outputs(slam, map, optimized, out_dir);
+    if (!stop_requested()) write_map_outputs(slam, map, optimized, out_dir);
   }
+  write_run_summary(folder, std::move(summary));
+  result.interrupted = stop_requested();
+  result.files = folder.files();
   return result;
 }
 

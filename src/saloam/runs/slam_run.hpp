@@ -7,10 +7,15 @@
 //   map.ply, map.png the global semantic map rebuilt from the optimised poses, with the loop edges
 //   trajectories.png odometry, loop-closed and (when known) ground-truth trajectories
 //   timing.json      per-stage timings, Hz, memory
-//   eval_odometry.{json,png}, eval_slam.{json,png}, summary.json  with SEQ/poses.txt
+//   eval_odometry.{json,png}, eval_slam.{json,png}  with SEQ/poses.txt
 //     (loops are judged against SEQ/poses_sensor.txt when a simulated sequence has it)
-// Ctrl-C ends the frame loop; everything above is still written for the
-// frames processed.
+//   summary.json     written last: where the frames came from (sequence,
+//                    first_frame), loops and evaluation, whether the run was
+//                    interrupted, and every file the run wrote
+// Each file is put in place only when complete (core/output_file.hpp), and
+// the folder holds no earlier run's files (core/output_folder.hpp). Ctrl-C
+// ends the frame loop; everything above but the map is still written for
+// the frames processed, and summary.json says "interrupted": true.
 
 #include <cstddef>
 #include <filesystem>
@@ -20,6 +25,7 @@
 #include <vector>
 
 #include "saloam/core/config.hpp"
+#include "saloam/core/output_folder.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/frame_source.hpp"
@@ -42,6 +48,7 @@ struct SlamRunResult {
   std::size_t loops_accepted = 0;
   std::size_t loops_verified = 0;
   bool interrupted = false;
+  std::vector<std::string> files;    ///< written into the output folder, in order (summary.json last)
   double seconds = 0;                ///< wall time of the frame loop
   double median_frame_ms = 0;        ///< odometry + loop closure
   double mean_loop_ms = 0;           ///< loop closure's share per frame, amortised
@@ -56,8 +63,20 @@ struct SlamRunResult {
 /// config's loop.sgpr_model; ConfigError when it is not set.
 std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config);
 
-/// Runs SlamSystem over every frame of `source`, writing into `out_dir`
-/// (created; never the source's folder).
+/// What run_slam() may write into its folder.
+inline const std::vector<std::string> kSlamOutputs{
+    "poses.txt",     "poses_tum.txt",   "poses_odometry.txt", "poses_odometry_tum.txt", "loops.csv",
+    "graph_map.json", "map.ply",        "map.png",            "trajectories.png",       "timing.json",
+    "eval_odometry.json", "eval_odometry.png", "eval_slam.json", "eval_slam.png", "summary.json", "view.html"};
+
+/// The output folder of a SLAM run over `source` (open_run_folder()).
+OutputFolder open_slam_folder(const std::filesystem::path& out_dir, const SourceInfo& source);
+
+/// Runs SlamSystem over every frame of `source`, writing into `folder`
+/// (held by the caller, e.g. to add the viewer page under the same lock).
+SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
+                       OutputFolder& folder, const SlamRunOptions& options = {});
+/// The same, in a folder of its own (open_slam_folder()).
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
                        const std::filesystem::path& out_dir, const SlamRunOptions& options = {});
 

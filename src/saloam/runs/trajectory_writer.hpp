@@ -4,35 +4,40 @@
 //     P_i = Tr Q_i Tr^-1, so `saloam eval`, the KITTI devkit and evo compare it
 //     with poses.txt directly; LiDAR-frame poses when no Tr is known
 //   TUM (timestamp x y z qx qy qz qw): LiDAR-frame poses Q_i = T_L0<-Li
-// Each line is flushed as soon as it is written: an interrupted run keeps
-// every frame it finished. The files are created with the first pose: a run
-// that stops before its first frame (e.g. an unreadable first scan) leaves no
-// pose file that could be taken for a result.
+// The files are written under temporary names from the first pose on, each
+// line flushed as it is written, and put in place by commit() when the run's
+// frames are done (an interrupted run commits the frames it finished). A run
+// that fails, or stops before its first frame, leaves no pose file that could
+// be taken for a result.
 
 #include <filesystem>
-#include <fstream>
+#include <memory>
 #include <optional>
 #include <vector>
 
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/types.hpp"
 
 namespace saloam {
 
 class TrajectoryWriter {
  public:
-  /// Removes both files if they exist (an earlier run's); InputError when
-  /// that fails. Nothing is created yet.
+  /// Nothing is created yet.
   TrajectoryWriter(std::filesystem::path kitti_file, std::filesystem::path tum_file, std::optional<Pose> velo_to_cam);
   /// Appends one pose (LiDAR frame) and returns the pose written to the KITTI
-  /// file; the first call creates the files (InputError when it cannot).
+  /// file; the first call creates the temporary files (InputError when it
+  /// cannot), every call checks its writes.
   Pose write(double timestamp, const Pose& lidar_pose);
+  /// Puts both files in place (when a pose was written); InputError naming a
+  /// file that could not be written.
+  void commit();
 
  private:
   void open();
 
   std::filesystem::path kitti_file_, tum_file_;
   std::optional<Pose> velo_to_cam_;
-  std::ofstream kitti_, tum_;
+  std::unique_ptr<AtomicFile> kitti_, tum_;
 };
 
 /// The KITTI-file poses of LiDAR-frame poses (camera convention when Tr is given).

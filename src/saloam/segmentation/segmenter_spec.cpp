@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <set>
 #include <sstream>
 
@@ -19,7 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr std::uintmax_t kMaxSpecBytes = 1 << 20;
+constexpr std::size_t kMaxSpecBytes = std::size_t{1} << 20;
 constexpr int kMaxRows = 1024, kMaxColumns = 16384, kMaxClasses = 256, kMaxWidth = 1024;
 
 /// Reads one YAML map, refusing keys it does not know and keys given twice.
@@ -178,17 +177,10 @@ KnnOptions read_knn(const YAML::Node& node, const fs::path& file) {
   return knn;
 }
 
+// Only a regular file of at most kMaxSpecBytes: a FIFO or a device in its
+// place is refused, never waited on or read without end.
 std::string read_limited(const fs::path& file) {
-  require_file(file, "segmentation model description");
-  std::error_code error;
-  const auto size = fs::file_size(file, error);
-  if (error) throw InputError(file, "cannot read its size: " + error.message());
-  if (size > kMaxSpecBytes) throw InputError(file, fmt::format("{} bytes: too large for a model description (at most 1 MiB)", size));
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (!in && !in.eof()) throw InputError(file, "cannot be read");
-  return text.str();
+  return read_file(file, kMaxSpecBytes, "segmentation model description");
 }
 
 }  // namespace
@@ -200,12 +192,18 @@ std::vector<std::uint16_t> semantickitti_learning_classes() {
 }
 
 SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& origin) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(std::string(yaml_text));
+    documents = YAML::LoadAll(std::string(yaml_text));
   } catch (const YAML::Exception& e) {
     throw InputError(origin, fmt::format("not valid YAML (line {}): {}", e.mark.line + 1, e.msg.substr(0, 200)));
   }
+  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
+  if (documents.size() > 1) {
+    throw InputError(origin, fmt::format("holds {} YAML documents (separated by '---'); a description is one",
+                                         documents.size()));
+  }
+  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
   const MapReader r(root, "", origin, {"format", "network", "projection", "classes", "knn"});
   if (r.text("format") != kSegmenterFormat)
     r.fail("format", fmt::format("expected '{}'", kSegmenterFormat));

@@ -8,6 +8,7 @@
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/sim/simulation_record.hpp"
 
 namespace saloam {
 namespace {
@@ -46,7 +47,9 @@ SimulatedSource::SimulatedSource(const SimulatedSequence& sequence, std::size_t 
       lookahead_(std::max<std::size_t>(lookahead, 1)),
       keep_folder_(std::move(keep_folder)) {
   if (keep_folder_) {
+    kept_.reset(new OutputFolder(open_sequence_output(*keep_folder_)));
     const SequenceWriter writer(*keep_folder_);
+    write_simulation_record(*keep_folder_, sequence_.options());
     writer.write_calib(sequence_.velo_to_cam());
     writer.write_camera_poses(sequence_.camera_poses());
     writer.write_times(sequence_.times());
@@ -65,8 +68,9 @@ SimulatedSource::~SimulatedSource() {
   if (keep_folder_) {
     try {
       finish_kept_folder(rendered_);
+      kept_->finish(rendered_ == sequence_.size() ? "complete" : "interrupted");
     } catch (const std::exception&) {
-      // A destructor must not throw; the folder then keeps all poses (still readable).
+      // A destructor must not throw; the folder then keeps all poses (still readable) and its record says "failed".
     }
   }
 }

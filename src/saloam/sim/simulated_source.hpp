@@ -8,10 +8,12 @@
 #include <deque>
 #include <exception>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
 
+#include "saloam/core/output_folder.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/io/frame_source.hpp"
 #include "saloam/sim/label_noise.hpp"
@@ -24,7 +26,8 @@ namespace saloam {
 /// part; it runs beside the consumer on another core). With `keep_folder`
 /// the frames are also written there as a sequence folder, exactly as
 /// `saloam simulate` would write them (trimmed to the frames rendered when
-/// the run stops early). The worker stops when the source is destroyed; an
+/// the run stops early), the folder held as simulate holds it
+/// (open_sequence_output()). The worker stops when the source is destroyed; an
 /// error on the worker is rethrown by scan().
 class SimulatedSource final : public FrameSource {
  public:
@@ -51,6 +54,7 @@ class SimulatedSource final : public FrameSource {
   const SourceInfo info_;
   const std::size_t lookahead_;
   const std::optional<std::filesystem::path> keep_folder_;
+  std::unique_ptr<OutputFolder> kept_;  ///< the keep folder's lock and record
 
   mutable std::mutex mutex_;
   std::condition_variable frame_ready_, slot_free_;

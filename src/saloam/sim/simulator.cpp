@@ -8,6 +8,7 @@
 
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
@@ -15,6 +16,7 @@
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/sim/simulation_record.hpp"
 #include "saloam/sim/trajectories.hpp"
 
 namespace fs = std::filesystem;
@@ -152,14 +154,16 @@ SimulatedFrame SimulatedSequence::render(std::size_t k) const {
 SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::path& out_dir) {
   const StageTimer timer;
   const SimulatedSequence sequence(options);
+  OutputFolder folder = open_sequence_output(out_dir);
   SequenceWriter writer(out_dir);
+  write_simulation_record(out_dir, options);
   writer.write_calib(sequence.velo_to_cam());
   // Written up front so that a crash mid-way still leaves a readable sequence
   // (the reader accepts more poses than scans); trimmed on interruption.
   writer.write_camera_poses(sequence.camera_poses());
   writer.write_times(sequence.times());
   const bool noisy = options.labels == LabelMode::kNoisy;
-  if (noisy) fs::create_directories(out_dir / "labels_gt");
+  if (noisy) create_folder(out_dir / "labels_gt");
 
   SimulationSummary summary;
   ProgressBar progress(sequence.size(), "simulate", options.show_progress);
@@ -196,6 +200,7 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
     summary.label_accuracy = summary.score.accuracy();
   }
   summary.seconds = timer.elapsed_s();
+  folder.finish(summary.interrupted ? "interrupted" : "complete");
   return summary;
 }
 

@@ -14,6 +14,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/calibration.hpp"
@@ -109,15 +110,7 @@ void write_cache(const fs::path& file, const nlohmann::json& key, const GraphSeq
   for (const auto& g : sequence.graphs) j["graphs"].push_back(graph_to_json(g));
   j["positions"] = nlohmann::json::array();
   for (const auto& p : sequence.positions) j["positions"].push_back({p.x(), p.y(), p.z()});
-  create_parent_folder(file);
-  fs::path partial = file;
-  partial += ".partial";
-  {
-    std::ofstream out(partial);
-    if (!out) throw InputError(partial, "cannot create graph cache");
-    out << j.dump() << '\n';
-  }
-  fs::rename(partial, file);
+  write_file_atomically(file, j.dump() + '\n');
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/hash.hpp"
 #include "saloam/core/progress.hpp"
@@ -117,11 +118,9 @@ std::optional<std::vector<TrainingScan>> read_cache(const fs::path& file, const 
 }
 
 void write_cache(const fs::path& file, const std::string& key, const std::vector<TrainingScan>& scans) {
-  create_parent_folder(file);
-  fs::path partial = file;
-  partial += ".partial";
+  AtomicFile cache(file);
   {
-    std::ofstream out(partial, std::ios::binary);
+    std::ostream& out = cache.stream();
     write_vector(out, std::vector<char>(kCacheMagic, kCacheMagic + sizeof kCacheMagic - 1));
     write_vector(out, std::vector<char>(key.begin(), key.end()));
     const std::uint64_t count = scans.size();
@@ -133,10 +132,8 @@ void write_cache(const fs::path& file, const std::string& key, const std::vector
       write_vector(out, s.target);
       write_vector(out, s.ring);
     }
-    out.close();
-    if (!out) throw InputError(partial, "cannot write the scan cache (disk full?)");
   }
-  fs::rename(partial, file);
+  cache.commit();
 }
 
 // ---- augmentation ----

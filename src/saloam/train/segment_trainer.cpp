@@ -14,6 +14,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/segmentation/torch/segnet.hpp"
@@ -434,9 +435,9 @@ void write_model(const SegmentTrainer& trainer, SegmenterSpec spec, const fs::pa
   const fs::path weights = out / (name + ".pt");
   trainer.save_model(weights);
   spec.network.weights = weights.string();
-  std::ofstream yaml(out / (name + ".yaml"));
-  yaml << "# A SegNet model trained by saloam segment-train (docs/segmentation.md).\n" << segmenter_spec_yaml(spec, out);
-  if (!yaml) throw InputError(out / (name + ".yaml"), "cannot be written");
+  write_file_atomically(out / (name + ".yaml"),
+                        "# A SegNet model trained by saloam segment-train (docs/segmentation.md).\n" +
+                            segmenter_spec_yaml(spec, out));
 }
 
 nlohmann::json projection_json(const ProjectionSpec& p) { return {{"means", p.means}, {"stds", p.stds}}; }

@@ -8,6 +8,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
 
@@ -31,18 +32,7 @@ std::mt19937_64 epoch_generator(std::uint64_t seed, int epoch) {
   return std::mt19937_64(sequence);
 }
 
-void write_json_atomically(const fs::path& file, const nlohmann::json& j) {
-  fs::path partial = file;
-  partial += ".partial";
-  {
-    std::ofstream out(partial);
-    if (!out) throw InputError(partial, "cannot create file");
-    out << j.dump(2) << '\n';
-    out.close();
-    if (!out) throw InputError(partial, "cannot be written (disk full?)");
-  }
-  fs::rename(partial, file);
-}
+void write_json_atomically(const fs::path& file, const nlohmann::json& j) { write_file_atomically(file, j.dump(2) + '\n'); }
 
 void replace_checkpoint(const fs::path& out, const std::function<void(const fs::path&)>& fill) {
   const fs::path partial = out / "checkpoint.partial";

@@ -23,7 +23,8 @@ void keep_freed_memory_for_reuse();
 /// The generator of epoch `epoch` of a run with `seed`: resuming needs no saved generator state.
 std::mt19937_64 epoch_generator(std::uint64_t seed, int epoch);
 
-/// Writes `j` to `file` through a temporary name, so a reader never sees half a file.
+/// Writes `j` to `file` through an AtomicFile (core/output_file.hpp): a reader
+/// never sees half a file, and a failed write is an InputError naming it.
 void write_json_atomically(const std::filesystem::path& file, const nlohmann::json& j);
 
 /// Writes a checkpoint: `fill(folder)` writes into a fresh `out/checkpoint.partial`,

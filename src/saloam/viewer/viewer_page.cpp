@@ -7,6 +7,8 @@
 #include <nlohmann/json.hpp>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/viewer/point_encoding.hpp"
 #include "saloam/viewer/viewer_assets.hpp"
@@ -146,7 +148,7 @@ std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, 
   ViewerPageStats local;
   ViewerPageStats& s = stats ? *stats : local;
   s = ViewerPageStats{};
-  const std::string data = script_safe(page_data(scene, options, source, s).dump());
+  const std::string data = script_safe(page_data(scene, options, source, s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   std::string page(viewer_assets::kPageTemplate);
   // Last placeholder first: every search finds its placeholder before any inserted text.
   replace_once(page, "/*SALOAM_DATA*/", data);
@@ -161,15 +163,31 @@ std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, 
   return page;
 }
 
+namespace {
+
+// The page replaces only an earlier page: never a pose file, a map or a scan
+// given by mistake as --out.
+void check_replaceable(const std::filesystem::path& page) {
+  if (!path_taken(page)) return;
+  std::error_code error;
+  if (std::filesystem::is_regular_file(page, error)) {
+    std::ifstream in(page, std::ios::binary);
+    std::string start(15, '\0');
+    in.read(start.data(), static_cast<std::streamsize>(start.size()));
+    if (in && start == "<!DOCTYPE html>") return;
+  }
+  throw InputError(page, "exists and is not a viewer page: the page never replaces another file; choose another --out");
+}
+
+}  // namespace
+
 ViewerPageStats write_viewer_page(const std::filesystem::path& run_dir, const std::filesystem::path& page,
                                   const ViewerOptions& options) {
+  check_replaceable(page);
   const ViewerScene scene = load_viewer_scene(run_dir, options);
   ViewerPageStats stats;
   const std::string html = viewer_page(scene, options, ViewerDataSource::kEmbedded, &stats);
-  std::ofstream out(page, std::ios::binary);
-  if (!out) throw InputError(page, "cannot write the viewer page");
-  out << html;
-  if (!out.flush()) throw InputError(page, "cannot write the viewer page (disk full?)");
+  write_file_atomically(page, html);
   return stats;
 }
 

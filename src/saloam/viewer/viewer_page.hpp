@@ -36,7 +36,8 @@ std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, 
                         ViewerPageStats* stats = nullptr);
 
 /// Reads the output folder of `saloam slam` and writes its self-contained
-/// page to `page` (the demo and `saloam view` call this).
+/// page to `page` (the demo and `saloam view` call this). InputError when
+/// `page` exists and is not a viewer page: it never replaces another file.
 ViewerPageStats write_viewer_page(const std::filesystem::path& run_dir, const std::filesystem::path& page,
                                   const ViewerOptions& options = {});
 

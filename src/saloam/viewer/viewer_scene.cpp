@@ -1,7 +1,6 @@
 #include "saloam/viewer/viewer_scene.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <numeric>
 #include <random>
 #include <sstream>
@@ -12,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/ply.hpp"
@@ -23,6 +23,9 @@ namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxSummaryBytes = std::size_t{64} << 20;
+constexpr std::size_t kMaxLoopFileBytes = std::size_t{256} << 20;
 
 fs::path required_file(const fs::path& run_dir, const std::string& name, const std::string& what) {
   const fs::path file = run_dir / name;
@@ -73,14 +76,16 @@ struct RunSummary {
 RunSummary read_run_summary(const fs::path& run_dir) {
   RunSummary summary;
   const fs::path file = run_dir / "summary.json";
-  if (!fs::is_regular_file(file)) return summary;
-  try {
-    const auto json = nlohmann::json::parse(std::ifstream(file));
-    if (json.contains("sequence")) summary.sequence = fs::path(json.at("sequence").get<std::string>());
-    summary.first_frame = json.value("first_frame", std::size_t{0});
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(file, fmt::format("not a summary of `saloam slam`: {}", e.what()));
+  if (!path_taken(file)) return summary;
+  const auto json = nlohmann::json::parse(read_file(file, kMaxSummaryBytes, "run summary"), nullptr, false);
+  const auto sequence = json.is_object() ? json.find("sequence") : json.end();
+  const auto first = json.is_object() ? json.find("first_frame") : json.end();
+  if (!json.is_object() || (sequence != json.end() && !sequence->is_string()) ||
+      (first != json.end() && !first->is_number_unsigned())) {
+    throw InputError(file, "not a summary of `saloam slam` (a JSON object with \"sequence\" and \"first_frame\")");
   }
+  if (sequence != json.end()) summary.sequence = fs::path(sequence->get<std::string>());
+  if (first != json.end()) summary.first_frame = first->get<std::size_t>();
   return summary;
 }
 
@@ -174,8 +179,7 @@ void attach_sequence(ViewerScene& scene, const RunSummary& summary, const Viewer
 }  // namespace
 
 std::vector<std::pair<std::size_t, std::size_t>> read_accepted_loops(const fs::path& file, std::size_t* verified) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file, "cannot read loop file");
+  std::istringstream in(read_file(file, kMaxLoopFileBytes, "loop file"));
   std::string line;
   if (!std::getline(in, line)) throw InputError(file, "empty loop file (no header)");
   const auto header = csv_fields(line);

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
+#include <ostream>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
-#include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 
 namespace saloam {
 namespace {
@@ -44,8 +46,19 @@ std::string tick_label(double v, double step) {
   return fmt::format("{:.{}f}", std::abs(v) < 1e-12 ? 0.0 : v, decimals);
 }
 
-void check_status(cairo_status_t status, const std::filesystem::path& file) {
+cairo_status_t write_to_stream(void* closure, const unsigned char* data, unsigned int length) {
+  auto& out = *static_cast<std::ostream*>(closure);
+  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(length));
+  return out ? CAIRO_STATUS_SUCCESS : CAIRO_STATUS_WRITE_ERROR;
+}
+
+// Writes the surface as a PNG through an AtomicFile: complete or absent, every write checked.
+void write_png(cairo_surface_t* surface, const std::filesystem::path& file) {
+  AtomicFile out(file);
+  const cairo_status_t status = cairo_surface_write_to_png_stream(surface, write_to_stream, &out.stream());
+  if (status == CAIRO_STATUS_WRITE_ERROR) out.flush();  // throws with the system's reason
   if (status != CAIRO_STATUS_SUCCESS) throw InputError(file, std::string("PNG write failed: ") + cairo_status_to_string(status));
+  out.commit();
 }
 
 }  // namespace
@@ -279,9 +292,8 @@ void Plot::save_png(const std::filesystem::path& file) {
   cairo_move_to(cr, width_ / 2.0 - ext.width / 2, 26);
   cairo_show_text(cr, title_.c_str());
 
-  create_parent_folder(file);
   cairo_surface_flush(impl_->surface);
-  check_status(cairo_surface_write_to_png(impl_->surface, file.c_str()), file);
+  write_png(impl_->surface, file);
 }
 
 RasterImage::RasterImage(int width_px, int height_px, Rgb background)
@@ -336,10 +348,8 @@ void RasterImage::save_png(const std::filesystem::path& file, int scale_x, int s
     }
   }
   cairo_surface_mark_dirty(surface);
-  create_parent_folder(file);
-  const auto status = cairo_surface_write_to_png(surface, file.c_str());
-  cairo_surface_destroy(surface);
-  check_status(status, file);
+  const std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> owned(surface, cairo_surface_destroy);
+  write_png(surface, file);
 }
 
 }  // namespace saloam
