@@ -1,13 +1,12 @@
 #include "saloam/core/sensor_profile.hpp"
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
 
 namespace saloam {
 namespace {
@@ -24,6 +23,24 @@ T value(const YAML::Node& map, const std::string& key, const std::filesystem::pa
     return node.as<T>();
   } catch (const YAML::Exception&) {
     throw InputError(file, fmt::format("'{}' of the sensor profile has the wrong type", key));
+  }
+}
+
+// A profile of 1024 lasers is about 10 kB.
+constexpr std::size_t kMaxProfileBytes = std::size_t{1} << 20;
+
+/// InputError when a key of the map `node` is given twice (yaml-cpp keeps
+/// either silently).
+void keys_once(const YAML::Node& node, const std::string& prefix, const std::filesystem::path& file) {
+  if (!node.IsMap()) return;
+  std::vector<std::string> keys;
+  for (const auto& entry : node) {
+    if (!entry.first.IsScalar()) throw InputError(file, "a key that is not a name");
+    const std::string key = entry.first.Scalar();
+    if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
+      throw InputError(file, fmt::format("'{}{}' is given twice: give each key once", prefix, key));
+    }
+    keys.push_back(key);
   }
 }
 
@@ -61,12 +78,20 @@ void check(const SensorProfile& p, const std::filesystem::path& file) {
 }  // namespace
 
 SensorProfile parse_sensor_profile(std::string_view yaml, const std::filesystem::path& file) {
-  YAML::Node root;
+  std::vector<YAML::Node> documents;
   try {
-    root = YAML::Load(std::string(yaml));
+    documents = YAML::LoadAll(std::string(yaml));
   } catch (const YAML::Exception& e) {
     throw InputError(file, fmt::format("invalid YAML: {}", e.what()));
   }
+  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
+  if (documents.size() > 1) {
+    throw InputError(file, fmt::format("holds {} YAML documents (separated by '---'); a sensor profile is one",
+                                       documents.size()));
+  }
+  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+  keys_once(root, "", file);
+  if (root.IsMap() && root["simulation"]) keys_once(root["simulation"], "simulation.", file);
   SensorProfile p;
   p.name = value<std::string>(root, "name", file);
   p.model = value<std::string>(root, "model", file);
@@ -88,11 +113,7 @@ SensorProfile parse_sensor_profile(std::string_view yaml, const std::filesystem:
 }
 
 SensorProfile load_sensor_profile(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file, std::filesystem::exists(file) ? "cannot read the sensor profile" : "sensor profile not found");
-  std::stringstream text;
-  text << in.rdbuf();
-  return parse_sensor_profile(text.str(), file);
+  return parse_sensor_profile(read_file(file, kMaxProfileBytes, "sensor profile"), file);
 }
 
 std::vector<SensorProfile> load_sensor_profiles(const std::filesystem::path& folder) {

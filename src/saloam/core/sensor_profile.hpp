@@ -59,8 +59,9 @@ struct SensorProfile {
 /// kMaxSensorLasers), ranges out of order or beyond 10 km, a sweep outside
 /// (0, 10] s, a start azimuth outside [-360, 360] deg, or simulation values
 /// outside their ranges (azimuth_steps [16, 8000], mount_height (0, 100] m,
-/// range_noise [0, 1] m).
+/// range_noise [0, 1] m), a key given twice, or more than one YAML document.
 SensorProfile parse_sensor_profile(std::string_view yaml, const std::filesystem::path& file);
+/// The profile in `file` (a regular file of at most 1 MiB; core/files.hpp's read_file).
 SensorProfile load_sensor_profile(const std::filesystem::path& file);
 /// Every profile in `folder` (*.yaml), ordered by name; InputError when the
 /// folder cannot be read, a file is malformed, or two files share a name.
