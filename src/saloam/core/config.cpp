@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "saloam/core/yaml_documents.hpp"
+
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
@@ -301,11 +303,10 @@ void validate_config(const SaloamConfig& config_in, std::string_view origin_in) 
 void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin) {
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(std::string(yaml_text));
+    documents = load_yaml_documents(yaml_text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}: invalid YAML: {}", origin, e.what()));
   }
-  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
   if (documents.size() > 1) {
     throw ConfigError(fmt::format("{}: holds {} YAML documents (separated by '---'); a configuration is one", origin,
                                   documents.size()));

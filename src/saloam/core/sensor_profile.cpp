@@ -7,6 +7,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/yaml_documents.hpp"
 
 namespace saloam {
 namespace {
@@ -80,11 +81,10 @@ void check(const SensorProfile& p, const std::filesystem::path& file) {
 SensorProfile parse_sensor_profile(std::string_view yaml, const std::filesystem::path& file) {
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(std::string(yaml));
+    documents = load_yaml_documents(yaml);
   } catch (const YAML::Exception& e) {
     throw InputError(file, fmt::format("invalid YAML: {}", e.what()));
   }
-  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
   if (documents.size() > 1) {
     throw InputError(file, fmt::format("holds {} YAML documents (separated by '---'); a sensor profile is one",
                                        documents.size()));

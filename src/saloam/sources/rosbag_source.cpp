@@ -107,7 +107,7 @@ auto guarded(const fs::path& bag, F&& f) {
 
 std::string topics_text(const std::vector<BagTopic>& topics) {
   std::string out;
-  for (const auto& t : topics) out += fmt::format("\n  {} ({}, {} messages)", t.topic, t.type, t.messages);
+  for (const auto& t : topics) out += fmt::format("{} {} ({}, {} messages)", out.empty() ? "" : ";", t.topic, t.type, t.messages);
   return out.empty() ? " none" : out;
 }
 
