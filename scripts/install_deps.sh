@@ -11,6 +11,8 @@ packages=(
   robin-map-dev
   libjs-three libcpp-httplib-dev chromium  # saloam view: three.js, its --serve server, the headless page test
   libtorch-dev  # saloam sgpr-train (optional: without it the rest builds and the trainer is left out)
+  liblzf-dev  # binary_compressed PCD (optional: without it such files are an error that says so)
+  librosbag-storage-dev  # ROS 1 bags (optional: without it bags are an error that says so)
 )
 
 missing=()

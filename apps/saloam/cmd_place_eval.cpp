@@ -52,7 +52,7 @@ int run_place_eval_command(PlaceEvalArgs args) {
   if (!args.graphs.empty()) run.graphs = args.graphs;
   run.graph.use_instances = !args.no_instances;
   run.check();  // before the sequence is read
-  const SaloamConfig config = args.config.resolve();
+  SaloamConfig config = args.config.resolve();
   const PlaceDetector detector = parse_place_detector(run.method);
   if (uses_sgpr(detector)) run.model = sgpr_model_path(args.model, config);
   run.labels = args.source.segment.enabled() ? std::string("segmented in-process")

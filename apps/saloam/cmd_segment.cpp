@@ -48,7 +48,7 @@ void print_score(const SegmentationScore& score, const fs::path& truth) {
 }
 
 int run_segment(SegmentArgs args) {
-  const SaloamConfig config = args.config.resolve();
+  SaloamConfig config = args.config.resolve();
   args.source.segment.segment = true;
   args.source.no_calib = true;  // labels need no calibration
   const std::unique_ptr<FrameSource> source = args.source.open(false, config);

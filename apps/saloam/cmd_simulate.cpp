@@ -1,5 +1,7 @@
-// `saloam simulate`: write a synthetic SemanticKITTI sequence (HDL-64E sweeps
-// ray cast in a procedural street world along a preset or KITTI trajectory).
+// `saloam simulate`: write a synthetic sequence (HDL-64E sweeps, or those of
+// a sensor profile, ray cast in a procedural street world along a preset or
+// KITTI trajectory): a SemanticKITTI folder, or with --format any layout
+// saloam reads (PCD, PLY and bags keep each point's ring and time).
 
 #include <cctype>
 #include <iostream>
@@ -14,8 +16,10 @@
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
 #include "saloam/sim/class_shares.hpp"
+#include "saloam/sim/simulated_source.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sim/trajectories.hpp"
+#include "saloam/sources/sequence_writer.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -27,6 +31,9 @@ struct SimulateArgs {
   std::string preset;
   std::string frames;
   std::string labels;  ///< gt or noisy; SimulationOptions' by default
+  std::string sensor;  ///< --sensor NAME|FILE
+  std::string format = "semantickitti";
+  bool azimuth_steps_given = false;
   SimulationOptions sim;  ///< --stride, --seed, --beams, --azimuth-steps and every default
   bool no_skew = false;
   bool no_dynamic = false;
@@ -65,10 +72,28 @@ SimulationOptions simulation_options(const SimulateArgs& args) {
   options.end_frame = range.end;
   if (args.labels == "noisy") options.labels = LabelMode::kNoisy;
   if (args.labels == "gt") options.labels = LabelMode::kGroundTruth;
+  if (!args.sensor.empty()) {
+    if (options.beams != 64) throw ConfigError("give either --sensor or --beams (lasers of the HDL-64E), not both");
+    options.sensor = sensor_profile(args.sensor);
+    if (!args.azimuth_steps_given) options.azimuth_steps = options.sensor->simulation.azimuth_steps;
+  }
   options.skew = !args.no_skew;
   options.world.dynamic_objects = !args.no_dynamic;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
   return options;
+}
+
+/// The simulated frames written by sources/sequence_writer.hpp in another
+/// layout (ring and time per point in PCD, PLY and bags; noisy labels
+/// without their ground truth).
+int write_in_layout(const SimulationOptions& options, const SimulateArgs& args) {
+  SequenceWriteOptions layout;
+  layout.format = *scan_format_from_name(args.format);
+  const SimulatedSequence sequence(options);
+  SimulatedSource source(sequence);
+  write_scan_sequence(source, args.out, layout);
+  std::cout << fmt::format("wrote {} frames as {} to {}\n", source.frames_rendered(), args.format, args.out);
+  return 0;
 }
 
 int run_simulate(const SimulateArgs& args) {
@@ -82,8 +107,10 @@ int run_simulate(const SimulateArgs& args) {
               << format_class_shares(measure_class_shares(sequence, options.show_progress));
     return 0;
   }
-  spdlog::info("simulating {} ({} beams, seed {}, skew {}, labels {}) into {}", source, options.beams, options.seed,
-               options.skew ? "on" : "off", options.labels == LabelMode::kNoisy ? "noisy" : "gt", args.out);
+  spdlog::info("simulating {} ({}, seed {}, skew {}, labels {}) into {}", source,
+               options.sensor ? options.sensor->title() : fmt::format("{} beams of the HDL-64E", options.beams),
+               options.seed, options.skew ? "on" : "off", options.labels == LabelMode::kNoisy ? "noisy" : "gt", args.out);
+  if (args.format != "semantickitti") return write_in_layout(options, args);
   const SimulationSummary s = simulate_sequence(options, args.out);
   if (args.stats) std::cout << "ground-truth class shares:\n" << format_class_shares(s.shares);
   std::cout << fmt::format("wrote {} frames, {} points ({:.0f} per frame) to {} in {:.1f} s ({:.2f} frames/s)\n", s.frames,
@@ -109,7 +136,7 @@ int run_simulate(const SimulateArgs& args) {
 }
 
 const CommandRegistration kRegistration{Command{
-    "simulate", "Write a synthetic SemanticKITTI sequence (ray-cast HDL-64E in a procedural street world)", 10,
+    "simulate", "Write a synthetic sequence (ray-cast HDL-64E or a sensor profile in a procedural street world)", 10,
     [](CLI::App& app) {
       auto args = std::make_shared<SimulateArgs>();
       app.add_option("--out", args->out,
@@ -128,8 +155,17 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--labels", args->labels, "gt: exact labels; noisy: emulated network output in labels/, truth in labels_gt/")
           ->check(CLI::IsMember({"gt", "noisy"}));
       app.add_option("--beams", args->sim.beams, "Number of beams: 64 (HDL-64E), 32 or 16")->check(CLI::IsMember({64, 32, 16}));
-      app.add_option("--azimuth-steps", args->sim.azimuth_steps, "Columns per turn (HDL-64E: about 2083)")
-          ->check(CLI::Range(16, 8000));
+      app.add_option("--sensor", args->sensor,
+                     "Sensor profile to render: hdl64e, hdl32e, vlp16, os1-64, os1-128 (config/sensors/) or a profile "
+                     "file; default the HDL-64E (--beams)");
+      app.add_option("--format", args->format,
+                     "Layout to write: semantickitti (default), pcd, ply, kitti-raw, rosbag (PCD, PLY and bags keep each "
+                     "point's ring and time)")
+          ->check(CLI::IsMember({"semantickitti", "pcd", "ply", "kitti-raw", "rosbag"}));
+      app.add_option("--azimuth-steps", args->sim.azimuth_steps,
+                     "Columns per turn (HDL-64E: about 2083; with --sensor the profile's)")
+          ->check(CLI::Range(16, 8000))
+          ->each([args](const std::string&) { args->azimuth_steps_given = true; });
       app.add_flag("--no-skew", args->no_skew, "Take each scan at one instant (no motion distortion)");
       app.add_flag("--no-dynamic", args->no_dynamic, "No moving cars or pedestrians");
       app.add_flag("--stats", args->stats,

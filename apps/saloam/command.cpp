@@ -18,6 +18,7 @@
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/sources/open_source.hpp"
+#include "saloam/sources/sensor_guess.hpp"
 
 namespace saloam::cli {
 
@@ -174,30 +175,113 @@ std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig
 }
 
 void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
-  app.add_option("SEQ_DIR", path, path_help)->required();
-  app.add_option("--labels", labels, "Folder of .label files to use instead of SEQ_DIR/labels");
+  app.add_option("SEQ_DIR", path, path_help + "; or a KITTI raw drive, a folder of .pcd/.ply files, a ROS 1 bag")
+      ->required();
+  app.add_option("--format", format,
+                 "Layout of SEQ_DIR: auto (detected), semantickitti, kitti-raw, pcd, ply, rosbag")
+      ->check(CLI::IsMember(scan_format_names()))
+      ->capture_default_str();
+  app.add_option("--topic", topic, "ROS bag topic of sensor_msgs/PointCloud2 (default: the only one)");
+  app.add_option("--sensor", sensor,
+                 "Sensor profile: auto (guessed from the first scan), none, a shipped one (hdl64e, hdl32e, vlp16, os1-64, "
+                 "os1-128: config/sensors/) or a profile file")
+      ->capture_default_str();
+  app.add_option("--labels", labels, "Folder of .label files (named like the scans) instead of SEQ_DIR/labels");
   app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
   segment.add_to(app);
 }
 
-std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, const SaloamConfig& config) const {
+namespace {
+SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
+  SourceOptions options;
+  const auto format = scan_format_from_name(args.format);
+  if (!format) throw ConfigError(fmt::format("--format {}: not one of {}", args.format, fmt::join(scan_format_names(), ", ")));
+  options.format = *format;
+  options.topic = args.topic;
+  if (!args.labels.empty()) options.labels = args.labels;
+  options.ignore_labels = ignore_labels;
+  options.ignore_calib = args.no_calib;
+  options.frames = FrameRange::parse(args.frames);
+  return options;
+}
+}  // namespace
+
+std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& config, SensorChoice* chosen) const {
   if (segment.enabled() && ignore_labels)
     throw ConfigError("--segment labels the scans, but this run does not use labels (--no-semantics, or a label-free "
                       "method): leave out one of them");
   if (segment.enabled() && !labels.empty()) throw ConfigError("give --labels DIR or --segment, not both");
-  SourceOptions options;
-  if (!labels.empty()) options.labels = labels;
-  options.ignore_labels = ignore_labels;
-  options.ignore_calib = no_calib;
-  options.frames = FrameRange::parse(frames);
-  options.segmentation = segment.stage(config);
-  return open_source(path, options);
+  SourceOptions options = source_options(*this, ignore_labels);
+  options.segmentation = segment.stage(config);  // checks the model before anything is read
+  auto reader = open_reader(path, options);
+  SensorChoice choice = choose_sensor(sensor, *reader);
+  if (choice.profile) {
+    apply_sensor_profile(*choice.profile, config.odometry.features);
+    validate_config(config, fmt::format("--sensor {}", choice.profile->name));
+    spdlog::info("sensor: {}, {}", choice.profile->title(), choice.how);
+  }
+  if (options.segmentation) options.segmentation->rings = config.odometry.features;
+  if (chosen) *chosen = std::move(choice);
+  return add_stages(std::move(reader), options);
+}
+
+std::vector<SensorProfile> shipped_sensor_profiles() { return load_sensor_profiles(data_dir() / "config" / "sensors"); }
+
+SensorProfile sensor_profile(const std::string& name_or_file) {
+  const std::filesystem::path given(name_or_file);
+  std::error_code error;
+  if (std::filesystem::is_regular_file(given, error)) return load_sensor_profile(given);
+  const auto shipped = shipped_sensor_profiles();
+  for (const auto& p : shipped) {
+    if (p.name == name_or_file) return p;
+  }
+  std::vector<std::string> names;
+  for (const auto& p : shipped) names.push_back(p.name);
+  throw ConfigError(fmt::format("--sensor {}: no such profile file, nor a shipped profile (in {}: {}; or auto, none)",
+                                name_or_file, (data_dir() / "config" / "sensors").string(), fmt::join(names, ", ")));
+}
+
+SensorChoice choose_sensor(const std::string& sensor, FrameSource& source) {
+  SensorChoice choice;
+  if (sensor == "none") {
+    choice.how = "none (--sensor none)";
+    return choice;
+  }
+  if (sensor != "auto") {
+    choice.profile = sensor_profile(sensor);
+    choice.how = fmt::format("as given (--sensor {})", sensor);
+    return choice;
+  }
+  if (!source.info().rereadable || source.size() == 0) {
+    choice.how = "none: a stream cannot be looked at before the run (give --sensor NAME)";
+    return choice;
+  }
+  const auto profiles = shipped_sensor_profiles();
+  LabelledCloud first;
+  try {
+    first = source.scan(0);
+  } catch (const InputError&) {
+    // The run reads it again and fails there, as a run does (its outputs
+    // say so); the guess only stands aside.
+    choice.how = "none: the first scan cannot be read";
+    return choice;
+  }
+  const SensorGuess guess = guess_sensor(first, profiles);
+  choice.profile = profiles[guess.profile];
+  std::string subset;
+  if (auto kept = laser_subset(*choice.profile, guess.lasers)) {
+    subset = fmt::format(", {} of its {} lasers", kept->beams(), choice.profile->beams());
+    choice.profile = std::move(kept);
+  }
+  choice.how =
+      fmt::format("guessed from the first scan: {}{} (--sensor NAME to choose another)", guess.found(), subset);
+  return choice;
 }
 
 void add_no_calib_flag(CLI::App& app, bool& no_calib) {
   app.add_flag("--no-calib", no_calib,
-               "Run without calib.txt (ignored if present): poses.txt holds LiDAR-frame poses, not KITTI's camera "
-               "frame");
+               "Ignore calib.txt: work in the LiDAR frame (pose files hold LiDAR-frame poses, poses.txt is taken as "
+               "such), as for a source without calib.txt");
 }
 
 CLI::Validator positive_number() {

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "saloam/core/config.hpp"
+#include "saloam/core/sensor_profile.hpp"
 #include "saloam/segmentation/segmented_source.hpp"
 #include "saloam/io/frame_source.hpp"
 
@@ -59,14 +60,37 @@ struct SegmentOptions {
   [[nodiscard]] std::optional<SegmentationStageOptions> stage(const SaloamConfig& config) const;
 };
 
+/// The options that choose a run's frames, shared by the commands that read
+/// a source (odom, slam, place-eval, bench, info, convert, segment): SEQ_DIR
+/// (any layout of sources/source_options.hpp), --format, --topic, --sensor,
+/// --labels, --frames and the segmentation's options;
+/// commands where calibration matters add --no-calib (add_no_calib_flag).
+/// Call `open()` after parsing.
+/// The sensor profile a run works with (--sensor), and how it was chosen.
+struct SensorChoice {
+  std::optional<SensorProfile> profile;  ///< none with --sensor none
+  std::string how;                       ///< "given (--sensor vlp16)", "guessed from the first scan: ..."
+};
 
+/// The sensor profiles shipped in data_dir()/config/sensors/ (by name).
+std::vector<SensorProfile> shipped_sensor_profiles();
+/// --sensor NAME (a shipped profile) or FILE (a profile of one's own,
+/// format in core/sensor_profile.hpp); ConfigError naming the shipped ones
+/// when it is neither.
+SensorProfile sensor_profile(const std::string& name_or_file);
+/// What --sensor `sensor` means for `source`: "none" (no profile: rings from
+/// the storage order or the HDL-64E/HDL-32E/VLP-16 layouts, as before
+/// profiles), a profile by name or file, or "auto": the shipped profile that
+/// fits the source's first scan best (sources/sensor_guess.hpp), cut down to
+/// the lasers found when the scan keeps only some of them (laser_subset); none when
+/// that scan cannot be read (the run then fails on it as it would anyway).
+SensorChoice choose_sensor(const std::string& sensor, FrameSource& source);
 
-/// The options that choose a run's frames, shared by the commands that run
-/// over a sequence (odom, slam, place-eval, bench): SEQ_DIR, --labels and
-/// --frames; commands where calibration matters add --no-calib
-/// (add_no_calib_flag). Call `open()` after parsing.
 struct SourceArgs {
   std::string path;
+  std::string format = "auto";
+  std::string sensor = "auto";
+  std::string topic;
   std::string labels;
   std::string frames;
   bool no_calib = false;
@@ -74,8 +98,11 @@ struct SourceArgs {
   void add_to(CLI::App& app, const std::string& path_help);
   /// open_source() with these options; whether labels are read is the
   /// command's choice (ConfigError when it ignores them but --segment asks
-  /// for them). `config` sets up the segmentation stage.
-  [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, const SaloamConfig& config) const;
+  /// for them). The sensor (--sensor, chosen on the reader and said in one
+  /// log line) goes into config.odometry.features (apply_sensor_profile)
+  /// before `config` sets up the segmentation stage; `chosen` receives it.
+  [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, SaloamConfig& config,
+                                                  SensorChoice* chosen = nullptr) const;
 };
 
 /// The folder of the running program (from /proc/self/exe); none when it
@@ -113,8 +140,9 @@ std::filesystem::path segmenter_description_path(const std::string& given, const
 /// Returns 2 with a message when the program was not built.
 int forward_to_program(const std::string& name, const std::vector<std::string>& arguments);
 
-/// --no-calib of the runs (odom, slam): without it a missing calib.txt is an
-/// error; with it poses.txt holds LiDAR-frame poses.
+/// --no-calib of the runs (odom, slam, place-eval): calib.txt is not read even
+/// when present, and the run works in the LiDAR frame, as it does for a
+/// source without calib.txt.
 void add_no_calib_flag(CLI::App& app, bool& no_calib);
 
 /// Checks for numeric options whose messages name the value: CLI11's

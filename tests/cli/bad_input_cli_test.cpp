@@ -89,34 +89,47 @@ TEST(BadInputCli, GapInScanNumbersStopsEveryCommandThatReadsASequence) {
   expect_has(failure_of(fmt::format("odom {} --out {}", s, quoted(tmp / "o"))), "000001.bin: is a directory");
 }
 
-TEST(BadInputCli, MissingCalibIsAnErrorUnlessNoCalibIsGiven) {
+std::size_t count_of(const std::string& text, const std::string& fragment) {
+  std::size_t n = 0;
+  for (auto at = text.find(fragment); at != std::string::npos; at = text.find(fragment, at + 1)) ++n;
+  return n;
+}
+
+// Issue 24: a folder without calib.txt runs in the LiDAR frame, saying so
+// once; --no-calib does the same when calib.txt is there.
+TEST(BadInputCli, MissingCalibRunsInTheLidarFrameAndSaysSoOnce) {
   TempDir tmp;
   const fs::path seq = write_sequence(tmp);
   fs::remove(seq / "calib.txt");
   const std::string s = quoted(seq);
+  const std::string said = "no calibration: pose files hold LiDAR-frame poses";
+  std::string output;
   for (const std::string command : {"odom", "slam"}) {
-    const std::string output = failure_of(fmt::format("{} {} --out {}", command, s, quoted(tmp / command)));
-    expect_has(output, "calib.txt: not found");
-    expect_has(output, "--no-calib");
-    EXPECT_FALSE(fs::exists(tmp / command / "poses.txt"));
+    ASSERT_EQ(run_command(saloam_cmd(fmt::format("{} {} --out {}", command, s, quoted(tmp / command))), &output), 0)
+        << output;
+    EXPECT_EQ(count_of(output, said), 1u) << output;
+    EXPECT_EQ(read_kitti_poses(tmp / command / "poses.txt").size(), 4u);
   }
-  const std::string output = failure_of(fmt::format("place-eval {} --method scancontext --out {}", s, quoted(tmp / "p")));
-  expect_has(output, "calib.txt: not found");
-  expect_has(output, "--no-calib");
-
-  std::string run_output;
-  ASSERT_EQ(run_command(saloam_cmd(fmt::format("odom {} --out {} --no-calib", s, quoted(tmp / "lidar"))), &run_output), 0)
-      << run_output;
-  EXPECT_EQ(read_kitti_poses(tmp / "lidar/poses.txt").size(), 4u);
-  ASSERT_EQ(run_command(saloam_cmd(fmt::format("place-eval {} --method scancontext --no-calib --out {}", s,
-                                               quoted(tmp / "p"))),
-                        &run_output),
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("place-eval {} --method scancontext --out {}", s, quoted(tmp / "p"))),
+                        &output),
             0)
-      << run_output;
+      << output;
 
-  // "  Tr:" (indented) is read like "Tr:".
-  std::ofstream(seq / "calib.txt") << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n  Tr: 1 0 0 0 0 1 0 0 0 0 1 0\n";
-  ASSERT_EQ(run_command(saloam_cmd(fmt::format("odom {} --out {}", s, quoted(tmp / "camera"))), &run_output), 0) << run_output;
+  // With calib.txt (a quarter turn: the frames differ), camera-frame poses;
+  // --no-calib keeps the LiDAR frame. "  Tr:" (indented) is read like "Tr:".
+  std::ofstream(seq / "calib.txt") << "P0: 1 0 0 0 0 1 0 0 0 0 1 0\n  Tr: 0 -1 0 0 0 0 -1 0 1 0 0 0\n";
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("odom {} --out {}", s, quoted(tmp / "camera"))), &output), 0) << output;
+  EXPECT_EQ(count_of(output, said), 0u) << output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("odom {} --out {} --no-calib", s, quoted(tmp / "lidar"))), &output), 0)
+      << output;
+  EXPECT_EQ(count_of(output, said), 1u) << output;
+  const auto camera = read_kitti_poses(tmp / "camera/poses.txt"), lidar = read_kitti_poses(tmp / "lidar/poses.txt");
+  ASSERT_EQ(camera.size(), lidar.size());
+  Pose tr = Pose::Identity();
+  tr.linear() << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+  for (std::size_t i = 0; i < camera.size(); ++i) {
+    EXPECT_LT((camera[i].matrix() - (tr * lidar[i] * tr.inverse()).matrix()).norm(), 1e-4) << i;
+  }
 }
 
 TEST(BadInputCli, NonRigidCalibAndPosesAndBackwardTimesAreRejected) {

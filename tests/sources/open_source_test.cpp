@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "saloam/core/error.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/sources/open_source.hpp"
@@ -54,15 +56,34 @@ TEST(OpenSource, AppliesTheFrameRange) {
   EXPECT_THROW((void)open_source(dir.path(), options), ConfigError);
 }
 
-TEST(OpenSource, AFolderWithoutCalibrationNeedsNoCalib) {
+TEST(OpenSource, AFolderWithoutCalibrationRunsInTheLidarFrame) {
   testing::TempDir dir;
   write_sequence(dir.path(), false);
-  const std::string error = testing::input_error_of([&] { (void)open_source(dir.path(), {}); });
-  EXPECT_NE(error.find("calib.txt: not found"), std::string::npos) << error;
-  EXPECT_NE(error.find("--no-calib"), std::string::npos) << error;
+  const auto source = open_source(dir.path(), {});
+  EXPECT_EQ(source->size(), 5u);
+  EXPECT_FALSE(source->info().velo_to_cam);
+  EXPECT_TRUE(source->info().camera_poses);  // poses.txt, taken as LiDAR-frame poses
+  const auto& notes = source->info().notes;
+  EXPECT_NE(std::find(notes.begin(), notes.end(), "calibration: none (no calib.txt): runs in the LiDAR frame"),
+            notes.end());
+}
+
+TEST(OpenSource, NamesTheFormatAndPicksTheReader) {
+  testing::TempDir dir;
+  write_sequence(dir / "seq", true);
   SourceOptions options;
-  options.ignore_calib = true;
-  EXPECT_EQ(open_source(dir.path(), options)->size(), 5u);
+  options.format = ScanFormat::kKittiRaw;
+  EXPECT_NE(testing::input_error_of([&] { (void)open_reader(dir / "seq", options); })
+                .find("velodyne_points/data: missing: a KITTI raw drive keeps its scans in velodyne_points/data/"),
+            std::string::npos);
+  options.format = ScanFormat::kSemanticKitti;
+  const auto source = open_reader(dir / "seq", options);
+  EXPECT_EQ(source->info().format, "semantickitti");
+  EXPECT_EQ(source->info().point_fields, "x y z remission");
+  EXPECT_EQ(scan_format_from_name("kitti-raw"), ScanFormat::kKittiRaw);
+  EXPECT_FALSE(scan_format_from_name("las").has_value());
+  EXPECT_EQ(format_name(ScanFormat::kRosbag), "rosbag");
+  EXPECT_EQ(scan_format_names().size(), 6u);
 }
 
 }  // namespace

@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
 
+#include "saloam/core/yaml_documents.hpp"
+
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
@@ -89,6 +91,13 @@ template <class T, class R>
 void check_member(const T& member, const R& range, const std::string& key, const std::string& origin) {
   if constexpr (std::is_same_v<T, ClassValueMap>) {
     for (const auto& [name, value] : member) check_value(value, range, key + "." + name, origin);
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    for (std::size_t i = 0; i < member.size(); ++i) {
+      if (std::isnan(member[i]) || !admits(range, member[i])) {
+        throw ConfigError(fmt::format("{}: '{}' has {} at [{}], not allowed (valid: {})", origin, key,
+                                      number_text(member[i]), i, describe(range)));
+      }
+    }
   } else {
     check_value(member, range, key, origin);
   }
@@ -123,6 +132,11 @@ void assign(T& member, const YAML::Node& node, const std::string& key, const std
       }
       assign(member[name], entry.second, key + "." + name, origin);
     }
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    if (!node.IsSequence()) throw ConfigError(fmt::format("{}: '{}' must be a list of numbers, e.g. [1.5, -2]", origin, key));
+    std::vector<double> values(node.size());
+    for (std::size_t i = 0; i < node.size(); ++i) assign(values[i], node[i], fmt::format("{}[{}]", key, i), origin);
+    member = std::move(values);
   } else {
     if (!node.IsScalar()) {
       throw ConfigError(fmt::format("{}: '{}' must be a single value", origin, key));
@@ -141,6 +155,10 @@ YAML::Node to_node(const T& value) {
   YAML::Node n;
   if constexpr (std::is_same_v<T, ClassValueMap>) {
     for (const auto& [name, v] : value) n[name] = fmt::format("{}", v);
+  } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+    n = YAML::Node(YAML::NodeType::Sequence);
+    for (const double v : value) n.push_back(number_text(v));
+    n.SetStyle(YAML::EmitterStyle::Flow);
   } else if constexpr (std::is_floating_point_v<T>) {
     n = number_text(value);
   } else {
@@ -218,6 +236,12 @@ void check_consistency(const SaloamConfig& config, const std::string& origin) {
     throw ConfigError(fmt::format("{}: 'loop.delta_min' = {} must not exceed 'loop.delta_max' = {}", origin,
                                   number_text(config.loop.delta_min), number_text(config.loop.delta_max)));
   }
+  if (!f.beam_elevations_deg.empty() && f.num_beams != 0 &&
+      f.num_beams != static_cast<int>(f.beam_elevations_deg.size())) {
+    throw ConfigError(fmt::format("{}: 'odometry.features.num_beams' = {} but 'odometry.features.beam_elevations_deg' "
+                                  "lists {} beams (num_beams 0 takes the list's)",
+                                  origin, f.num_beams, f.beam_elevations_deg.size()));
+  }
   if (!(f.pose_time_in_sweep <= f.sweep_duration)) {
     throw ConfigError(fmt::format("{}: 'odometry.features.pose_time_in_sweep' = {} must lie within the sweep, "
                                   "[0, 'odometry.features.sweep_duration' = {}]",
@@ -279,11 +303,10 @@ void validate_config(const SaloamConfig& config_in, std::string_view origin_in) 
 void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin) {
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(std::string(yaml_text));
+    documents = load_yaml_documents(yaml_text);
   } catch (const YAML::Exception& e) {
     throw ConfigError(fmt::format("{}: invalid YAML: {}", origin, e.what()));
   }
-  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
   if (documents.size() > 1) {
     throw ConfigError(fmt::format("{}: holds {} YAML documents (separated by '---'); a configuration is one", origin,
                                   documents.size()));

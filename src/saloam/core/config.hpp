@@ -85,7 +85,15 @@ struct FeatureConfig {
   double thin_object_max_radius = 0.5;
   double min_range = 2.5;       ///< [m] closer returns are ignored (vehicle body)
   double max_range = 120.0;     ///< [m]
-  int num_beams = 0;            ///< 0 = detect 64/32/16 from the data
+  /// Beams of the sensor: 0 = the number of beam_elevations_deg, or without
+  /// those 64/32/16 detected from the data (the HDL-64E, HDL-32E or VLP-16
+  /// layout that fits the elevation range).
+  int num_beams = 0;
+  /// Elevation [deg] of each laser, top first, from the sensor profile
+  /// (--sensor, config/sensors/*.yaml): rings of scans without a ring field
+  /// that are not stored laser by laser are the nearest laser's. Empty: the
+  /// layout of num_beams.
+  std::vector<double> beam_elevations_deg;
   /// Take rings from the storage order when the scan is stored ring by ring
   /// (KITTI, simulator), else from the elevation angle. The order stays exact
   /// when points were motion-compensated; the elevation then does not.
@@ -306,7 +314,9 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
   v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1", AtLeast{1});
   v("min_range", c.min_range, "min range [m]", AtLeast{0});
   v("max_range", c.max_range, "max range [m]", Above{0});
-  v("num_beams", c.num_beams, "beams (0 = detect)", OneOf{0, 16, 32, 64});
+  v("num_beams", c.num_beams, "beams (0 = beam_elevations_deg's, else detect 64/32/16)", Range{0, 1024});
+  v("beam_elevations_deg", c.beam_elevations_deg, "[deg] laser elevations, top first (--sensor; [] = layout of num_beams)",
+    Range{-90, 90});
   v("ring_from_point_order", c.ring_from_point_order, "rings from storage order when it is ring by ring");
   v("pose_time_in_sweep", c.pose_time_in_sweep, "[s] instant of the sweep a pose refers to", AtLeast{0});
   v("sweep_duration", c.sweep_duration, "[s] one revolution", Above{0});

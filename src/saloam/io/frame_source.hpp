@@ -1,9 +1,11 @@
 #pragma once
 // Where a run's frames come from. Every run (odometry, SLAM, place
 // evaluation, bench, demo) reads its frames through one FrameSource: a
-// reader of recorded data (SequenceFolderSource: a SemanticKITTI folder), the
-// simulator rendering in memory (SimulatedSource, sim/), or a stage that
-// wraps another source and changes what it serves (FrameRangeSource below).
+// reader of recorded data (SequenceFolderSource here: a SemanticKITTI folder;
+// the other layouts' readers in sources/: KITTI raw drives, PCD and PLY
+// folders, ROS bags), the simulator rendering in memory (SimulatedSource,
+// sim/), or a stage that wraps another source and changes what it serves
+// (FrameRangeSource below).
 // Runs see only this interface; sources/open_source.hpp picks the reader for
 // a path and puts the stages in front of it.
 //
@@ -17,8 +19,10 @@
 //    order; a stream (rereadable false) serves frames 0, 1, 2, ... once
 //    each, in that order (std::logic_error otherwise);
 //  - velo_to_cam, camera_poses and sensor_camera_poses are there when known;
-//    pose lists hold one pose per frame, in the KITTI camera convention of
-//    poses.txt (P_i = Tr Q_i Tr^-1), not re-based.
+//    pose lists hold one pose per frame, not re-based: in the KITTI camera
+//    convention of poses.txt (P_i = Tr Q_i Tr^-1) when velo_to_cam is known,
+//    else LiDAR-frame poses Q_i = T_L0<-Li (a source without calibration runs
+//    in the LiDAR frame).
 //
 // A stage (decorator) owns the source it wraps, starts from a copy of its
 // info and changes what it changes: FrameRangeSource the frames, times,
@@ -45,7 +49,8 @@ struct SourceInfo {
   bool has_labels = false;     ///< scans carry per-point classes
   bool rereadable = true;      ///< false: a stream (see above)
   std::optional<Pose> velo_to_cam;                ///< Tr, velodyne to camera 0, when known
-  std::optional<std::vector<Pose>> camera_poses;  ///< ground truth (poses.txt), when known
+  /// Reference poses (poses.txt; a KITTI raw drive's GPS/INS), when known; frame as said above.
+  std::optional<std::vector<Pose>> camera_poses;
   /// Where the scans were really taken, when that differs from camera_poses
   /// (a simulated sequence whose given heights did not fit its ground).
   std::optional<std::vector<Pose>> sensor_camera_poses;
@@ -54,6 +59,17 @@ struct SourceInfo {
   std::optional<std::filesystem::path> folder;
   /// Frame i is the folder's (or the recording's) frame first_frame + i (after `--frames A:B`: A).
   std::size_t first_frame = 0;
+  /// The layout read, as --format names it ("semantickitti", "kitti-raw",
+  /// "pcd", "ply", "rosbag"), or "simulated".
+  std::string format;
+  /// The point fields of the scans as the source names them ("x y z
+  /// intensity ring t"; KITTI .bin scans: "x y z remission"), from the first
+  /// scan's header.
+  std::string point_fields;
+  /// Where the times, the calibration and the reference come from, one line
+  /// each ("times: times.txt", "reference: oxts/ (GPS/INS) ..."): what
+  /// `saloam info` shows beside the numbers.
+  std::vector<std::string> notes;
 
   [[nodiscard]] std::size_t size() const { return times.size(); }
 };

@@ -18,6 +18,23 @@ std::optional<std::vector<Pose>> sensor_camera_poses(const SequenceReader& reade
   return poses;
 }
 
+std::vector<std::string> notes(const SequenceReader& reader, bool calib) {
+  std::vector<std::string> out;
+  out.emplace_back(reader.has_times_file() ? "times: times.txt" : "times: no times.txt, 0.1 s steps assumed");
+  if (calib) {
+    out.emplace_back("calibration: calib.txt (Tr, velodyne to camera 0): poses in KITTI's camera frame");
+  } else {
+    out.emplace_back(reader.has_calib() ? "calibration: calib.txt ignored (--no-calib): runs in the LiDAR frame"
+                                        : "calibration: none (no calib.txt): runs in the LiDAR frame");
+  }
+  if (!reader.has_poses()) {
+    out.emplace_back("reference: none (no poses.txt)");
+  } else {
+    out.emplace_back(calib ? "reference: poses.txt (camera frame)" : "reference: poses.txt (taken as LiDAR frame)");
+  }
+  return out;
+}
+
 }  // namespace
 
 SequenceFolderSource::SequenceFolderSource(SequenceReader reader, bool read_calib) : reader_(std::move(reader)) {
@@ -29,6 +46,9 @@ SequenceFolderSource::SequenceFolderSource(SequenceReader reader, bool read_cali
   if (reader_.has_poses()) info_.camera_poses = reader_.camera_poses();
   info_.sensor_camera_poses = sensor_camera_poses(reader_);
   info_.folder = reader_.root();
+  info_.format = "semantickitti";
+  info_.point_fields = "x y z remission";
+  info_.notes = notes(reader_, info_.velo_to_cam.has_value());
 }
 
 }  // namespace saloam

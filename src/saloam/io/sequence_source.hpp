@@ -2,7 +2,8 @@
 // A SemanticKITTI sequence folder (io/sequence.hpp) as a FrameSource:
 // rereadable, labels when the folder (or the labels folder given) has them,
 // Tr from calib.txt, ground truth from poses.txt and, in simulated
-// sequences, poses_sensor.txt.
+// sequences, poses_sensor.txt. Without calib.txt (or with read_calib false)
+// it has no Tr: poses.txt is then taken as LiDAR-frame poses.
 
 #include "saloam/io/frame_source.hpp"
 #include "saloam/io/sequence.hpp"

@@ -14,6 +14,7 @@
 
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/odometry/parallel.hpp"
+#include "saloam/odometry/rings.hpp"
 
 namespace saloam {
 
@@ -598,11 +599,18 @@ std::vector<std::vector<std::uint32_t>> rings_from_elevation(const LabelledCloud
   return rings;
 }
 
+/// Rings from the ring field when the scan has one, else from the storage
+/// order when it is ring by ring, else from the elevation: the sensor
+/// profile's lasers when known, else the layout of num_beams.
 std::vector<std::vector<std::uint32_t>> rings_from_times(const LabelledCloud& cloud, const std::vector<float>& times,
                                                          const FeatureConfig& config) {
+  if (cloud.has_rings()) return rings_from_ring_field(cloud, times);
+  const auto& lasers = config.beam_elevations_deg;
   std::vector<std::vector<std::uint32_t>> rings;
-  if (config.ring_from_point_order) rings = rings_from_storage(times, config, config.num_beams);
-  if (rings.empty()) rings = rings_from_elevation(cloud, times, config);
+  const int expected = config.num_beams > 0 ? config.num_beams : static_cast<int>(lasers.size());
+  if (config.ring_from_point_order) rings = rings_from_storage(times, config, expected);
+  if (rings.empty()) rings = lasers.empty() ? rings_from_elevation(cloud, times, config)
+                                            : rings_from_laser_elevations(cloud, times, lasers);
   return rings;
 }
 }  // namespace
@@ -619,6 +627,9 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // motion compensation), else from the elevation angle.
   const std::vector<float> times = point_sweep_times(cloud, config, parallel);
   const std::vector<std::vector<std::uint32_t>> rings = rings_from_times(cloud, times, config);
+  // De-skewing takes the points' own times when the scan has them
+  // (relative to the scan's timestamp), else the sweep model's.
+  const std::vector<float>& sweep_times = cloud.has_times() ? cloud.time : times;
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.
   std::vector<ScanFeatures> per_ring(rings.size());
@@ -659,10 +670,11 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
         if (edges && axes && is_thin_round(static_class(cloud.label[i]))) {
           const auto axis = thin_object_axis(ring_points, k, config.thin_object_max_radius);
           if (!axis) continue;
-          target.push_back(axis->point, static_cast<ClassIndex>(c), times[ring[static_cast<std::size_t>(axis->central)]]);
+          const std::uint32_t central = ring[static_cast<std::size_t>(axis->central)];
+          target.push_back(axis->point, static_cast<ClassIndex>(c), sweep_times[central]);
           continue;
         }
-        target.push_back(ring_points[k], static_cast<ClassIndex>(c), times[i]);
+        target.push_back(ring_points[k], static_cast<ClassIndex>(c), sweep_times[i]);
       }
     };
     emit(selection.edges, true, per_ring[r].edges);

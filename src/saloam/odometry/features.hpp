@@ -27,7 +27,9 @@ inline constexpr int kNumClassIndices = kNumLearningClasses;
 struct FeatureCloud {
   std::vector<Eigen::Vector3d> points;
   std::vector<ClassIndex> classes;
-  std::vector<float> sweep_time;  ///< [s] since sweep start, for de-skewing
+  /// [s] for de-skewing: since the sweep start (the azimuth model), or the
+  /// point's own time relative to the scan's timestamp when the scan has them.
+  std::vector<float> sweep_time;
 
   [[nodiscard]] std::size_t size() const { return points.size(); }
   void push_back(const Eigen::Vector3d& p, ClassIndex c, float t) {
@@ -109,10 +111,12 @@ std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledClo
                                                               const FeatureConfig& config, int expected_rings);
 
 /// Point indices per ring (top ring first), each ring in azimuth order, as
-/// extract_features() finds them: from the storage order when the scan is
+/// extract_features() finds them: from the ring field when the cloud has one
+/// (rings ordered by elevation), else from the storage order when the scan is
 /// stored ring by ring (and config.ring_from_point_order), else from the
-/// elevation angle. Points in no ring (outside the layout's field of view,
-/// invalid) are left out.
+/// elevation angle: the nearest of config.beam_elevations_deg (the sensor
+/// profile's lasers) when given, else the layout of config.num_beams. Points
+/// in no ring (outside the field of view, invalid) are left out.
 std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, const FeatureConfig& config);
 
 /// Poles and tree trunks: objects whose cross-section is a small disc.
@@ -158,7 +162,10 @@ int odometry_class(std::uint16_t raw_label);
 /// Vegetation stays alone. Index 0 (unlabeled mode) stays 0.
 ClassIndex class_group(ClassIndex c);
 
-/// Full extraction on one scan. With `use_labels` false (unlabeled scan or
+/// Full extraction on one scan, rings as scan_rings() finds them; each
+/// feature's sweep time (for de-skewing) is the point's own time when the
+/// cloud has per-point times (LabelledCloud::time, relative to the scan's
+/// timestamp), else the sweep model's (sweep_time_from_azimuth). With `use_labels` false (unlabeled scan or
 /// label-agnostic mode) every point is class 0; otherwise dynamic and
 /// unlabeled points are dropped from the features (after the roughness, which
 /// is pure geometry: removing them first would create false edges).

@@ -27,6 +27,22 @@ LidarModel LidarModel::hdl64e(int beams) {
   return m;
 }
 
+LidarModel LidarModel::from_profile(const SensorProfile& profile) {
+  if (!profile.sweep_clockwise || std::abs(profile.sweep_start_azimuth_deg - 180.0) > 1e-9) {
+    throw ConfigError(profile.name + ": the simulator renders sweeps turning clockwise from behind (sweep_clockwise "
+                                     "true, sweep_start_azimuth_deg 180)");
+  }
+  LidarModel m;
+  m.elevation_deg = profile.elevation_deg;
+  m.azimuth_steps = profile.simulation.azimuth_steps;
+  m.min_range = profile.min_range;
+  m.max_range = profile.max_range;
+  m.range_noise = profile.simulation.range_noise;
+  m.sweep_period = profile.sweep_duration;
+  if (profile.simulation.kitti_ego_body) m.ego_body = kitti_ego_body();
+  return m;
+}
+
 std::vector<Eigen::AlignedBox3d> LidarModel::kitti_ego_body() {
   constexpr double kSensorHeight = 1.73, kBeltLine = 0.93, kRoof = 1.45;
   return {Eigen::AlignedBox3d(Eigen::Vector3d(-2.39, -0.91, -kSensorHeight), Eigen::Vector3d(2.03, 0.91, kBeltLine - kSensorHeight)),
@@ -167,6 +183,7 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
   });
 
   SimulatedScan scan;
+  const double sweep_span = sweep.skew ? sweep.time_end - sweep.time_start : 0.0;
   std::size_t count = 0;
   for (const auto& r : grid) count += r.valid ? 1 : 0;
   scan.cloud.reserve(count);
@@ -182,6 +199,12 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
       scan.column.push_back(static_cast<std::uint16_t>(c));
       scan.range.push_back(r.range);
     }
+  }
+  // Ring and time fields after the points (push_back drops them).
+  scan.cloud.ring = scan.ring;
+  scan.cloud.time.resize(scan.column.size());
+  for (std::size_t i = 0; i < scan.column.size(); ++i) {
+    scan.cloud.time[i] = static_cast<float>(lidar.column_fraction(scan.column[i]) * sweep_span);
   }
   scan.cloud.has_labels = true;
   for (const float dz : column_offset) {

@@ -1,6 +1,7 @@
 #pragma once
-// A spinning multi-beam LiDAR (Velodyne HDL-64E as in KITTI) and the ray
-// casting of one sweep in a simulated World.
+// A spinning multi-beam LiDAR (Velodyne HDL-64E as in KITTI by default, or
+// any sensor profile of core/sensor_profile.hpp) and the ray casting of one
+// sweep in a simulated World.
 //
 // Sweep convention: the head spins clockwise seen from above (azimuth
 // decreasing), starting and ending behind the car (azimuth +-180 deg), like
@@ -10,13 +11,17 @@
 // in the sensor frame at its own column's instant, as a real spinning LiDAR
 // reports it (motion-distorted); the frame's pose is the pose at sweep start,
 // so de-skewing a point of time fraction s = (pi - azimuth) / (2 pi) into the
-// sweep-start frame uses the motion from pose i towards pose i+1.
+// sweep-start frame uses the motion from pose i towards pose i+1. Each point
+// carries its beam (LabelledCloud::ring, 0 = top) and its column's time
+// (LabelledCloud::time, seconds after the sweep start, the scan's timestamp),
+// as a driver's clouds do.
 
 #include <cstdint>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "saloam/core/sensor_profile.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/sim/world.hpp"
 
@@ -38,6 +43,11 @@ struct LidarModel {
   /// from -8.83 to -24.9 deg. With beams = 32 or 16, every 2nd / 4th beam.
   /// Mounted on KITTI's car (kitti_ego_body()).
   static LidarModel hdl64e(int beams = 64);
+  /// The sensor of a profile: its lasers, range limits, sweep period,
+  /// firing positions, range noise and, with ego_body kitti, KITTI's car.
+  /// ConfigError for a sweep other than the simulator's (clockwise from
+  /// behind, azimuth 180 deg).
+  static LidarModel from_profile(const SensorProfile& profile);
   /// KITTI's recording car seen from its roof-mounted HDL-64E (1.73 m above
   /// the road): a box for the body below the belt line (0.93 m above the
   /// road, from 2.03 m ahead of the sensor to 2.39 m behind it, 1.82 m wide)

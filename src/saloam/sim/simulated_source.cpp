@@ -33,6 +33,8 @@ SourceInfo simulated_info(const SimulatedSequence& sequence) {
   info.velo_to_cam = sequence.velo_to_cam();
   info.camera_poses = sequence.camera_poses();
   info.sensor_camera_poses = moved_sensor_poses(sequence);
+  info.format = "simulated";
+  info.point_fields = "x y z remission";
   return info;
 }
 

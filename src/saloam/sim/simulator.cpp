@@ -27,12 +27,27 @@ Pose output_velo_to_cam(const SimulationOptions& options) {
   return options.velo_to_cam_given ? options.velo_to_cam : kitti_velo_to_cam();
 }
 
+namespace {
+/// The trajectory's LiDAR poses moved to the sensor's mount: `dz` [m] along
+/// each pose's up axis (a sensor mounted lower than KITTI's rides below it).
+std::vector<Pose> mounted(std::vector<Pose> poses, double dz) {
+  if (dz == 0.0) return poses;
+  for (Pose& T : poses) T = T * Eigen::Translation3d(0.0, 0.0, dz);
+  return poses;
+}
+}  // namespace
+
+double sensor_mount_height(const SimulationOptions& options) {
+  return options.sensor ? options.sensor->simulation.mount_height : options.world.sensor_height;
+}
+
 std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options) {
+  const double dz = sensor_mount_height(options) - options.world.sensor_height;
   if (!options.camera_poses.empty()) {
     if (!options.velo_to_cam_given) throw ConfigError("a camera-frame trajectory needs its velodyne-to-camera Tr");
-    return camera_to_lidar_poses(options.camera_poses, options.velo_to_cam);
+    return mounted(camera_to_lidar_poses(options.camera_poses, options.velo_to_cam), dz);
   }
-  return preset_trajectory(options.preset, options.frame_period);
+  return mounted(preset_trajectory(options.preset, options.frame_period), dz);
 }
 
 std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::size_t trajectory_size) {
@@ -72,7 +87,10 @@ SweepSpec sweep_for_frame(const std::vector<Pose>& traj, std::size_t i, const Si
 namespace {
 
 LidarModel lidar_for(const SimulationOptions& options) {
-  LidarModel lidar = LidarModel::hdl64e(options.beams);
+  if (options.sensor && options.beams != 64) {
+    throw ConfigError("beams picks lasers of the HDL-64E: with a sensor profile, leave it at 64");
+  }
+  LidarModel lidar = options.sensor ? LidarModel::from_profile(*options.sensor) : LidarModel::hdl64e(options.beams);
   if (options.azimuth_steps < 16) throw ConfigError("azimuth steps must be at least 16");
   lidar.azimuth_steps = options.azimuth_steps;
   lidar.sweep_period = options.frame_period;
@@ -82,6 +100,7 @@ LidarModel lidar_for(const SimulationOptions& options) {
 World world_for(const std::vector<Pose>& trajectory, const SimulationOptions& options) {
   WorldOptions world_options = options.world;
   world_options.frame_period = options.frame_period;
+  world_options.sensor_height = sensor_mount_height(options);
   return build_world(trajectory, options.seed, world_options);
 }
 

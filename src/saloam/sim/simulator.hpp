@@ -1,6 +1,7 @@
 #pragma once
 // Synthetic SemanticKITTI sequences: a trajectory (preset or KITTI poses),
-// a world built along it, one simulated HDL-64E sweep per frame, written in
+// a world built along it, one simulated sweep per frame (the HDL-64E, or a
+// sensor profile's LiDAR), written in
 // the SemanticKITTI layout so every other command reads it like real data:
 //   velodyne/NNNNNN.bin  labels/NNNNNN.label  [labels_gt/NNNNNN.label]
 //   poses.txt (camera frame, P_i = Tr Q_i Tr^-1, P_0 = I)  calib.txt (Tr)  times.txt (s; 10 Hz sensor)
@@ -14,9 +15,11 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "saloam/core/sensor_profile.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/sim/class_shares.hpp"
 #include "saloam/sim/lidar.hpp"
@@ -42,7 +45,15 @@ struct SimulationOptions {
   std::size_t stride = 1;
   std::uint64_t seed = 1;
   LabelMode labels = LabelMode::kGroundTruth;
+  /// Lasers of the HDL-64E: all 64, or every 2nd (32) or 4th (16): the same
+  /// sensor thinned out (--beams); 64 with a sensor profile.
   int beams = 64;
+  /// A sensor profile rendered instead of the HDL-64E (--sensor): its lasers,
+  /// ranges, noise, car body and mount height (the trajectory, a car's
+  /// LiDAR at world.sensor_height, is moved down or up to it).
+  std::optional<SensorProfile> sensor;
+  /// Firing positions per turn (the CLI takes a profile's
+  /// simulation.azimuth_steps unless --azimuth-steps is given).
   int azimuth_steps = 2083;
   bool skew = true;
   bool show_progress = true;
@@ -66,7 +77,11 @@ struct SimulationSummary {
   double max_sensor_offset = 0;
 };
 
-/// The whole source trajectory in the LiDAR frame, Q_i = T_L0<-Li.
+/// Height of the simulated sensor above the road [m]: the profile's mount,
+/// else world.sensor_height (KITTI's 1.73 m).
+double sensor_mount_height(const SimulationOptions& options);
+/// The whole source trajectory in the LiDAR frame, Q_i = T_L0<-Li, at the
+/// sensor's mount height.
 std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options);
 /// Tr used for the output (KITTI 00's for presets unless given).
 Pose output_velo_to_cam(const SimulationOptions& options);

@@ -1,22 +1,110 @@
 #include "saloam/sources/open_source.hpp"
 
+#include <array>
+#include <fstream>
+
+#include <fmt/format.h>
+
 #include "saloam/core/error.hpp"
 #include "saloam/io/sequence_source.hpp"
+#include "saloam/sources/kitti_raw_drive.hpp"
+#include "saloam/sources/point_cloud_folder.hpp"
+#include "saloam/sources/rosbag_source.hpp"
+#include "saloam/sources/scan_files.hpp"
+
+namespace fs = std::filesystem;
 
 namespace saloam {
+namespace {
 
-std::unique_ptr<FrameSource> open_reader(const std::filesystem::path& path, const SourceOptions& options) {
+constexpr std::array<std::pair<ScanFormat, std::string_view>, 6> kNames{{{ScanFormat::kAuto, "auto"},
+                                                                        {ScanFormat::kSemanticKitti, "semantickitti"},
+                                                                        {ScanFormat::kKittiRaw, "kitti-raw"},
+                                                                        {ScanFormat::kPcd, "pcd"},
+                                                                        {ScanFormat::kPly, "ply"},
+                                                                        {ScanFormat::kRosbag, "rosbag"}}};
+
+bool starts_with_bag_magic(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::string head(kRosbagMagic.size(), '\0');
+  return in.read(head.data(), static_cast<std::streamsize>(head.size())) && head == kRosbagMagic;
+}
+
+ScanFormat detect_file(const fs::path& file) {
+  const auto ext = file.extension();
+  if (starts_with_bag_magic(file) || ext == ".bag") return ScanFormat::kRosbag;
+  if (ext == ".pcd") return ScanFormat::kPcd;
+  if (ext == ".ply") return ScanFormat::kPly;
+  throw InputError(file, "not a scan source saloam reads: expected a ROS 1 bag (.bag), a .pcd or .ply file, or a folder");
+}
+
+ScanFormat detect_folder(const fs::path& folder) {
+  std::error_code ec;
+  if (fs::is_directory(folder / "velodyne", ec)) return ScanFormat::kSemanticKitti;
+  if (fs::is_directory(folder / "velodyne_points" / "data", ec)) return ScanFormat::kKittiRaw;
+  const bool pcd = has_files_with_extension(folder, ".pcd");
+  const bool ply = has_files_with_extension(folder, ".ply");
+  if (pcd && ply) throw InputError(folder, "holds both .pcd and .ply files: name the format with --format pcd|ply");
+  if (pcd) return ScanFormat::kPcd;
+  if (ply) return ScanFormat::kPly;
+  throw InputError(folder, "no scans found: expected velodyne/*.bin (SemanticKITTI), velodyne_points/data/*.bin "
+                           "(KITTI raw), *.pcd or *.ply files, or a ROS 1 bag file");
+}
+
+std::unique_ptr<FrameSource> open_semantic_kitti(const fs::path& path, const SourceOptions& options) {
   SequenceOptions sequence;
   sequence.labels_dir = options.labels;
-  sequence.ignore_labels = options.ignore_labels || options.segmentation.has_value();
-  auto source = std::make_unique<SequenceFolderSource>(SequenceReader(path, sequence), !options.ignore_calib);
-  if (!options.ignore_calib && !source->info().velo_to_cam) {
-    throw InputError(path / "calib.txt",
-                     "not found: needed for poses in KITTI's camera frame, comparable with the ground truth; pass "
-                     "--no-calib to work in the LiDAR frame (pose files hold LiDAR-frame poses, poses.txt is taken "
-                     "as given)");
+  sequence.ignore_labels = options.ignore_labels;
+  return std::make_unique<SequenceFolderSource>(SequenceReader(path, sequence), !options.ignore_calib);
+}
+
+}  // namespace
+
+std::string_view format_name(ScanFormat format) {
+  for (const auto& [f, name] : kNames) {
+    if (f == format) return name;
   }
-  return source;
+  return "?";
+}
+
+std::optional<ScanFormat> scan_format_from_name(std::string_view name) {
+  for (const auto& [f, n] : kNames) {
+    if (n == name) return f;
+  }
+  return std::nullopt;
+}
+
+const std::vector<std::string>& scan_format_names() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> out;
+    for (const auto& [f, n] : kNames) out.emplace_back(n);
+    return out;
+  }();
+  return names;
+}
+
+ScanFormat detect_scan_format(const fs::path& path) {
+  std::error_code ec;
+  const auto status = fs::status(path, ec);
+  if (status.type() == fs::file_type::not_found) throw InputError(path, "not found");
+  if (status.type() == fs::file_type::directory) return detect_folder(path);
+  if (status.type() == fs::file_type::regular) return detect_file(path);
+  throw InputError(path, ec ? fmt::format("cannot access: {}", ec.message()) : std::string("is not a file or folder"));
+}
+
+std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptions& given) {
+  SourceOptions options = given;
+  options.ignore_labels = given.ignore_labels || given.segmentation.has_value();
+  const ScanFormat format = options.format == ScanFormat::kAuto ? detect_scan_format(path) : options.format;
+  switch (format) {
+    case ScanFormat::kSemanticKitti: return open_semantic_kitti(path, options);
+    case ScanFormat::kKittiRaw: return std::make_unique<KittiRawDrive>(path, options);
+    case ScanFormat::kPcd:
+    case ScanFormat::kPly: return std::make_unique<PointCloudFolder>(path, format, options);
+    case ScanFormat::kRosbag: return std::make_unique<RosbagSource>(path, options);
+    case ScanFormat::kAuto: break;
+  }
+  throw InputError(path, "no scan format");
 }
 
 std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, const SourceOptions& options) {
@@ -27,7 +115,7 @@ std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, con
   return source;
 }
 
-std::unique_ptr<FrameSource> open_source(const std::filesystem::path& path, const SourceOptions& options) {
+std::unique_ptr<FrameSource> open_source(const fs::path& path, const SourceOptions& options) {
   return add_stages(open_reader(path, options), options);
 }
 

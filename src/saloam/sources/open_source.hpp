@@ -1,41 +1,47 @@
 #pragma once
 // The one place where a command opens the frames it runs on: the reader for
 // a path, then the stages every frame goes through before a run sees it.
-//   reader   a SemanticKITTI sequence folder (SequenceFolderSource)
+//   readers  every layout of source_options.hpp, each a FrameSource that
+//            fills SourceInfo (times, labels?, Tr?, reference poses, folder,
+//            format, point fields, notes):
+//              semantickitti  SequenceFolderSource (io/sequence_source.hpp)
+//              kitti-raw      KittiRawDrive        (sources/kitti_raw_drive.hpp)
+//              pcd, ply       PointCloudFolder     (sources/point_cloud_folder.hpp)
+//              rosbag         RosbagSource         (sources/rosbag_source.hpp)
 //   stages   the frame range (--frames A:B, FrameRangeSource), then the
 //            segmentation (--segment: labels from a network, SegmentedSource)
-// A new reader is one more case in open_reader(); a new stage wraps the
-// source in add_stages(), in the order frames should pass it, with its
-// option in SourceOptions. The simulator is no path: the demo builds its
+// A new reader is one more case in open_reader() (and in detect_scan_format
+// when a path can say what it is); a new stage wraps the source in
+// add_stages(), in the order frames should pass it, with its option in
+// SourceOptions. The simulator is no path: the demo builds its
 // SimulatedSource itself and hands it to add_stages().
+//
+// Frames: a source with Tr (calib.txt) gives KITTI camera-frame reference
+// poses and runs write camera-frame poses; a source without (no calib.txt,
+// --no-calib, KITTI raw drives, bags) runs in the LiDAR frame, and the run
+// says so once (runs/output_folder.hpp).
 
 #include <filesystem>
 #include <memory>
-#include <optional>
 
-#include "saloam/core/frame_range.hpp"
 #include "saloam/io/frame_source.hpp"
-#include "saloam/segmentation/segmented_source.hpp"
+#include "saloam/sources/source_options.hpp"
 
 namespace saloam {
 
-struct SourceOptions {
-  /// --labels: .label files from this folder instead of the sequence's labels/.
-  std::optional<std::filesystem::path> labels;
-  /// Frames without labels (--no-semantics, label-agnostic loop detectors).
-  bool ignore_labels = false;
-  /// --no-calib: calib.txt is not read; the run works in the LiDAR frame
-  /// (pose files hold LiDAR-frame poses, poses.txt is taken as such).
-  bool ignore_calib = false;
-  FrameRange frames;  ///< --frames A:B; everything by default
-  /// --segment: every scan labelled by this model (the reader's labels are not read).
-  std::optional<SegmentationStageOptions> segmentation;
-};
+/// The format of `path` by what it holds: a file starting with the bag magic
+/// "#ROSBAG V2.0" or named *.bag: rosbag; a .pcd or .ply file: that format;
+/// a folder with velodyne/: semantickitti; with velodyne_points/data:
+/// kitti-raw; with .pcd or .ply files: that format. InputError naming the
+/// path and listing what was looked for when nothing matches (or both .pcd
+/// and .ply files lie in one folder).
+ScanFormat detect_scan_format(const std::filesystem::path& path);
 
-/// The reader for `path`. A SemanticKITTI folder needs calib.txt unless
-/// ignore_calib: without Tr a run's poses.txt could not be compared with the
-/// ground truth (InputError naming --no-calib). Reader errors are
-/// InputErrors naming the file.
+/// The reader for `path` as `options.format` (detected when kAuto), with
+/// options.topic, labels, ignore_labels and ignore_calib (labels are not
+/// read when the segmentation stage makes them). InputError naming
+/// the file for a missing path, a layout that is not that format, a corrupt
+/// file or (for a bag) a build without rosbag_storage.
 std::unique_ptr<FrameSource> open_reader(const std::filesystem::path& path, const SourceOptions& options);
 
 /// `source` behind the stages `options` asks for: the frame range

@@ -94,7 +94,13 @@ std::optional<fs::path> sequence_folder(const RunSummary& summary, const ViewerO
     if (!fs::is_directory(*options.sequence)) throw InputError(*options.sequence, "sequence folder not found");
     return options.sequence;
   }
-  if (summary.sequence && fs::is_directory(*summary.sequence)) return summary.sequence;
+  if (summary.sequence && fs::is_directory(*summary.sequence / "velodyne")) return summary.sequence;
+  if (summary.sequence && fs::is_directory(*summary.sequence)) {
+    spdlog::warn("{}: the run read another layout than a SemanticKITTI folder; no ground truth and no scans (give "
+                 "--sequence)",
+                 summary.sequence->string());
+    return std::nullopt;
+  }
   if (summary.sequence) {
     spdlog::warn("{}: the run's sequence folder is gone; no ground truth and no scans (give --sequence)",
                  summary.sequence->string());

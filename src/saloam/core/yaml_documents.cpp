@@ -1,0 +1,46 @@
+#include "saloam/core/yaml_documents.hpp"
+
+#include <sstream>
+#include <string>
+
+#include <yaml-cpp/eventhandler.h>
+#include <yaml-cpp/parser.h>
+
+namespace saloam {
+namespace {
+
+/// Parser events thrown away: only whether a document ends is of interest.
+class Discard : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark&) override {}
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
+}  // namespace
+
+std::vector<YAML::Node> load_yaml_documents(std::string_view text) {
+  const std::string copy(text);
+  {
+    std::istringstream in(copy);
+    YAML::Parser parser(in);
+    Discard discard;
+    std::size_t documents = 0;
+    while (parser.HandleNextDocument(discard)) {
+      if (++documents > kMaxYamlDocuments) {
+        throw YAML::Exception(YAML::Mark::null_mark(), "more than 64 YAML documents");
+      }
+    }
+  }
+  std::vector<YAML::Node> documents = YAML::LoadAll(copy);
+  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
+  return documents;
+}
+
+}  // namespace saloam

@@ -1,0 +1,52 @@
+#pragma once
+// What a command asks of a source: the layout to read it as, the bag topic,
+// labels, calibration, the frame range and the segmentation stage. Shared by open_reader() and the
+// readers (sources/*.hpp); the commands fill it from cli::SourceArgs
+// (SEQ_DIR, --format, --topic, --labels, --frames, --no-calib).
+//
+// The layouts (--format):
+//   semantickitti  SEQ/velodyne/NNNNNN.bin (+ labels/, times.txt, poses.txt, calib.txt)
+//   kitti-raw      DRIVE/velodyne_points/data/*.bin + timestamps, oxts/ (GPS/INS reference)
+//   pcd, ply       a folder of .pcd or .ply files (or one file), ordered by name
+//   rosbag         a ROS 1 bag's sensor_msgs/PointCloud2 messages on one topic
+//   auto           detected from the path (detect_scan_format)
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "saloam/core/frame_range.hpp"
+#include "saloam/segmentation/segmented_source.hpp"
+
+namespace saloam {
+
+enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag };
+
+/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag".
+[[nodiscard]] std::string_view format_name(ScanFormat format);
+/// The format of a --format value, nullopt for an unknown name.
+[[nodiscard]] std::optional<ScanFormat> scan_format_from_name(std::string_view name);
+/// Every --format value, for option checks and help texts.
+[[nodiscard]] const std::vector<std::string>& scan_format_names();
+
+struct SourceOptions {
+  ScanFormat format = ScanFormat::kAuto;  ///< --format
+  /// --topic: the bag topic to read; empty: the only PointCloud2 topic of the bag.
+  std::string topic;
+  /// --labels: .label files from this folder (named like the scans) instead
+  /// of the source's own labels/.
+  std::optional<std::filesystem::path> labels;
+  /// Frames without labels (--no-semantics, label-agnostic loop detectors).
+  bool ignore_labels = false;
+  /// --no-calib: calib.txt is not read; the run works in the LiDAR frame
+  /// (pose files hold LiDAR-frame poses, poses.txt is taken as such). A
+  /// source without calib.txt runs so anyway.
+  bool ignore_calib = false;
+  FrameRange frames;  ///< --frames A:B; everything by default
+  /// --segment: every scan labelled by this model (the reader's labels are not read).
+  std::optional<SegmentationStageOptions> segmentation;
+};
+
+}  // namespace saloam
