@@ -65,7 +65,8 @@ TEST(SensorProfiles, BadFilesNameTheProblem) {
 }
 
 TEST(SensorProfiles, AppliedToTheOdometrysSettings) {
-  const auto& vlp = named(shipped(), "vlp16");
+  const auto all = shipped();
+  const auto& vlp = named(all, "vlp16");
   FeatureConfig features;
   apply_sensor_profile(vlp, features);
   EXPECT_EQ(features.num_beams, 16);
