@@ -82,7 +82,7 @@ TEST(InfoCli, ASimulatedVlp16InPcdFilesHasRingsTimesAndItsSensor) {
   ASSERT_EQ(run_command(quoted(cli_path()) + " odom " + quoted(dir / "vlp") + " --out " + quoted(dir / "odom"), &output), 0)
       << output;
   EXPECT_NE(output.find("sensor: vlp16 (Velodyne VLP-16), guessed"), std::string::npos) << output;
-  EXPECT_NE(output.find("4 frames, 0 registration failures, 0 degenerate frames"), std::string::npos) << output;
+  EXPECT_NE(output.find("4 frames, 0 registration failures"), std::string::npos) << output;
 }
 
 TEST(InfoCli, WhatIsNotASourceIsAnErrorSayingWhy) {

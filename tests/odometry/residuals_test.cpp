@@ -225,16 +225,19 @@ TEST(Registration, DegenerateDirectionKeepsTheInitialGuess) {
   ASSERT_GT(settings.degeneracy_eigenvalue, 0.0);
   const auto result = register_scan(scan.edges, scan.planars, map, guess, settings);
   ASSERT_TRUE(result.ok);
-  EXPECT_EQ(result.degenerate_directions, 1);
+  // Along x nothing constrains the pose; the roll, from points at most 4 m
+  // off the axis, is weak at the features' RMS range too (about 17 m).
+  EXPECT_GE(result.degenerate_directions, 1);
+  EXPECT_LE(result.degenerate_directions, 2);
   EXPECT_TRUE(result.degenerate());
-  EXPECT_LT(result.smallest_eigenvalue, 1e-6);
+  EXPECT_LT(result.smallest_eigenvalue, settings.degeneracy_eigenvalue);
   // Across, up and in yaw the scene decides: the truth. Along the corridor
-  // the guess stays, seen from the true yaw (the corridor's axis is x in
-  // the world: the estimate moves only across it).
+  // the guess stays (the estimate moves only across the corridor's axis,
+  // world x).
   const Pose err = truth.inverse() * result.pose;
-  EXPECT_LT(rotation_angle(err), 1e-4);
-  EXPECT_NEAR(result.pose.translation().y(), truth.translation().y(), 1e-3);
-  EXPECT_NEAR(result.pose.translation().z(), truth.translation().z(), 1e-3);
+  EXPECT_LT(rotation_angle(err), 1e-3);
+  EXPECT_NEAR(result.pose.translation().y(), truth.translation().y(), 0.01);
+  EXPECT_NEAR(result.pose.translation().z(), truth.translation().z(), 0.01);
   EXPECT_NEAR(result.pose.translation().x(), guess.translation().x(), 0.01);
 
   // The structured scene constrains every direction: no degeneracy, and the
