@@ -224,7 +224,7 @@ int run_demo(const DemoOptions& options) {
   const std::size_t shown = info.size() / 2;
   SlamRunOptions run_options;
   run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
-    if (baseline) baseline->add(scan, t);
+    if (baseline) baseline->add(scan, t, info.first_frame + i);
     if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
   };
   OutputFolder slam_folder = open_slam_folder(out / "slam", info);

@@ -31,8 +31,9 @@ int run_odom(const OdomOptions& options) {
   const std::filesystem::path out_dir(options.out);
   const OdometryRunResult result = run_odometry(*source, config.odometry, out_dir);
   const double median_ms = result.median_frame_ms();
-  std::cout << fmt::format("{} frames, {} registration failures, median {:.1f} ms/frame ({:.1f} Hz)\n", result.frames,
-                           result.registration_failures, median_ms, median_ms > 0 ? 1000.0 / median_ms : 0.0);
+  std::cout << fmt::format("{} frames, {} registration failures, {} degenerate frames, median {:.1f} ms/frame ({:.1f} Hz)\n",
+                           result.frames, result.registration_failures, result.degenerate_frames, median_ms,
+                           median_ms > 0 ? 1000.0 / median_ms : 0.0);
   std::cout << fmt::format("wrote {} ({})\n", out_dir.string(), fmt::join(result.files, ", "));
   if (result.interrupted) {
     spdlog::warn("interrupted: {} frames written", result.frames);

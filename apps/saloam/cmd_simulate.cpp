@@ -49,6 +49,8 @@ Pose load_velo_to_cam(const std::filesystem::path& calib, const std::filesystem:
     const std::string stem = trajectory.stem().string();
     const bool numeric = !stem.empty() && std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); });
     if (!numeric || !std::filesystem::is_regular_file(calib)) throw;
+    // A sequence number of a few digits ("00".."21"); a longer name is no sequence.
+    if (stem.size() > 6) throw;
     return read_velo_to_cam(calib, std::stoi(stem));
   }
 }

@@ -33,6 +33,8 @@ void print_summary(const SlamRunResult& r) {
                            "loop closure {:.2f} ms/frame amortised; peak memory {:.0f} MiB\n",
                            r.frames, r.keyframes, r.loops_accepted, r.loops_verified, r.median_frame_ms,
                            r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.mean_loop_ms, r.peak_rss_mib);
+  std::cout << fmt::format("odometry: {} registration failures, {} degenerate frames\n", r.registration_failures,
+                           r.degenerate_frames);
   if (r.loop_summary) {
     const auto& s = *r.loop_summary;
     std::cout << fmt::format("loops vs ground truth ({}): {} true, {} false ({} reverse); revisit stretches {} "

@@ -4,6 +4,9 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include <iostream>
+
+#include <nlohmann/json.hpp>
 #include <spdlog/cfg/env.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -55,9 +58,31 @@ int run_guarded(const std::function<int()>& command) {
   } catch (const std::filesystem::filesystem_error& e) {
     spdlog::error("{}", describe(e));  // "PATH: reason", not the library's raw text
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
+    spdlog::error("{}", describe_exception(e));
   }
   return 2;
+}
+
+std::string describe_exception(const std::exception& e) {
+  std::string_view text = e.what();
+  if (dynamic_cast<const nlohmann::json::exception*>(&e)) {
+    // "[json.exception.type_error.316] invalid UTF-8 byte ...": the library's tag is no news to a user.
+    if (const auto end = text.find("] "); text.starts_with("[json.exception.") && end != std::string_view::npos) {
+      text.remove_prefix(end + 2);
+    }
+    return "JSON: " + plain_error_text(text);
+  }
+  // std::stoi and its siblings throw with their own name as the whole text.
+  if (dynamic_cast<const std::invalid_argument*>(&e) || dynamic_cast<const std::out_of_range*>(&e)) {
+    if (text.starts_with("sto")) return "a number that is not one or is out of range (" + plain_error_text(text) + ")";
+  }
+  if (dynamic_cast<const std::bad_alloc*>(&e)) return "out of memory";
+  return plain_error_text(text);
+}
+
+int print_parse_error(const CLI::ParseError& e) {
+  std::cerr << plain_error_text(e.what()) << "\nRun with --help for more information.\n";
+  return e.get_exit_code();
 }
 
 }  // namespace saloam::cli

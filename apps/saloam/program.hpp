@@ -2,7 +2,9 @@
 // What every saloam program does around its command: logging, -v / -q,
 // Ctrl-C, and one clear message and exit code for every error.
 
+#include <exception>
 #include <functional>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
@@ -24,5 +26,14 @@ struct Verbosity {
 /// and keep what it has (130; a second Ctrl-C leaves at once); an error is
 /// logged as one message naming what failed (2).
 int run_guarded(const std::function<int()>& command);
+
+/// An exception's text as an error message: plain and short
+/// (plain_error_text), without a library's tags ("[json.exception...]") or
+/// bare function names ("stoul").
+std::string describe_exception(const std::exception& e);
+
+/// Prints a command-line error (escaped, cut when long: an argument can hold
+/// anything) and returns CLI11's exit code for it.
+int print_parse_error(const CLI::ParseError& e);
 
 }  // namespace saloam::cli

@@ -9,7 +9,9 @@
 #include <string>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
+#include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
@@ -184,6 +186,49 @@ TEST(BadInputCli, OptionValuesAreCheckedWithReadableMessages) {
   expect_has(output, "--resolution");
   expect_has(output, "must be a positive number, got '0'");
   EXPECT_LT(output.size(), 400u) << output;  // no 300-digit range
+}
+
+TEST(BadInputCli, CommandLineErrorsArePlainAndShort) {
+  TempDir tmp;
+  const fs::path seq = write_sequence(tmp);
+  std::string output;
+  const std::string huge(100'000, '7');
+  EXPECT_NE(run_command(saloam_cmd(fmt::format("odom {} --out {} --frames {}", quoted(seq), quoted(tmp / "o"), huge)),
+                        &output),
+            0);
+  expect_has(output, "--frames");
+  expect_has(output, "more bytes)");
+  EXPECT_LT(output.size(), 1000u);
+  EXPECT_NE(run_command(saloam_cmd(fmt::format("odom {} --out {} --frames $(printf '1\\033[31m:3')", quoted(seq),
+                                               quoted(tmp / "o"))),
+                        &output),
+            0);
+  expect_has(output, "\\x1b[31m");
+  EXPECT_EQ(output.find('\x1b'), std::string::npos) << output;
+}
+
+// A folder name that is not UTF-8 (any bytes but '/' and NUL are allowed)
+// breaks no output: summary.json records it readably and exactly, and the
+// viewer finds the sequence again from it.
+TEST(BadInputCli, PathsThatAreNotUtf8BreakNoOutput) {
+  TempDir tmp;
+  const fs::path seq = write_sequence(tmp);
+  const fs::path odd_seq = tmp / "seq\xff\xfe";
+  fs::rename(seq, odd_seq);
+  const fs::path out = tmp / "run\xff";
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {}", quoted(odd_seq), quoted(out))), &output), 0)
+      << output;
+  for (const char* name : {"summary.json", "map.ply", "view.html", "poses.txt"}) {
+    EXPECT_TRUE(fs::is_regular_file(out / name)) << name << "\n" << output;
+  }
+  std::ifstream summary_file(out / "summary.json");
+  const auto summary = nlohmann::json::parse(summary_file);
+  EXPECT_EQ(summary["sequence_hex"], to_hex(fs::absolute(odd_seq).lexically_normal().string()));
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {} --out {}", quoted(out), quoted(tmp / "page.html"))), &output), 0)
+      << output;
+  EXPECT_EQ(output.find("no ground truth"), std::string::npos) << output;
+  expect_has(output, "with ground truth");
 }
 
 TEST(BadInputCli, PathsAreNamedWithTheirProblem) {

@@ -11,6 +11,8 @@
 
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include "cli/cli_fixture.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/place/sgpr_weights.hpp"
@@ -165,6 +167,45 @@ TEST(InputsCli, ViewerBudgetsAreCheckedWithShortMessages) {
     EXPECT_LT(output.size(), 300u) << output;
     EXPECT_EQ(output.find("18446744073709551615"), std::string::npos) << output;
   }
+}
+
+// Failures that are reported: a scan of one point fails its registration in
+// odom and slam alike (warned, counted, in summary.json), and a scene that
+// leaves directions unconstrained is reported as degenerate. The street
+// scans have vertical poles and one wall but no ground: nothing fixes the
+// height, the roll or the pitch.
+TEST(InputsCli, RegistrationFailuresAndDegenerateFramesAreReportedByOdomAndSlam) {
+  TempDir tmp;
+  const fs::path seq = write_street_sequence(tmp / "seq", 7);
+  {
+    LabelledCloud one;
+    one.has_labels = true;
+    one.push_back({5.0F, 1.0F, 0.5F}, 0.3F, cls::kPole, 0);
+    SequenceWriter(seq).write_scan(4, one);
+  }
+  for (const std::string command : {"odom", "slam"}) {
+    const fs::path out = tmp / command;
+    std::string output;
+    ASSERT_EQ(run_command(saloam_cmd(fmt::format("{} {} --out {}", command, quoted(seq), quoted(out))), &output), 0)
+        << output;
+    expect_has(output, "frame 4: registration failed (");
+    expect_has(output, "1 registration failures, 5 degenerate frames");
+    // One warning per stretch of degenerate frames: 1-3, then 5-6 after the failure.
+    expect_has(output, "frame 1: degenerate geometry: ");
+    expect_has(output, "frame 5: degenerate geometry");
+    EXPECT_EQ(output.find("frame 2: degenerate"), std::string::npos) << output;
+    const auto summary = nlohmann::json::parse(file_text(out / "summary.json"));
+    EXPECT_EQ(summary["registration_failures"], 1) << command;
+    EXPECT_EQ(summary["degenerate_frames"], 5) << command;
+  }
+  // Off: no direction is called degenerate.
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("odom {} --out {} --set odometry.degeneracy_eigenvalue=0", quoted(seq),
+                                               quoted(tmp / "off"))),
+                        &output),
+            0)
+      << output;
+  expect_has(output, "1 registration failures, 0 degenerate frames");
 }
 
 }  // namespace

@@ -24,6 +24,22 @@ TEST(Errors, TextIsPlainAndShortWhateverTheInputHeld) {
   EXPECT_STREQ(ConfigError("a\tb\x1b[31m").what(), "a\tb\\x1b[31m");
 }
 
+TEST(Files, Utf8AndHexForPathsInJson) {
+  EXPECT_TRUE(is_valid_utf8("/tmp/plain"));
+  EXPECT_TRUE(is_valid_utf8("/tmp/caf\xc3\xa9/\xe2\x82\xac/\xf0\x9f\x98\x80"));  // é, €, an emoji
+  EXPECT_FALSE(is_valid_utf8("bad\xff\xfename"));
+  EXPECT_FALSE(is_valid_utf8("cut\xc3"));            // a sequence cut short
+  EXPECT_FALSE(is_valid_utf8("\xc0\xaf"));          // overlong '/'
+  EXPECT_FALSE(is_valid_utf8("\xed\xa0\x80"));      // a surrogate
+  EXPECT_FALSE(is_valid_utf8("\xf4\x90\x80\x80"));  // beyond U+10FFFF
+  const std::string bytes("a\xff\x00/z", 5);
+  EXPECT_EQ(to_hex(bytes), "61ff002f7a");
+  EXPECT_EQ(from_hex(to_hex(bytes)), bytes);
+  EXPECT_FALSE(from_hex("6"));
+  EXPECT_FALSE(from_hex("zz"));
+  EXPECT_FALSE(from_hex("6A"));  // to_hex writes lower case only
+}
+
 TEST(Files, RequireFileNamesWhatIsWrong) {
   testing::TempDir dir;
   std::ofstream(dir / "a.txt") << "x";

@@ -196,6 +196,79 @@ TEST(Registration, ConvergesAsWellFarFromTheOrigin) {
   }
 }
 
+// A corridor: a floor and two walls along x, nothing across. Every residual
+// is blind to a shift along x.
+ScanFeatures corridor(std::mt19937& rng) {
+  ScanFeatures f;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 1500; ++i) f.planars.push_back({30 * u(rng), 4 * u(rng), -1.7}, 0, 0.0f);
+  for (int i = 0; i < 1000; ++i) f.planars.push_back({30 * u(rng), -4.0, 2 * u(rng) + 1}, 0, 0.0f);
+  for (int i = 0; i < 1000; ++i) f.planars.push_back({30 * u(rng), 4.0, 2 * u(rng) + 1}, 0, 0.0f);
+  return f;
+}
+
+TEST(Registration, DegenerateDirectionKeepsTheInitialGuess) {
+  std::mt19937 rng(13);
+  const ScanFeatures world = corridor(rng);
+  OdometryConfig config;
+  config.use_semantics = false;
+  const SemanticLocalMap map = map_of(world.edges, world.planars);
+  // The sensor moved 0.7 m along the corridor, 0.1 m across and turned 2 deg;
+  // the prediction (initial guess) says 0.6 m along, nothing else.
+  Vector6d xi;
+  xi << 0.7, 0.1, 0.02, 0.0, 0.0, 0.035;
+  const Pose truth = se3_exp(xi);
+  Pose guess = Pose::Identity();
+  guess.translation().x() = 0.6;
+  const ScanFeatures scan = seen_from(world, truth);
+  const auto settings = RegistrationSettings::from_config(config);
+  ASSERT_GT(settings.degeneracy_eigenvalue, 0.0);
+  const auto result = register_scan(scan.edges, scan.planars, map, guess, settings);
+  ASSERT_TRUE(result.ok);
+  // Along x nothing constrains the pose; the roll, from points at most 4 m
+  // off the axis, is weak at the features' RMS range too (about 17 m).
+  EXPECT_GE(result.degenerate_directions, 1);
+  EXPECT_LE(result.degenerate_directions, 2);
+  EXPECT_TRUE(result.degenerate());
+  EXPECT_LT(result.smallest_eigenvalue, settings.degeneracy_eigenvalue);
+  // Across, up and in yaw the scene decides: the truth. Along the corridor
+  // the guess stays (the estimate moves only across the corridor's axis,
+  // world x).
+  const Pose err = truth.inverse() * result.pose;
+  EXPECT_LT(rotation_angle(err), 1e-3);
+  EXPECT_NEAR(result.pose.translation().y(), truth.translation().y(), 0.01);
+  EXPECT_NEAR(result.pose.translation().z(), truth.translation().z(), 0.01);
+  EXPECT_NEAR(result.pose.translation().x(), guess.translation().x(), 0.01);
+
+  // The structured scene constrains every direction: no degeneracy, and the
+  // same pose, bit for bit, as with the check off.
+  const ScanFeatures full = scene(rng);
+  const SemanticLocalMap full_map = map_of(full.edges, full.planars);
+  const ScanFeatures full_scan = seen_from(full, truth);
+  auto off = settings;
+  off.degeneracy_eigenvalue = 0;
+  const auto checked = register_scan(full_scan.edges, full_scan.planars, full_map, guess, settings);
+  const auto unchecked = register_scan(full_scan.edges, full_scan.planars, full_map, guess, off);
+  ASSERT_TRUE(checked.ok);
+  EXPECT_EQ(checked.degenerate_directions, 0);
+  EXPECT_GT(checked.smallest_eigenvalue, settings.degeneracy_eigenvalue);
+  EXPECT_TRUE(checked.pose.matrix() == unchecked.pose.matrix());
+  EXPECT_EQ(unchecked.degenerate_directions, 0);  // not counted when off
+}
+
+TEST(Registration, NormalizedHessianWeighsRotationAtTheLever) {
+  // One plane residual with normal x at 10 m along y: a yaw of phi moves the
+  // point by 10 phi along x. At a lever of 10 m, yaw and x translation count alike.
+  Eigen::Matrix<double, 1, 6> J;
+  const Plane plane{Eigen::Vector3d(0, 10, 0), Eigen::Vector3d::UnitX()};
+  point_to_plane_residual(Pose::Identity(), Eigen::Vector3d(0, 10, 0), plane, &J);
+  const Eigen::Matrix<double, 6, 6> H = J.transpose() * J;
+  const Eigen::Matrix<double, 6, 6> n = normalized_hessian(H, 1, 10.0);
+  EXPECT_NEAR(n(0, 0), 1.0, 1e-12);
+  EXPECT_NEAR(std::abs(n(5, 5)), 1.0, 1e-12);
+  EXPECT_NEAR(normalized_hessian(4.0 * H, 4, 10.0)(0, 5), n(0, 5), 1e-12);  // per correspondence
+}
+
 // The pose and the fit are bit-identical serial and over any number of
 // threads: the association writes per feature, and the normal equations and
 // the fit are summed in blocks fixed by the number of residuals.

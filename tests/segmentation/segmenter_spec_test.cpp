@@ -121,6 +121,14 @@ TEST(SegmenterSpec, ErrorsNameTheFileAndTheKey) {
   EXPECT_NE(error_of("format: [unclosed\n").find("not valid YAML"), std::string::npos);
 }
 
+TEST(SegmenterSpec, MalformedYamlEndsWithAnErrorNotOutOfMemory) {
+  // Found by the segmenter_spec fuzzer (fuzz/regressions/segmenter_spec/):
+  // yaml-cpp's LoadAll on a flow sequence cut at its start took 5 GB and
+  // more without end; the documents are counted first (load_yaml_documents).
+  const std::string yaml = ", remission], means:6\n  channels: [range, x]\nclasses: [unlabeled, car]\n";
+  EXPECT_NE(error_of(yaml).find("/models/m.yaml: not valid YAML"), std::string::npos) << error_of(yaml);
+}
+
 TEST(SegmenterSpec, ReadsOnlySmallRegularFiles) {
   testing::TempDir dir;
   EXPECT_NE(testing::input_error_of([&] { (void)read_segmenter_spec(dir / "missing.yaml"); }).find("not found"),

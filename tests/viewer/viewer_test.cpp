@@ -9,6 +9,13 @@
 #include <regex>
 #include <thread>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
 #include "saloam/viewer/point_encoding.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 #include "saloam/viewer/viewer_server.hpp"
@@ -223,11 +230,92 @@ TEST(Viewer, ServerSendsThePageTheMapAndScansOnDemand) {
   const auto beyond = client.Get("/scan/20");
   ASSERT_TRUE(beyond);
   EXPECT_EQ(beyond->status, 404);
-  EXPECT_NE(beyond->body.find("frame 20 out of range"), std::string::npos) << beyond->body;
+  EXPECT_NE(beyond->body.find("scan 20: not available"), std::string::npos) << beyond->body;
+  // No file name or absolute path in an error body (the log has them).
+  EXPECT_EQ(beyond->body.find(tmp.path().string()), std::string::npos) << beyond->body;
+  EXPECT_EQ(beyond->body.find('/'), std::string::npos) << beyond->body;
+  const auto huge = client.Get("/scan/99999999999999999999999");
+  ASSERT_TRUE(huge);
+  EXPECT_EQ(huge->status, 404);
+  EXPECT_LT(huge->body.size(), 100u) << huge->body;
 
   server.stop();
   listener.join();
   EXPECT_FALSE(server.running());
+}
+
+// A server on a fake run, listening on 127.0.0.1 until the fixture ends.
+struct ServingRun {
+  TempDir tmp;
+  std::unique_ptr<ViewerServer> server;
+  std::thread listener;
+  int port = 0;
+
+  ServingRun() {
+    const auto run = testing::write_fake_run(tmp.path(), 500, 5, 200);
+    const ViewerOptions options;
+    server = std::make_unique<ViewerServer>(load_viewer_scene(run.run_dir, options), options);
+    port = server->bind("127.0.0.1", 0);
+    listener = std::thread([this] { server->listen(); });
+    while (!server->running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ~ServingRun() {
+    server->stop();
+    listener.join();
+  }
+};
+
+TEST(Viewer, ServerAnswersOnlyToLoopbackHostNames) {
+  // DNS rebinding: a page of evil.example whose name the attacker points at
+  // 127.0.0.1 reaches the server, but with its own name in the Host header.
+  ServingRun serving;
+  const int port = serving.port;
+  httplib::Client client("127.0.0.1", port);
+  for (const std::string host : {fmt::format("127.0.0.1:{}", port), fmt::format("localhost:{}", port),
+                                 fmt::format("LocalHost:{}", port), fmt::format("[::1]:{}", port)}) {
+    const auto answer = client.Get("/map.bin", {{"Host", host}});
+    ASSERT_TRUE(answer) << host;
+    EXPECT_EQ(answer->status, 200) << host;
+  }
+  for (const std::string host : {fmt::format("evil.example:{}", port), std::string("evil.example"),
+                                 std::string("127.0.0.1"), fmt::format("127.0.0.1:{}", port + 1),
+                                 fmt::format("127.0.0.1.evil.example:{}", port), fmt::format("x127.0.0.1:{}", port),
+                                 std::string("")}) {
+    const auto answer = client.Get("/", {{"Host", host}});
+    ASSERT_TRUE(answer) << host;
+    EXPECT_EQ(answer->status, 403) << host;
+    EXPECT_EQ(answer->body.find("<html"), std::string::npos) << host;
+  }
+  EXPECT_TRUE(viewer_host_allowed(fmt::format("localhost:{}", port), port));
+  EXPECT_FALSE(viewer_host_allowed(fmt::format("localhost:{}0", port), port));
+  EXPECT_FALSE(viewer_host_allowed(":8080", 8080));
+}
+
+TEST(Viewer, IdleConnectionsDoNotStallTheServer) {
+  // Twelve connections that send nothing (more than httplib's default pool
+  // of 8 workers, each of which would wait 5 s on one): a request still
+  // gets its answer at once.
+  ServingRun serving;
+  std::vector<int> idle;
+  for (int i = 0; i < 12; ++i) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(static_cast<std::uint16_t>(serving.port));
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
+    idle.push_back(fd);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));  // the server has accepted them
+  httplib::Client client("127.0.0.1", serving.port);
+  const auto start = std::chrono::steady_clock::now();
+  const auto answer = client.Get("/map.bin");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  ASSERT_TRUE(answer);
+  EXPECT_EQ(answer->status, 200);
+  EXPECT_LT(seconds, 1.5);
+  for (const int fd : idle) ::close(fd);
 }
 
 }  // namespace

@@ -167,6 +167,12 @@ struct OdometryConfig {
   /// sequence measured (docs/odometry.md, "Per-class weights").
   bool adaptive_class_weights = true;
   int threads = 1;               ///< worker threads for association (0 = all cores)
+  /// A registration direction whose eigenvalue of the Hessian per
+  /// correspondence (rotations as the displacement they cause at the
+  /// features' RMS range; 1 = every residual constrains it fully) is below
+  /// this is degenerate: the pose keeps the constant-velocity prediction
+  /// along it, and the frame is counted and reported (0 = off).
+  double degeneracy_eigenvalue = 0.02;
 };
 
 /// Semantic Scan Context (Li et al., "SSC: Semantic Scan Context for
@@ -344,6 +350,7 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("class_voxel_size", c.class_voxel_size, "[m] per-class voxel size", Above{0});
   v("class_weight", c.class_weight, "w^l: per-class residual weight", AtLeast{0});
   v("adaptive_class_weights", c.adaptive_class_weights, "scale w^l by inverse residual variance per class");
+  v("degeneracy_eigenvalue", c.degeneracy_eigenvalue, "below it a registration direction is degenerate (0: off)", Range{0, 1});
   v("threads", c.threads, "threads (0 = all cores)", AtLeast{0});
 }
 

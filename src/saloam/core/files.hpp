@@ -4,6 +4,7 @@
 // std::filesystem::filesystem_error text.
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -27,6 +28,13 @@ bool path_taken(const std::filesystem::path& path);
 void create_folder(const std::filesystem::path& folder);
 /// create_folder() of the parent of `file`, when it has one.
 void create_parent_folder(const std::filesystem::path& file);
+
+/// Whether `text` is valid UTF-8 (JSON strings must be; a path need not be).
+bool is_valid_utf8(std::string_view text);
+/// The bytes of `text` as lower-case hexadecimal, two digits a byte.
+std::string to_hex(std::string_view text);
+/// The bytes to_hex() wrote; nullopt when `hex` is not such a text.
+std::optional<std::string> from_hex(std::string_view hex);
 
 /// "PATH: reason" for a filesystem_error (path1 when set, else the message).
 std::string describe(const std::filesystem::filesystem_error& error);

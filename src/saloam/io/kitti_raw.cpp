@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/io/point_fields.hpp"
 #include "saloam/io/text_input.hpp"
@@ -24,13 +25,6 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kMaxLatitude = 85.0;  // Mercator's y diverges at the poles
 constexpr double kMaxAltitude = 1e5;   // [m]: far above anything that carries a LiDAR
 constexpr double kMaxAngle = 7.0;      // [rad]: a little beyond 2 pi
-
-std::ofstream create_text(const std::filesystem::path& file) {
-  create_parent_folder(file);
-  std::ofstream out(file, std::ios::trunc);
-  if (!out) throw InputError(file, "cannot open for writing");
-  return out;
-}
 
 Eigen::Vector3d mercator(double lat, double lon, double scale) {
   return {scale * lon * kDeg * kEarthRadius, scale * kEarthRadius * std::log(std::tan((90.0 + lat) * kDeg / 2.0)), 0.0};
@@ -158,11 +152,12 @@ OxtsRecord read_oxts(const std::filesystem::path& file) {
 }
 
 void write_oxts(const std::filesystem::path& file, const OxtsRecord& r) {
-  auto out = create_text(file);
+  AtomicFile text(file);  // complete under its name, or absent
+  std::ostream& out = text.stream();
   out << fmt::format("{:.17g} {:.17g} {:.17g} {:.17g} {:.17g} {:.17g}", r.lat, r.lon, r.alt, r.roll, r.pitch, r.yaw);
   for (int i = 6; i < 30; ++i) out << (i == 25 ? " 4" : i == 26 ? " 10" : " 0");  // navstat 4, numsats 10
   out << '\n';
-  if (!out) throw InputError(file, "write failed");
+  text.commit();
 }
 
 std::vector<Pose> oxts_to_poses(const std::vector<OxtsRecord>& records) {
@@ -241,7 +236,8 @@ void write_kitti_timestamps(const std::filesystem::path& file, const std::vector
 }
 
 void write_kitti_timestamps_ns(const std::filesystem::path& file, const std::vector<std::int64_t>& times) {
-  auto out = create_text(file);
+  AtomicFile text(file);
+  std::ostream& out = text.stream();
   for (const std::int64_t t : times) {
     const std::int64_t s = t >= 0 ? t / kNanosPerSecond : (t - kNanosPerSecond + 1) / kNanosPerSecond;
     const long nanos = static_cast<long>(t - s * kNanosPerSecond);
@@ -260,7 +256,7 @@ void write_kitti_timestamps_ns(const std::filesystem::path& file, const std::vec
     out << fmt::format("{:04d}-{:02d}-{:02d} {:02d}:{:02d}:{:02d}.{:09d}\n", y, m, d, in_day / 3600, in_day % 3600 / 60,
                        in_day % 60, nanos);
   }
-  if (!out) throw InputError(file, "write failed");
+  text.commit();
 }
 
 Pose parse_imu_to_velo(std::istream& in, const std::filesystem::path& file) {
@@ -281,7 +277,8 @@ Pose read_imu_to_velo(const std::filesystem::path& file) {
 }
 
 void write_imu_to_velo(const std::filesystem::path& file, const Pose& imu_to_velo) {
-  auto out = create_text(file);
+  AtomicFile text(file);
+  std::ostream& out = text.stream();
   const Eigen::Matrix3d R = imu_to_velo.linear();
   const Eigen::Vector3d t = imu_to_velo.translation();
   out << "calib_time: written by saloam\nR:";
@@ -289,7 +286,7 @@ void write_imu_to_velo(const std::filesystem::path& file, const Pose& imu_to_vel
     for (int c = 0; c < 3; ++c) out << fmt::format(" {:.17g}", R(r, c));
   }
   out << fmt::format("\nT: {:.17g} {:.17g} {:.17g}\n", t.x(), t.y(), t.z());
-  if (!out) throw InputError(file, "write failed");
+  text.commit();
 }
 
 }  // namespace saloam

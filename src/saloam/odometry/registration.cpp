@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/odometry/parallel.hpp"
@@ -28,7 +29,15 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
                            : PlaneOrientation::kAny;
   }
   s.parallel = config.threads != 1;
+  s.degeneracy_eigenvalue = config.degeneracy_eigenvalue;
   return s;
+}
+
+Eigen::Matrix<double, 6, 6> normalized_hessian(const Eigen::Matrix<double, 6, 6>& hessian, int correspondences,
+                                               double lever) {
+  Vector6d inverse_scale;
+  inverse_scale << 1, 1, 1, 1 / lever, 1 / lever, 1 / lever;
+  return inverse_scale.asDiagonal() * hessian * inverse_scale.asDiagonal() / std::max(1, correspondences);
 }
 
 namespace {
@@ -226,16 +235,57 @@ NormalEquations normal_equations(const FeatureCloud& edges, const FeatureCloud& 
   return sum_in_blocks(edges.size() + planars.size(), settings.parallel, kResidualBlock, NormalEquations{}, term);
 }
 
+// The RMS distance of the features from the sensor [m] (at least 1 m): the
+// lever arm at which normalized_hessian() weighs rotations.
+double feature_lever(const FeatureCloud& edges, const FeatureCloud& planars) {
+  double sum = 0;
+  for (const auto& p : edges.points) sum += p.squaredNorm();
+  for (const auto& p : planars.points) sum += p.squaredNorm();
+  const auto n = static_cast<double>(edges.size() + planars.size());
+  return n > 0 ? std::max(1.0, std::sqrt(sum / n)) : 1.0;
+}
+
+// The eigen-decomposition of normalized_hessian(): eigenvalues ascending.
+Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>> normalized_eigen(const Eigen::Matrix<double, 6, 6>& H,
+                                                                             int correspondences, double lever) {
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, 6, 6>>(normalized_hessian(H, correspondences, lever));
+}
+
+// Solution remapping (Zhang et al. 2016): the step without its components
+// along the degenerate directions of H, so that the pose keeps the initial
+// guess there. The directions are orthonormal in the normalised coordinates
+// y = (rho, lever * phi), where the step is projected.
+Vector6d without_degenerate_directions(const Vector6d& delta, const Eigen::Matrix<double, 6, 6>& H,
+                                       int correspondences, double lever, double threshold) {
+  const auto eig = normalized_eigen(H, correspondences, lever);
+  Vector6d scale;
+  scale << 1, 1, 1, lever, lever, lever;
+  Vector6d y = scale.asDiagonal() * delta;
+  bool degenerate = false;
+  for (int i = 0; i < 6 && eig.eigenvalues()(i) < threshold; ++i) {
+    const Vector6d u = eig.eigenvectors().col(i);
+    y -= u.dot(y) * u;
+    degenerate = true;
+  }
+  if (!degenerate) return delta;
+  return scale.cwiseInverse().asDiagonal() * y;
+}
+
 // Gauss-Newton over the given correspondences from T; false when a step is
 // not finite (T is then the last finite pose).
 bool solve(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
-           const std::vector<PlaneMatch>& plane_matches, const RegistrationSettings& settings, Pose& T,
+           const std::vector<PlaneMatch>& plane_matches, const RegistrationSettings& settings, double lever, Pose& T,
            RegistrationResult& result) {
   for (int it = 0; it < settings.max_iterations; ++it) {
     auto [H, g] = normal_equations(edges, planars, edge_matches, plane_matches, T, settings);
+    const Eigen::Matrix<double, 6, 6> undamped = H;
     // Small Levenberg-Marquardt damping keeps weakly constrained directions stable.
     H.diagonal().array() += 1e-6 * H.diagonal().maxCoeff() + 1e-9;
-    const Vector6d delta = -H.ldlt().solve(g);
+    Vector6d delta = -H.ldlt().solve(g);
+    if (settings.degeneracy_eigenvalue > 0) {
+      delta = without_degenerate_directions(delta, undamped, result.correspondences(), lever,
+                                            settings.degeneracy_eigenvalue);
+    }
     if (!delta.allFinite()) return false;
     T = apply_update(delta, T);
     ++result.iterations;
@@ -257,11 +307,12 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   Pose T = initial;
   std::vector<EdgeMatch> edge_matches(edges.size());
   std::vector<PlaneMatch> plane_matches(planars.size());
+  const double lever = feature_lever(edges, planars);
   for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
     const Pose round_start = T;
     associate(edges, planars, map, T, settings, edge_matches, plane_matches, result);
     if (result.correspondences() < 20) return result;  // not enough to constrain 6 DoF reliably
-    if (!solve(edges, planars, edge_matches, plane_matches, settings, T, result)) return result;
+    if (!solve(edges, planars, edge_matches, plane_matches, settings, lever, T, result)) return result;
     if (outer + 1 >= settings.outer_iterations) break;
     const bool refreshed = refresh && refresh(T);
     const Pose moved = round_start.inverse() * T;
@@ -273,6 +324,9 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   result.pose = T;
   result.ok = true;
   evaluate_fit(edges, planars, edge_matches, plane_matches, T, settings, result);
+  const auto eig = normalized_eigen(result.hessian, result.correspondences(), lever);
+  result.smallest_eigenvalue = eig.eigenvalues()(0);
+  for (int i = 0; i < 6 && eig.eigenvalues()(i) < settings.degeneracy_eigenvalue; ++i) ++result.degenerate_directions;
   return result;
 }
 

@@ -38,6 +38,14 @@ struct RegistrationSettings {
   /// (RegistrationResult::inliers). Loop verification sets loop.inlier_distance;
   /// the odometry counts none (0): nothing reads its inliers.
   double inlier_distance{};
+  /// Degeneracy (Zhang, Kaess and Singh, "On degeneracy of optimization-based
+  /// state estimation problems", ICRA 2016): a direction whose eigenvalue of
+  /// the normalised Hessian (normalized_hessian()) is below this is not
+  /// constrained by the scene (a corridor along its axis, an open field in
+  /// yaw); Gauss-Newton then leaves the pose at the initial guess (the
+  /// odometry's constant-velocity prediction) along it and moves it only in
+  /// the constrained directions. 0: off (every direction is solved).
+  double degeneracy_eigenvalue{};
 
   /// From the config; without semantics all weights are 1 and no plane constraint applies.
   static RegistrationSettings from_config(const OdometryConfig& config);
@@ -56,6 +64,11 @@ struct RegistrationResult {
   int associations = 0;  ///< association rounds (neighbour search and fit for every feature)
   bool ok = false;  ///< false: too few correspondences, pose = initial guess
   bool converged = false;  ///< the last Gauss-Newton round ended on a negligible step
+  /// Eigenvalues of normalized_hessian() at the final fit below
+  /// settings.degeneracy_eigenvalue (0 when that is 0): the directions in
+  /// which the pose kept the initial guess.
+  int degenerate_directions = 0;
+  double smallest_eigenvalue = 0;  ///< of normalized_hessian() at the final fit
 
   // The fit at the final pose over the final correspondences (what loop
   // verification tests and the pose graph weighs):
@@ -75,8 +88,16 @@ struct RegistrationResult {
   std::array<double, kNumClassIndices> class_dof{};
 
   [[nodiscard]] int correspondences() const { return edge_matches + planar_matches; }
+  [[nodiscard]] bool degenerate() const { return degenerate_directions > 0; }
   [[nodiscard]] double mean_inlier_residual() const { return inliers > 0 ? inlier_residual_sum / inliers : 0.0; }
 };
+
+/// The Hessian per correspondence with the rotation scaled to the
+/// displacement it causes at `lever` metres from the sensor (y = (rho,
+/// lever * phi)): translation and rotation eigenvalues on one scale, 1 when
+/// every residual fully constrains a direction, 0 when none does.
+Eigen::Matrix<double, 6, 6> normalized_hessian(const Eigen::Matrix<double, 6, 6>& hessian, int correspondences,
+                                               double lever);
 
 /// Registers features (sensor frame) to the map starting from `initial` (T_world<-sensor).
 RegistrationResult register_scan(const FeatureCloud& edges, const FeatureCloud& planars,

@@ -49,10 +49,38 @@ OdometryRun::OdometryRun(const OdometryConfig& config, const std::filesystem::pa
   result_.camera_frame = velo_to_cam.has_value();
 }
 
-bool OdometryRun::add(const LabelledCloud& scan, double time) {
+bool RegistrationHealth::note(const SemanticOdometry& odometry, std::size_t frame) {
+  if (odometry.poses().size() <= 1) return true;  // the first frame has nothing to register to
+  const RegistrationResult& r = odometry.last_frame_stats().registration;
+  spdlog::debug("frame {}: {} correspondences, smallest normalised eigenvalue {:.4f}", frame, r.correspondences(),
+                r.smallest_eigenvalue);
+  if (!r.ok) {
+    ++failures_;
+    in_degenerate_stretch_ = false;
+    spdlog::warn("frame {}: registration failed ({} correspondences, too few); kept the constant-velocity prediction",
+                 frame, r.correspondences());
+    return false;
+  }
+  if (!r.degenerate()) {
+    in_degenerate_stretch_ = false;
+    return true;
+  }
+  ++degenerate_frames_;
+  if (!in_degenerate_stretch_) {  // once per stretch of degenerate frames
+    spdlog::warn("frame {}: degenerate geometry: {} of 6 directions unconstrained (smallest eigenvalue {:.3g} < "
+                 "odometry.degeneracy_eigenvalue {:.3g}); the constant-velocity prediction holds them (counted in "
+                 "summary.json until the scene constrains every direction again)",
+                 frame, r.degenerate_directions, r.smallest_eigenvalue, odometry.config().degeneracy_eigenvalue);
+  }
+  in_degenerate_stretch_ = true;
+  return true;
+}
+
+bool OdometryRun::add(const LabelledCloud& scan, double time, std::size_t frame) {
   const Pose q = odometry_.register_frame(scan, time);
-  const bool ok = odometry_.poses().size() == 1 || odometry_.last_frame_stats().registration.ok;
-  if (!ok) ++result_.registration_failures;
+  const bool ok = health_.note(odometry_, frame);
+  result_.registration_failures = health_.failures();
+  result_.degenerate_frames = health_.degenerate_frames();
   result_.output_poses.push_back(writer_.write(time, q));
   result_.lidar_poses.push_back(q);
   result_.timestamps.push_back(time);
@@ -70,8 +98,9 @@ nlohmann::json odometry_summary(const SourceInfo& info, const OdometryConfig& co
                          {"frames", result.frames},
                          {"semantics", config.use_semantics && info.has_labels},
                          {"camera_frame", result.camera_frame},
-                         {"registration_failures", result.registration_failures}};
-  if (info.folder) summary["sequence"] = std::filesystem::absolute(*info.folder).lexically_normal().string();
+                         {"registration_failures", result.registration_failures},
+                         {"degenerate_frames", result.degenerate_frames}};
+  if (info.folder) put_summary_path(summary, "sequence", std::filesystem::absolute(*info.folder).lexically_normal());
   return summary;
 }
 
@@ -86,9 +115,7 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
   OdometryRun run(config, out_dir, tr);
   ProgressBar progress(info.size(), options.progress_label, options.show_progress);
   for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
-    if (!run.add(source.scan(i), info.times.at(i))) {
-      spdlog::warn("frame {}: registration failed (too few correspondences); kept the prediction", info.first_frame + i);
-    }
+    run.add(source.scan(i), info.times.at(i), info.first_frame + i);
     progress.set_status(fmt::format("{:.0f} ms", run.odometry().timings().back().total_ms()));
     progress.advance();
   }

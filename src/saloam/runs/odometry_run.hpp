@@ -30,6 +30,24 @@ struct OdometryRunOptions {
   std::string progress_label = "odom";
 };
 
+/// How the frames' registrations went: failures (too few correspondences:
+/// the frame kept the prediction) and degenerate frames (some directions
+/// unconstrained: the prediction held those), counted and warned about as
+/// they happen; both runs (odom, slam) report them in summary.json.
+class RegistrationHealth {
+ public:
+  /// Looks at the registration of the frame `odometry` processed last
+  /// (frame number `frame` of the source, for the warning); false when it failed.
+  bool note(const SemanticOdometry& odometry, std::size_t frame);
+  [[nodiscard]] std::size_t failures() const { return failures_; }
+  [[nodiscard]] std::size_t degenerate_frames() const { return degenerate_frames_; }
+
+ private:
+  std::size_t failures_ = 0;
+  std::size_t degenerate_frames_ = 0;
+  bool in_degenerate_stretch_ = false;
+};
+
 struct OdometryRunResult {
   std::vector<Pose> lidar_poses;     ///< T_L0<-Li (world = first processed scan)
   std::vector<Pose> output_poses;    ///< as written to poses.txt
@@ -37,6 +55,7 @@ struct OdometryRunResult {
   std::vector<FrameTimings> timings;
   std::size_t frames = 0;
   std::size_t registration_failures = 0;
+  std::size_t degenerate_frames = 0;  ///< RegistrationHealth
   bool camera_frame = false;         ///< poses.txt uses the camera convention
   bool interrupted = false;
   std::vector<std::string> files;    ///< written into the output folder, in order
@@ -53,7 +72,9 @@ class OdometryRun {
   OdometryRun(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> velo_to_cam);
   /// Registers the next scan and writes its pose; false when the
   /// registration failed (too few correspondences: the prediction was kept).
-  bool add(const LabelledCloud& scan, double time);
+  /// Failures and degenerate frames are counted and warned about, named by
+  /// `frame` (the source's frame number).
+  bool add(const LabelledCloud& scan, double time, std::size_t frame);
   /// Puts the pose files in place (TrajectoryWriter::commit).
   void commit();
   [[nodiscard]] const SemanticOdometry& odometry() const { return odometry_; }
@@ -63,6 +84,7 @@ class OdometryRun {
   SemanticOdometry odometry_;
   TrajectoryWriter writer_;
   OdometryRunResult result_;
+  RegistrationHealth health_;
 };
 
 /// What run_odometry() may write into its folder.

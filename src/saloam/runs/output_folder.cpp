@@ -57,6 +57,12 @@ void update_run_summary(OutputFolder& folder) {
   folder.finish(stop_requested() ? "interrupted" : "complete");
 }
 
+void put_summary_path(nlohmann::json& summary, const std::string& key, const std::filesystem::path& path) {
+  const std::string text = path.string();
+  summary[key] = text;  // dump() replaces invalid bytes
+  if (!is_valid_utf8(text)) summary[key + "_hex"] = to_hex(text);
+}
+
 std::optional<std::size_t> recorded_first_frame(const std::filesystem::path& result_file) {
   const std::filesystem::path file = result_file.parent_path() / "summary.json";
   if (!path_taken(file)) return std::nullopt;

@@ -38,6 +38,12 @@ void update_run_summary(OutputFolder& folder);
 /// The sequence frame of the first pose in `result_file`: "first_frame" of
 /// the summary.json beside it when that summary lists the file among the
 /// run's; none for a file no run summary claims (e.g. a sequence's poses.txt).
+/// Records `path` under `key` in a run summary: as text, and when the path is
+/// not valid UTF-8 (JSON text must be) the text with U+FFFD for the bad
+/// bytes, readable, plus its exact bytes in hex under KEY_hex, which readers
+/// prefer (summary.json never fails over a path, and names the right folder).
+void put_summary_path(nlohmann::json& summary, const std::string& key, const std::filesystem::path& path);
+
 std::optional<std::size_t> recorded_first_frame(const std::filesystem::path& result_file);
 
 /// The velodyne-to-camera Tr for a run's KITTI pose files: the source's, so

@@ -212,7 +212,9 @@ nlohmann::json evaluate_run(const SlamSystem& slam, const SaloamConfig& config, 
                          {"keyframes", result.keyframes},
                          {"detector", config.loop.detector},
                          {"loops_verified", result.loops_verified},
-                         {"loops_accepted", result.loops_accepted}};
+                         {"loops_accepted", result.loops_accepted},
+                         {"registration_failures", result.registration_failures},
+                         {"degenerate_frames", result.degenerate_frames}};
   if (truth.camera && result.frames >= 2) {
     result.odometry_evaluation = evaluate_trajectories(*truth.camera, odometry_out);
     result.slam_evaluation = evaluate_trajectories(*truth.camera, slam_out);
@@ -238,7 +240,7 @@ nlohmann::json evaluate_run(const SlamSystem& slam, const SaloamConfig& config, 
     }
     summary["loops"] = loop_summary_json(*result.loop_summary);
   }
-  if (origin.folder) summary["sequence"] = std::filesystem::absolute(*origin.folder).lexically_normal().string();
+  if (origin.folder) put_summary_path(summary, "sequence", std::filesystem::absolute(*origin.folder).lexically_normal());
   return summary;
 }
 
@@ -274,7 +276,8 @@ namespace {
 // The frame loop: every frame of `source` through the SLAM, the odometry's
 // poses written as they come, and a stream's scans kept for the map.
 double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& odometry_writer,
-                      std::optional<MapScanStore>& map_scans, const SlamRunOptions& options) {
+                      std::optional<MapScanStore>& map_scans, const SlamRunOptions& options,
+                      RegistrationHealth& health) {
   const SourceInfo& info = source.info();
   ProgressBar progress(info.size(), "slam", options.show_progress);
   const StageTimer timer;
@@ -282,6 +285,7 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
     const LabelledCloud scan = source.scan(i);
     const double t = info.times.at(i);
     odometry_writer.write(t, slam.process(scan, t));
+    health.note(slam.odometry(), info.first_frame + i);
     if (options.on_scan) options.on_scan(i, scan, t);
     if (map_scans) map_scans->offer(i, scan);
     progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
@@ -338,7 +342,10 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   SlamSystem slam(config, std::move(network));
   TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
   TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);
-  SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options));
+  RegistrationHealth health;
+  SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options, health));
+  result.registration_failures = health.failures();
+  result.degenerate_frames = health.degenerate_frames();
   odometry_writer.commit();
   const std::vector<Pose> optimized = slam.optimized_poses();
   nlohmann::json summary = write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);

@@ -12,6 +12,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/core/yaml_documents.hpp"
 
 namespace saloam {
 namespace {
@@ -194,11 +195,12 @@ std::vector<std::uint16_t> semantickitti_learning_classes() {
 SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& origin) {
   std::vector<YAML::Node> documents;
   try {
-    documents = YAML::LoadAll(std::string(yaml_text));
+    // Documents counted before LoadAll, which never ends (and runs out of
+    // memory) on some malformed inputs (load_yaml_documents).
+    documents = load_yaml_documents(yaml_text);
   } catch (const YAML::Exception& e) {
     throw InputError(origin, fmt::format("not valid YAML (line {}): {}", e.mark.line + 1, e.msg.substr(0, 200)));
   }
-  std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
   if (documents.size() > 1) {
     throw InputError(origin, fmt::format("holds {} YAML documents (separated by '---'); a description is one",
                                          documents.size()));

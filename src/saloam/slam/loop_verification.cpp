@@ -44,6 +44,8 @@ LoopVerificationSettings LoopVerificationSettings::from_config(const SaloamConfi
   s.fine.max_iterations = kIterations;
   s.fine.outer_iterations = kFineRounds;
   s.fine.inlier_distance = config.loop.inlier_distance;
+  // A loop's fit is judged for degeneracy (min_translation_eigenvalue), not held at its guess.
+  s.fine.degeneracy_eigenvalue = 0;
   s.coarse = s.fine;
   s.coarse.max_correspondence_distance = kCoarseDistance;
   s.coarse.robust_kernel_scale = kCoarseKernel;

@@ -29,6 +29,8 @@ Pose velo_to_cam_for(const fs::path& calib, const fs::path& trajectory) {
     const bool numeric =
         !stem.empty() && std::all_of(stem.begin(), stem.end(), [](unsigned char c) { return std::isdigit(c); });
     if (!numeric || !fs::is_regular_file(calib)) throw;
+    // A sequence number of a few digits ("00".."21"); a longer name is no sequence.
+    if (stem.size() > 6) throw;
     return read_velo_to_cam(calib, std::stoi(stem));
   }
 }

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 #include <yaml-cpp/yaml.h>
 
@@ -89,17 +90,39 @@ GraphSequence folder_graphs(const SourceSpec& spec, const GraphBuilderConfig& gr
   return out;
 }
 
+// Graph caches of a few thousand frames are tens of MB.
+constexpr std::size_t kMaxGraphCacheBytes = std::size_t{1} << 30;
+
+// The cached graphs when `file` holds them for `key`; nullopt when there is
+// none, it is stale, or damaged (a warning: it is then rebuilt). Anything
+// but a regular file in its place is an error (read_file).
 std::optional<GraphSequence> read_cache(const fs::path& file, const nlohmann::json& key) {
-  if (!fs::is_regular_file(file)) return std::nullopt;
-  std::ifstream in(file);
-  nlohmann::json j = nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded() || !j.contains("key") || j["key"] != key) return std::nullopt;
-  GraphSequence out;
-  out.name = j.at("name").get<std::string>();
-  for (const auto& g : j.at("graphs")) out.graphs.push_back(graph_from_json(g, file));
-  for (const auto& p : j.at("positions")) out.positions.emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
-  if (out.graphs.size() != out.positions.size()) return std::nullopt;
-  return out;
+  if (!path_taken(file)) return std::nullopt;
+  const nlohmann::json j =
+      nlohmann::json::parse(read_file(file, kMaxGraphCacheBytes, "graph cache"), nullptr, /*allow_exceptions=*/false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("key")) {
+    spdlog::warn("{}: not a graph cache (damaged?); rebuilding it", plain_error_text(file.string()));
+    return std::nullopt;
+  }
+  if (j["key"] != key) return std::nullopt;
+  try {
+    GraphSequence out;
+    out.name = j.at("name").get<std::string>();
+    for (const auto& g : j.at("graphs")) out.graphs.push_back(graph_from_json(g, file));
+    for (const auto& p : j.at("positions")) {
+      const Eigen::Vector3d position(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+      if (!position.allFinite()) throw InputError(file, "a position is not finite");
+      out.positions.push_back(position);
+    }
+    if (out.graphs.size() != out.positions.size()) throw InputError(file, "graphs and positions differ in number");
+    return out;
+  } catch (const nlohmann::json::exception&) {
+    spdlog::warn("{}: damaged graph cache (a field of the wrong type or missing); rebuilding it",
+                 plain_error_text(file.string()));
+  } catch (const InputError& e) {
+    spdlog::warn("{}; rebuilding the graph cache", e.what());
+  }
+  return std::nullopt;
 }
 
 void write_cache(const fs::path& file, const nlohmann::json& key, const GraphSequence& sequence) {

@@ -7,6 +7,7 @@
 #include <random>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
 #include "saloam/core/cancellation.hpp"
@@ -78,10 +79,15 @@ void write_vector(std::ostream& out, const std::vector<T>& v) {
   out.write(reinterpret_cast<const char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T)));
 }
 
+// A vector as write_vector() wrote it; false when the stream ends or fails
+// first, or it claims more than `max_size` elements or more bytes than are left.
 template <class T>
-bool read_vector(std::istream& in, std::vector<T>& v, std::uint64_t max_size) {
+bool read_vector(std::istream& in, std::vector<T>& v, std::uint64_t max_size, std::uint64_t& bytes_left) {
   std::uint64_t n = 0;
-  if (!in.read(reinterpret_cast<char*>(&n), sizeof n) || n > max_size) return false;
+  if (bytes_left < sizeof n || !in.read(reinterpret_cast<char*>(&n), sizeof n) || n > max_size) return false;
+  bytes_left -= sizeof n;
+  if (n * sizeof(T) > bytes_left) return false;
+  bytes_left -= n * sizeof(T);
   v.resize(n);
   return static_cast<bool>(in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(n * sizeof(T))));
 }
@@ -94,26 +100,43 @@ std::string cache_key(const SourceSpec& spec, const FeatureConfig& rings) {
       .dump();
 }
 
+// The cached scans when `file` holds them for `key`; nullopt when there is
+// none, it is stale, or it is damaged (a warning: it is then rebuilt). Every
+// read is checked, and no length is trusted beyond the file's size.
 std::optional<std::vector<TrainingScan>> read_cache(const fs::path& file, const std::string& key) {
+  if (!path_taken(file)) return std::nullopt;
+  require_file(file, "scan cache");  // a folder or a FIFO in its place is an error, never waited on
+  std::error_code error;
+  std::uint64_t bytes_left = fs::file_size(file, error);
   std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
+  if (error || !in) throw InputError(file, "cannot read the scan cache");
+  const auto damaged = [&file]() -> std::optional<std::vector<TrainingScan>> {
+    spdlog::warn("{}: damaged or cut scan cache; rebuilding it", plain_error_text(file.string()));
+    return std::nullopt;
+  };
   std::vector<char> magic, stored_key;
-  if (!read_vector(in, magic, 64) || std::string(magic.begin(), magic.end()) != kCacheMagic) return std::nullopt;
-  if (!read_vector(in, stored_key, 1 << 20) || std::string(stored_key.begin(), stored_key.end()) != key) return std::nullopt;
+  if (!read_vector(in, magic, 64, bytes_left) || std::string(magic.begin(), magic.end()) != kCacheMagic) return damaged();
+  if (!read_vector(in, stored_key, 1 << 20, bytes_left)) return damaged();
+  if (std::string(stored_key.begin(), stored_key.end()) != key) return std::nullopt;  // stale
   std::uint64_t count = 0;
-  if (!in.read(reinterpret_cast<char*>(&count), sizeof count) || count > 10'000'000) return std::nullopt;
-  std::vector<TrainingScan> scans(count);
+  if (bytes_left < sizeof count || !in.read(reinterpret_cast<char*>(&count), sizeof count) || count > 10'000'000)
+    return damaged();
+  bytes_left -= sizeof count;
+  std::vector<TrainingScan> scans;
   constexpr std::uint64_t kMaxPoints = 10'000'000;
-  for (auto& s : scans) {
+  for (std::uint64_t k = 0; k < count; ++k) {
+    TrainingScan s;
     std::vector<std::int32_t> beams;
-    if (!read_vector(in, beams, 1) || beams.size() != 1 || !read_vector(in, s.xyz, kMaxPoints) ||
-        !read_vector(in, s.remission, kMaxPoints) || !read_vector(in, s.target, kMaxPoints) ||
-        !read_vector(in, s.ring, kMaxPoints))
-      return std::nullopt;
+    if (!read_vector(in, beams, 1, bytes_left) || beams.size() != 1 || !read_vector(in, s.xyz, kMaxPoints, bytes_left) ||
+        !read_vector(in, s.remission, kMaxPoints, bytes_left) || !read_vector(in, s.target, kMaxPoints, bytes_left) ||
+        !read_vector(in, s.ring, kMaxPoints, bytes_left))
+      return damaged();
     s.beams = beams[0];
     const std::size_t n = s.xyz.size();
-    if (s.remission.size() != n || s.target.size() != n || s.ring.size() != n) return std::nullopt;
+    if (s.remission.size() != n || s.target.size() != n || s.ring.size() != n) return damaged();
+    scans.push_back(std::move(s));
   }
+  if (bytes_left != 0) return damaged();
   return scans;
 }
 

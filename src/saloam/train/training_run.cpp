@@ -43,11 +43,13 @@ void replace_checkpoint(const fs::path& out, const std::function<void(const fs::
   fs::rename(partial, out / "checkpoint");
 }
 
+// A checkpoint's state.json holds options and a few counters.
+constexpr std::size_t kMaxCheckpointStateBytes = 16u << 20;
+
 nlohmann::json read_checkpoint_state(const fs::path& out) {
   const fs::path file = out / "checkpoint" / "state.json";
   require_file(file, "checkpoint state (nothing to resume)");
-  std::ifstream in(file);
-  nlohmann::json state = nlohmann::json::parse(in, nullptr, false);
+  nlohmann::json state = nlohmann::json::parse(read_file(file, kMaxCheckpointStateBytes, "checkpoint state"), nullptr, false);
   if (state.is_discarded() || !state.contains("options")) throw InputError(file, "not a checkpoint state");
   return state;
 }

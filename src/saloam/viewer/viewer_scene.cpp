@@ -85,6 +85,12 @@ RunSummary read_run_summary(const fs::path& run_dir) {
     throw InputError(file, "not a summary of `saloam slam` (a JSON object with \"sequence\" and \"first_frame\")");
   }
   if (sequence != json.end()) summary.sequence = fs::path(sequence->get<std::string>());
+  // A path that is not UTF-8 is recorded exactly in hex beside its readable text.
+  if (const auto hex = json.find("sequence_hex"); hex != json.end() && hex->is_string()) {
+    const auto bytes = from_hex(hex->get<std::string>());
+    if (!bytes) throw InputError(file, "\"sequence_hex\" is not a hexadecimal path");
+    summary.sequence = fs::path(*bytes);
+  }
   if (first != json.end()) summary.first_frame = first->get<std::size_t>();
   return summary;
 }

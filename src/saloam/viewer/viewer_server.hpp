@@ -4,13 +4,21 @@
 //   /            the page (ViewerDataSource::kServer)
 //   /map.bin     the decimated map (point_encoding.hpp)
 //   /scan/N      scan N (processed-frame index), loaded from the sequence on demand
+// Only requests whose Host names the loopback and the port are answered (DNS
+// rebinding); error bodies are short and name no file.
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 #include "saloam/viewer/viewer_scene.hpp"
 
 namespace saloam {
+
+/// Whether a request's Host header names this server on the loopback:
+/// 127.0.0.1:PORT, localhost:PORT or [::1]:PORT (anything else, e.g. a
+/// rebound DNS name, is refused with 403).
+bool viewer_host_allowed(std::string_view host, int port);
 
 class ViewerServer {
  public:
