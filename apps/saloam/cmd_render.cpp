@@ -39,7 +39,7 @@ int run_render(const RenderArgs& args) {
   MapRenderOptions options = args.map;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
   const auto map_png = out / "map.png";
-  const MapRenderStats s = render_map(args.sequence, map_png, options);
+  const MapRenderStats s = render_map(reader, map_png, options);
   std::cout << fmt::format("map: {} ({}x{} px, {:.2f} m/px, {} scans, {} points)\n", map_png.string(), s.width, s.height,
                            s.metres_per_pixel, s.scans_used, s.points_drawn);
   return 0;

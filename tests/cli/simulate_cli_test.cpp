@@ -1,11 +1,18 @@
 // End-to-end: `saloam simulate` (presets, KITTI trajectories, noisy labels,
 // bad options) and `saloam render`.
 
+#include <cairo.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <vector>
 
+#include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/sequence.hpp"
 #include "testing/test_support.hpp"
@@ -129,6 +136,51 @@ TEST(RenderCli, WritesMapAndRangeImage) {
   EXPECT_GT(fs::file_size(dir / "png" / "range_000002.png"), 2000u);
   EXPECT_NE(run_command(quoted(cli_path()) + " render " + quoted(seq) + " --out " + quoted(dir / "png") + " --frame 7", &output), 0);
   EXPECT_NE(output.find("out of range"), std::string::npos) << output;
+}
+
+/// Pixels of map.png in a shade of `colour` (the map darkens by relief, to 72 %).
+int pixels_of(const fs::path& png, const Rgb& colour) {
+  cairo_surface_t* surface = cairo_image_surface_create_from_png(png.c_str());
+  int count = 0;
+  if (cairo_surface_status(surface) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(surface);
+    const int width = cairo_image_surface_get_width(surface), height = cairo_image_surface_get_height(surface);
+    const int stride = cairo_image_surface_get_stride(surface);
+    const unsigned char* data = cairo_image_surface_get_data(surface);
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const unsigned char* p = data + y * stride + 4 * x;  // B, G, R, A
+        const double shade = static_cast<double>(p[0]) / std::max<int>(colour.b, 1);
+        const auto near = [shade](int pixel, int full) { return std::abs(pixel - shade * full) <= 2.0; };
+        count += shade >= 0.7 && shade <= 1.0 && near(p[2], colour.r) && near(p[1], colour.g);
+      }
+    }
+  }
+  cairo_surface_destroy(surface);
+  return count;
+}
+
+TEST(RenderCli, TheMapShowsTheGivenLabels) {
+  TempDir dir;
+  const fs::path seq = dir / "seq";
+  std::string output;
+  ASSERT_EQ(run_command(simulate(seq, "--frames 0:3"), &output), 0) << output;
+  // Another labels folder that calls every point a car.
+  fs::create_directories(dir / "cars");
+  for (const auto& entry : fs::directory_iterator(seq / "labels")) {
+    const std::vector<std::uint32_t> cars(fs::file_size(entry.path()) / 4, cls::kCar);
+    std::ofstream(dir / "cars" / entry.path().filename(), std::ios::binary)
+        .write(reinterpret_cast<const char*>(cars.data()), static_cast<std::streamsize>(4 * cars.size()));
+  }
+  const auto render = [&](const std::string& extra, const std::string& name) {
+    EXPECT_EQ(run_command(quoted(cli_path()) + " render " + quoted(seq) + " --out " + quoted(dir / name) + extra, &output), 0)
+        << output;
+    return pixels_of(dir / name / "map.png", class_color(cls::kCar));
+  };
+  const int own = render("", "own");
+  const int cars = render(" --labels-dir " + quoted(dir / "cars"), "cars");
+  EXPECT_GT(cars, 1000);
+  EXPECT_GT(cars, 10 * own) << "own labels: " << own << " car pixels";
 }
 
 }  // namespace

@@ -6,13 +6,14 @@
 #include <cstdio>
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 namespace saloam {
 
 ProgressBar::ProgressBar(std::size_t total, std::string label, bool enabled)
     : total_(std::max<std::size_t>(total, 1)),
       label_(std::move(label)),
-      enabled_(enabled),
+      enabled_(enabled && spdlog::should_log(spdlog::level::info)),
       tty_(isatty(STDERR_FILENO) != 0),
       start_(std::chrono::steady_clock::now()),
       last_draw_(start_) {}

@@ -1,6 +1,7 @@
 #pragma once
 // A progress bar for long runs on stderr: redrawn in place on a terminal,
-// a line every 10 % otherwise (CI logs), with rate and time left.
+// a line every 10 % otherwise (CI logs), with rate and time left. Progress
+// is information: with the log level above info (`saloam -q`) nothing is drawn.
 
 #include <chrono>
 #include <cstddef>

@@ -22,8 +22,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 }  // namespace
 
-MapRenderStats render_map(const fs::path& sequence_dir, const fs::path& png, const MapRenderOptions& options) {
-  const SequenceReader reader(sequence_dir);
+MapRenderStats render_map(const SequenceReader& reader, const fs::path& png, const MapRenderOptions& options) {
   const std::vector<Pose> poses = reader.lidar_poses();
   const std::size_t n = reader.size();
   const std::size_t step = options.frame_step > 0 ? options.frame_step : std::max<std::size_t>(1, n / 300);

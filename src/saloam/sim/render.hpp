@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "saloam/core/types.hpp"
+#include "saloam/io/sequence.hpp"
 #include "saloam/mapping/map_render.hpp"
 
 namespace saloam {
@@ -26,11 +27,11 @@ struct MapRenderStats : TopDownStats {
   std::size_t scans_used = 0;
 };
 
-/// Top-down map of the sequence at `sequence_dir` (needs poses.txt and
-/// calib.txt) written to `png`: its scans, de-skewed with the poses, drawn
+/// Top-down map of the sequence `reader` reads (it needs poses) written to
+/// `png`: its scans with the reader's labels, de-skewed with the poses, drawn
 /// into a TopDownCanvas (the highest point per pixel wins, so buildings and
 /// trees show over the ground as in an aerial view).
-MapRenderStats render_map(const std::filesystem::path& sequence_dir, const std::filesystem::path& png,
+MapRenderStats render_map(const SequenceReader& reader, const std::filesystem::path& png,
                           const MapRenderOptions& options = {});
 
 /// Range image of one scan (rows = HDL-64E beams by elevation, columns =
