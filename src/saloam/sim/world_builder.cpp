@@ -51,6 +51,10 @@ class WorldBuilder {
  public:
   WorldBuilder(World& w, std::uint64_t seed) : w_(w), seed_(seed) {}
 
+  /// A step between consecutive trajectory poses longer than this [m] is
+  /// the jump between two passes through the world, not a drive.
+  static constexpr double kPassJump = 5.0;
+
   void build_path(const std::vector<Pose>& trajectory) {
     const double h = w_.options_.sensor_height;
     w_.ego_s_.reserve(trajectory.size());
@@ -62,6 +66,15 @@ class WorldBuilder {
     for (std::size_t i = 1; i < trajectory.size(); ++i) {
       const Eigen::Vector3d p = trajectory[i].translation() - Eigen::Vector3d(0, 0, h);
       const double len = (p - prev).norm();
+      if (len > kPassJump) {
+        // The jump from one pass to the next (SimulationOptions::passes):
+        // no road along it, no arc length (moving objects do not travel it).
+        w_.path_.push_back(p);
+        w_.path_s_.push_back(s);
+        w_.ego_s_.push_back(s);
+        prev = p;
+        continue;
+      }
       const int pieces = std::max(1, static_cast<int>(std::ceil(len / 0.5)));
       if (len > 1e-6) {
         for (int k = 1; k <= pieces; ++k) {
