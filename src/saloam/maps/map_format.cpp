@@ -520,12 +520,16 @@ void remove_stale_partials(const fs::path& target) {
 
 }  // namespace
 
-void write_map(const fs::path& folder, const SavedMap& map,
-               const std::function<const StoredFeatures&(std::size_t)>& features) {
-  std::error_code ec;
+void check_map_destination(const fs::path& folder) {
   if (path_taken(folder) && !is_saloam_map(folder)) {
     throw InputError(folder, "exists and is not a saloam map: it is left as it is (choose another --save-map)");
   }
+}
+
+void write_map(const fs::path& folder, const SavedMap& map,
+               const std::function<const StoredFeatures&(std::size_t)>& features) {
+  std::error_code ec;
+  check_map_destination(folder);
   if (map.keyframes.empty()) throw InputError(folder, "no keyframe to save: the map would be empty");
   if (map.places.size() != map.keyframes.size()) throw InputError(folder, "one place descriptor per keyframe is needed");
   if (!folder.parent_path().empty()) create_folder(folder.parent_path());

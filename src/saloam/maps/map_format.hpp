@@ -94,6 +94,10 @@ struct SavedMap {
 void write_map(const std::filesystem::path& folder, const SavedMap& map,
                const std::function<const StoredFeatures&(std::size_t)>& features);
 
+/// InputError when `folder` exists and is not a saloam map (write_map would
+/// refuse it): a run checks before it starts.
+void check_map_destination(const std::filesystem::path& folder);
+
 /// Reads and validates map.json, config.yaml, keyframes.bin, edges.bin and
 /// places.bin of the map in `folder` (not the features). InputError naming
 /// the file and the problem.

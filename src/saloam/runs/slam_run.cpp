@@ -329,6 +329,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
   const std::filesystem::path& out_dir = folder.path();
+  if (options.save_map) check_map_destination(*options.save_map);
 
   // A stream cannot be read again for the map: keep what the map needs as it goes by.
   const SemanticMapOptions map_options = SemanticMapOptions::from_config(config.slam);
