@@ -58,6 +58,10 @@ TEST(KittiRaw, BadTimestampsNameTheLine) {
   EXPECT_NE(error_of("2011-09-26 13:02:25.9\n2011-13-26 13:02:25.9\n").find("ts.txt: line 2: '2011-13-26 13:02:25.9' is not a KITTI timestamp"), std::string::npos);
   EXPECT_NE(error_of("2011-09-26 13:02:25.9\n2011-09-26 13:02:25.8\n").find("ts.txt: line 2: timestamp"), std::string::npos);
   EXPECT_NE(error_of("1317042145.9\n").find("line 1"), std::string::npos);
+  // Years whose nanoseconds since 1970 do not fit 64 bits (the fuzzer's 0000).
+  EXPECT_NE(error_of("0000-01-01 00:00:00.0\n").find("line 1: '0000-01-01 00:00:00.0' is not a KITTI timestamp"),
+            std::string::npos);
+  EXPECT_NE(error_of("9999-12-31 23:59:59.9\n").find("is not a KITTI timestamp"), std::string::npos);
 }
 
 TEST(KittiRaw, OxtsRecordsBecomePosesAndBack) {

@@ -65,6 +65,11 @@ long days_from_civil(long y, unsigned m, unsigned d) {
   return era * 146097 + static_cast<long>(doe) - 719468;
 }
 
+/// Years a timestamp may carry: wide of any recording, inside the range of
+/// 64-bit nanoseconds since 1970.
+constexpr int kFirstYear = 1900;
+constexpr int kLastYear = 2200;
+
 /// "YYYY-MM-DD hh:mm:ss[.fffffffff]" as nanoseconds since the epoch (exact:
 /// times of one drive subtract without rounding), or nullopt. A tenth
 /// fraction digit rounds the nanoseconds.
@@ -74,6 +79,8 @@ std::optional<std::int64_t> parse_date_time(std::string_view s) {
   const auto hour = digits_at(s, 11, 2), minute = digits_at(s, 14, 2), second = digits_at(s, 17, 2);
   if (!year || !month || !day || !hour || !minute || !second) return std::nullopt;
   if (*month < 1 || *month > 12 || *day < 1 || *day > 31 || *hour > 23 || *minute > 59 || *second > 60) return std::nullopt;
+  // Nanoseconds since 1970 in 64 bits reach the years 1678-2262.
+  if (*year < kFirstYear || *year > kLastYear) return std::nullopt;
   std::int64_t nanos = 0;
   if (s.size() > 19) {
     if (s[19] != '.' || s.size() == 20 || s.size() > 30) return std::nullopt;

@@ -10,4 +10,11 @@ void deskew(FeatureCloud& cloud, const Vector6d& frame_motion, double frame_peri
   }
 }
 
+ScanFeatures deskewed(const ScanFeatures& scan, const Vector6d& frame_motion, double frame_period, double pose_time_in_sweep) {
+  ScanFeatures out = scan;
+  deskew(out.edges, frame_motion, frame_period, pose_time_in_sweep);
+  deskew(out.planars, frame_motion, frame_period, pose_time_in_sweep);
+  return out;
+}
+
 }  // namespace saloam

@@ -13,5 +13,7 @@ namespace saloam {
 /// `frame_motion` = twist log(T_prev^-1 T_curr) of one frame period `frame_period` [s].
 /// A point measured at sweep time tau maps with exp((tau - pose_time) / period * twist).
 void deskew(FeatureCloud& cloud, const Vector6d& frame_motion, double frame_period, double pose_time_in_sweep);
+/// A copy of `scan` with its edges and planars de-skewed as above.
+ScanFeatures deskewed(const ScanFeatures& scan, const Vector6d& frame_motion, double frame_period, double pose_time_in_sweep);
 
 }  // namespace saloam

@@ -3,7 +3,8 @@
 // steps: extract LOAM features with their classes; predict the motion
 // (constant velocity); downsample per class and de-skew; register to the
 // local map (semantic ICP, de-skewing again as the estimate moves); add the
-// frame to the local map; report the pose at the scan's pose instant.
+// frame to the local map; report the pose at the scan's pose instant. The
+// first two frames, before a motion is known, are the start-up's (start_up.hpp).
 // The SLAM system feeds it frames and reads its poses and features.
 
 #include <memory>
@@ -18,6 +19,7 @@
 #include "saloam/odometry/features.hpp"
 #include "saloam/odometry/local_map.hpp"
 #include "saloam/odometry/registration.hpp"
+#include "saloam/odometry/start_up.hpp"
 
 namespace saloam {
 
@@ -65,10 +67,6 @@ class SemanticOdometry {
   /// matched) in its sensor frame at the reported pose instant: poses().back()
   /// maps them into the world.
   [[nodiscard]] const ScanFeatures& last_features() const { return last_features_; }
-  /// The first frame's features, de-skewed with the motion the second frame
-  /// revealed (frame 0 is reported before any motion is known): set by the
-  /// second frame, in frame 0's sensor frame at its pose instant.
-  [[nodiscard]] const std::optional<ScanFeatures>& revised_first_features() const { return revised_first_; }
   [[nodiscard]] const OdometryConfig& config() const { return config_; }
   /// w^l used for the next frame, per class index (matched class groups:
   /// the group's index): the configured weights, scaled when
@@ -81,6 +79,7 @@ class SemanticOdometry {
     Pose pose = Pose::Identity();
     Vector6d motion = Vector6d::Zero();  ///< expected twist over one frame
     double period = 0.1;                 ///< [s] time since the previous frame
+    bool motion_known = false;           ///< from two earlier frames (not for frames 0 and 1)
   };
 
   Pose process(const LabelledCloud& cloud, double timestamp);
@@ -90,10 +89,9 @@ class SemanticOdometry {
   ScanFeatures downsample_and_deskew(ScanFeatures& measured, const MotionPrediction& prediction) const;
   /// Registers `features` to the local map; de-skews them again from
   /// `measured` as the estimate moves. Returns the mid-sweep pose.
-  Pose align(ScanFeatures& features, ScanFeatures& measured, const MotionPrediction& prediction);
-  /// The second frame's coarse registration against frame 0 (bootstrap): where its fine one starts.
-  Pose coarse_start(ScanFeatures& features, const Pose& initial, const RegistrationSettings& settings,
-                    const FeatureRefresh& refresh);
+  Pose register_to_map(ScanFeatures& features, const ScanFeatures& measured, const MotionPrediction& prediction);
+  /// De-skews the scan again from `measured` between registration rounds (none before the motion is known).
+  FeatureRefresh deskew_refresh(const ScanFeatures& measured, const MotionPrediction& prediction) const;
   void update_map(const ScanFeatures& features, const Pose& sweep_pose);
   /// Adaptive class weights: folds the frame's per-class residuals into the
   /// running variances and sets settings_.class_weight from them.
@@ -118,10 +116,7 @@ class SemanticOdometry {
   std::vector<FrameTimings> cpu_timings_;
   FrameStats last_stats_;
   ScanFeatures last_features_;
-  std::optional<ScanFeatures> revised_first_;
-  ScanFeatures first_raw_;  ///< first frame's features before de-skewing (bootstrap)
-  /// Frame 0 with a wide search radius, for the second frame's coarse registration (bootstrap).
-  std::optional<SemanticLocalMap> bootstrap_map_;
+  std::optional<StartUp> start_up_;  ///< frames 0 and 1
 };
 
 }  // namespace saloam

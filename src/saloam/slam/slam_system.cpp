@@ -71,9 +71,6 @@ Pose SlamSystem::process(const LabelledCloud& scan, double timestamp) {
   const Pose odometry_pose = odometry_.register_frame(scan, timestamp);
   timing.odometry_ms = timer.elapsed_ms();
   if (previous > 0) travelled_ += (odometry_.poses()[previous - 1].translation() - odometry_pose.translation()).norm();
-  if (previous == 1 && odometry_.revised_first_features() && !keyframes_.empty()) {
-    keyframes_.front().features = StoredFeatures::from(*odometry_.revised_first_features());
-  }
 
   if (keyframe_due(odometry_pose)) {
     add_keyframe(scan, odometry_pose, timestamp, timing);
