@@ -38,6 +38,7 @@ struct SimulateArgs {
   bool no_skew = false;
   bool no_dynamic = false;
   bool stats = false;
+  std::vector<std::string> passes;  ///< --passes A:B[:reverse],...
 };
 
 // Tr from a KITTI calib.txt (`Tr:` line) or from the per-sequence list
@@ -79,6 +80,8 @@ SimulationOptions simulation_options(const SimulateArgs& args) {
     options.sensor = sensor_profile(args.sensor);
     if (!args.azimuth_steps_given) options.azimuth_steps = options.sensor->simulation.azimuth_steps;
   }
+  for (const auto& pass : args.passes) options.passes.push_back(parse_route_pass(pass));
+  if (options.pass > 0 && options.passes.empty()) throw ConfigError("--pass needs --passes");
   options.skew = !args.no_skew;
   options.world.dynamic_objects = !args.no_dynamic;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
@@ -154,6 +157,12 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--frames", args->frames, "Source frames A:B (B exclusive; A: or :B allowed)");
       app.add_option("--stride", args->sim.stride, "Use every K-th source pose (frames K x 0.1 s apart in times.txt; each sweep still lasts 0.1 s)")->check(CLI::Range(1, 100000));
       app.add_option("--seed", args->sim.seed, "World and noise seed");
+      app.add_option("--passes", args->passes,
+                     "Several drives through one world (route pose ranges A:B, A:B:reverse for the opposite lane "
+                     "backwards), one after the other in time; --pass K renders the K-th (from 0), --frames within it. "
+                     "simulation.yaml records where its first frame lies in the world (origin)")
+          ->delimiter(',');
+      app.add_option("--pass", args->sim.pass, "Which of --passes to render (from 0)");
       app.add_option("--labels", args->labels, "gt: exact labels; noisy: emulated network output in labels/, truth in labels_gt/")
           ->check(CLI::IsMember({"gt", "noisy"}));
       app.add_option("--beams", args->sim.beams, "Number of beams: 64 (HDL-64E), 32 or 16")->check(CLI::IsMember({64, 32, 16}));

@@ -25,6 +25,7 @@ struct SlamOptions {
   std::string detector;
   std::string model;
   bool no_map = false;
+  std::string save_map;
   ConfigOptions config;
 };
 
@@ -75,13 +76,20 @@ int run_slam_command(const SlamOptions& options) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
   const bool labels = config.odometry.use_semantics || needs_labels(parse_place_detector(config.loop.detector));
-  const std::unique_ptr<FrameSource> source = options.source.open(!labels, config);
+  SensorChoice sensor;
+  const std::unique_ptr<FrameSource> source = options.source.open(!labels, config, &sensor);
   SlamRunOptions run_options;
   run_options.write_map = !options.no_map;
+  if (!options.save_map.empty()) run_options.save_map = options.save_map;
+  if (sensor.profile) run_options.sensor = sensor.profile->name;
 
   OutputFolder folder = open_slam_folder(options.out, source->info());
   const SlamRunResult result = run_slam(*source, config, load_loop_network(config), folder, run_options);
   print_summary(result);
+  if (result.map_bytes) {
+    std::cout << fmt::format("saved map: {} ({} keyframes, {:.1f} MB, {:.2f} s)\n", options.save_map, result.keyframes,
+                             static_cast<double>(*result.map_bytes) / 1e6, result.map_save_seconds);
+  }
   if (run_options.write_map && !result.interrupted) write_view_page(folder);
   std::cout << fmt::format("wrote {} ({})\n", folder.path().string(), fmt::join(folder.files(), ", "));
   if (result.interrupted) {
@@ -102,6 +110,9 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--model", options->model, "SGPR weights (.sgw) for the sgpr and hybrid detectors (loop.sgpr_model)")
           ->check(CLI::ExistingFile);
       app.add_flag("--no-map", options->no_map, "Skip the global map (map.ply, map.png)");
+      app.add_option("--save-map", options->save_map,
+                     "Save the map for later runs (a folder: keyframes, descriptors, pose graph, configuration; "
+                     "docs/map_format.md); `saloam localize --map` reads it");
       add_no_calib_flag(app, options->source.no_calib);
       options->config.add_to(app);
       return [options] { return run_slam_command(*options); };

@@ -284,6 +284,48 @@ struct SlamConfig {
   int map_frame_step = 2;           ///< every n-th frame goes into the global map
 };
 
+/// Localisation in a saved map (`saloam localize`, docs/map_format.md):
+/// relocalisation by place recognition and the loop closure's verification
+/// (loop.*), then tracking against the map with the odometry between.
+struct LocalizeConfig {
+  /// [m] travel between relocalisation attempts while not placed (each
+  /// describes the scan and scores it against every map keyframe).
+  double relocalize_interval = 2.0;
+  /// A relocalisation is believed only when this many later fixes agree
+  /// with it: tracking registrations, `confirm_interval` m apart, started at
+  /// the pose the odometry predicts from it and passing the loop closure's
+  /// acceptance test.
+  int confirmations = 2;
+  double confirm_interval = 1.0;  ///< [m]
+  /// [m] map keyframes whose position lies within this of the predicted pose
+  /// form the tracking submap.
+  double track_radius = 40.0;
+  /// [m] keyframes of the tracking submap are at least this far apart (the
+  /// map's keyframes overlap; fewer make the submap cheaper).
+  double submap_spacing = 2.0;
+  /// [m] the tracking submap is rebuilt when the pose has moved this far
+  /// from where it was built.
+  double submap_rebuild_distance = 8.0;
+  /// Register every n-th frame against the map; the odometry carries the
+  /// frames between.
+  int track_every = 2;
+  /// A tracking fit is used when at least this fraction of the scan's
+  /// features are inliers (closer than loop.inlier_distance) ...
+  double track_min_inlier_fraction = 0.3;
+  /// ... and it moves the odometry's prediction by at most this [m] / [deg].
+  double track_max_correction = 1.0;
+  double track_max_correction_deg = 3.0;
+  /// [m] travel without a usable fit after which the run says it has left
+  /// the mapped area and goes on with the odometry alone.
+  double leave_after = 15.0;
+  /// [m] travel on the odometry alone after the last fix beyond which frames
+  /// are no longer placed (marked, no pose) until the run relocalises.
+  double max_odometry_distance = 300.0;
+  /// Map keyframes whose features are kept in memory at once (the rest are
+  /// read again from the map when needed).
+  int cached_keyframes = 400;
+};
+
 /// In-process semantic segmentation of raw scans (`--segment`; the first
 /// box of the paper's Fig. 2): the model, and the pipeline stage that runs it
 /// beside the odometry.
@@ -303,6 +345,7 @@ struct SaloamConfig {
   LoopClosureConfig loop;
   SlamConfig slam;
   SegmentationConfig segmentation;
+  LocalizeConfig localize;
 };
 
 /// Calls v(name, member, description, range) for every field; range is the
@@ -412,6 +455,23 @@ void visit_fields(SegmentationConfig& c, Visitor&& v) {
   v("lookahead", c.lookahead, "scans segmented ahead of the odometry", Range{1, 256});
 }
 
+template <class Visitor>
+void visit_fields(LocalizeConfig& c, Visitor&& v) {
+  v("relocalize_interval", c.relocalize_interval, "[m] travel between relocalisation attempts", AtLeast{0});
+  v("confirmations", c.confirmations, "agreeing tracking fixes that confirm a relocalisation", Range{0, 100});
+  v("confirm_interval", c.confirm_interval, "[m] travel between confirming fixes", AtLeast{0});
+  v("track_radius", c.track_radius, "[m] map keyframes this near the pose form the tracking submap", Above{0});
+  v("submap_spacing", c.submap_spacing, "[m] least spacing of the tracking submap's keyframes", AtLeast{0});
+  v("submap_rebuild_distance", c.submap_rebuild_distance, "[m] motion that rebuilds the tracking submap", Above{0});
+  v("track_every", c.track_every, "register every n-th frame against the map", Range{1, 1000});
+  v("track_min_inlier_fraction", c.track_min_inlier_fraction, "tracking fit: min inlier fraction", Range{0, 1});
+  v("track_max_correction", c.track_max_correction, "[m] tracking fit: max correction of the prediction", Above{0});
+  v("track_max_correction_deg", c.track_max_correction_deg, "[deg] tracking fit: max rotation correction", Above{0});
+  v("leave_after", c.leave_after, "[m] travel without a fit that means leaving the map", Above{0});
+  v("max_odometry_distance", c.max_odometry_distance, "[m] odometry-only travel after which frames are not placed", AtLeast{0});
+  v("cached_keyframes", c.cached_keyframes, "map keyframes whose features stay in memory", Range{1, 10000000});
+}
+
 /// Calls v(section, struct) for every section; nested sections use dots.
 template <class Visitor>
 void visit_sections(SaloamConfig& c, Visitor&& v) {
@@ -421,6 +481,7 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
   v("loop.ssc", c.loop.ssc);
   v("slam", c.slam);
   v("segmentation", c.segmentation);
+  v("localize", c.localize);
 }
 
 /// Throws ConfigError, starting with `origin`, for the first field outside

@@ -27,11 +27,15 @@ ScanContext make_scan_context(std::span<const Eigen::Vector3f> points, const Sca
     float& cell = grid(ring, sector);
     cell = std::max(cell, p.z() + static_cast<float>(config.lidar_height));
   }
+  return scan_context_from_descriptor((grid.array() == kNoPoint).select(0.0F, grid));
+}
+
+ScanContext scan_context_from_descriptor(Eigen::MatrixXf descriptor) {
   ScanContext sc;
-  sc.descriptor = (grid.array() == kNoPoint).select(0.0F, grid);
+  sc.descriptor = std::move(descriptor);
   sc.ring_key = sc.descriptor.rowwise().mean();
   sc.unit_columns = sc.descriptor;
-  for (int c = 0; c < config.num_sectors; ++c) {
+  for (Eigen::Index c = 0; c < sc.unit_columns.cols(); ++c) {
     const float norm = sc.unit_columns.col(c).norm();
     if (norm > 0) sc.unit_columns.col(c) /= norm;
   }

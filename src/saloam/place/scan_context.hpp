@@ -29,6 +29,10 @@ struct ScanContext {
 /// Builds the descriptor of one scan (points in the sensor frame).
 ScanContext make_scan_context(std::span<const Eigen::Vector3f> points, const ScanContextConfig& config = {});
 
+/// The descriptor with its derived parts (ring key, unit columns) from the
+/// max-height grid alone (what a saved map stores).
+ScanContext scan_context_from_descriptor(Eigen::MatrixXf descriptor);
+
 struct ScanContextMatch {
   double distance = 1.0;  ///< in [0, 2]; 0 = identical after the best shift (Eq. 6 of the paper)
   int shift = 0;          ///< sectors the candidate is rotated by for the best match

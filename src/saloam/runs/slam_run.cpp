@@ -14,6 +14,7 @@
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/ply.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/maps/slam_map.hpp"
 #include "saloam/mapping/map_render.hpp"
 #include "saloam/place/graph_json.hpp"
 #include "saloam/runs/map_building.hpp"
@@ -332,6 +333,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
   const std::filesystem::path& out_dir = folder.path();
+  if (options.save_map) check_map_destination(*options.save_map);
 
   // A stream cannot be read again for the map: keep what the map needs as it goes by.
   const SemanticMapOptions map_options = SemanticMapOptions::from_config(config.slam);
@@ -350,6 +352,22 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   const std::vector<Pose> optimized = slam.optimized_poses();
   nlohmann::json summary = write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);
 
+  if (options.save_map && !stop_requested() && !slam.keyframes().empty()) {
+    const StageTimer save_timer;
+    MapManifest manifest;
+    manifest.sensor = options.sensor;
+    if (info.folder) manifest.source = std::filesystem::absolute(*info.folder).lexically_normal().string();
+    manifest.first_frame = info.first_frame;
+    manifest.camera_frame_outputs = tr.has_value();
+    if (tr) manifest.velo_to_cam = *tr;
+    write_slam_map(*options.save_map, slam, config, manifest);
+    result.map_save_seconds = save_timer.elapsed_s();
+    result.map_bytes = map_disk_bytes(*options.save_map);
+    summary["saved_map"] = {{"folder", std::filesystem::absolute(*options.save_map).lexically_normal().string()},
+                            {"bytes", *result.map_bytes},
+                            {"keyframes", slam.keyframes().size()},
+                            {"seconds", result.map_save_seconds}};
+  }
   if (options.write_map && !stop_requested()) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)
                                         : build_semantic_map(source, optimized, map_options, map_step,

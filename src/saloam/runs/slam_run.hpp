@@ -40,6 +40,10 @@ struct SlamRunOptions {
   /// Called with every scan after the SLAM has processed it (e.g. to run a
   /// second odometry on the same stream).
   std::function<void(std::size_t frame, const LabelledCloud& scan, double time)> on_scan;
+  /// Where to save the map for later runs (`--save-map`, maps/map_format.hpp);
+  /// none: no map is saved. Not saved when the run is interrupted.
+  std::optional<std::filesystem::path> save_map;
+  std::string sensor;  ///< the sensor profile's name, recorded in the saved map
 };
 
 struct SlamRunResult {
@@ -59,6 +63,8 @@ struct SlamRunResult {
   std::optional<LoopSummary> loop_summary;
   std::string loop_reference;  ///< file the loops were judged against: poses_sensor.txt when present, else poses.txt
   std::optional<LoopSummary> loop_summary_poses_txt;  ///< against poses.txt, when poses_sensor.txt was used
+  std::optional<std::uintmax_t> map_bytes;  ///< size of the saved map on disk (when one was saved)
+  double map_save_seconds = 0;
 };
 
 /// Loads the SGPR network when the configured detector needs one, from the

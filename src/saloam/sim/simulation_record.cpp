@@ -4,9 +4,11 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/lie.hpp"
 #include "saloam/core/output_file.hpp"
 
 namespace fs = std::filesystem;
@@ -38,6 +40,18 @@ std::string simulation_record(const SimulationOptions& o) {
                       o.first_frame, end, o.stride, o.seed, o.beams, o.azimuth_steps);
   text += fmt::format("labels: {}\nskew: {}\ndynamic_objects: {}\n", o.labels == LabelMode::kNoisy ? "noisy" : "gt",
                       o.skew, o.world.dynamic_objects);
+  if (!o.passes.empty()) {
+    // Passes of one world: the pass drawn and where its first frame lies in
+    // the world (T_world<-L0, 3x4 row-major), so that two passes' poses
+    // relate: T_a0<-b0 = origin_a^-1 origin_b.
+    std::vector<std::string> passes;
+    for (const auto& p : o.passes) passes.push_back(route_pass_text(p));
+    const std::vector<Pose> trajectory = source_lidar_trajectory(o);
+    const Pose& origin = trajectory.at(selected_frames(o, trajectory.size()).front());
+    double v[12];
+    pose_to_3x4(origin, v);
+    text += fmt::format("passes: {}\npass: {}\norigin: {:.9f}\n", fmt::join(passes, ","), o.pass, fmt::join(v, v + 12, " "));
+  }
   return text;
 }
 

@@ -41,17 +41,110 @@ double sensor_mount_height(const SimulationOptions& options) {
   return options.sensor ? options.sensor->simulation.mount_height : options.world.sensor_height;
 }
 
-std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options) {
-  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+RoutePass parse_route_pass(std::string_view text) {
+  const std::string t(text);
+  const auto bad = [&] {
+    return ConfigError(fmt::format("pass '{}': use FIRST:END or FIRST:END:reverse (route pose indices, END may be empty)", t));
+  };
+  RoutePass pass;
+  std::string_view rest = text;
+  const auto first_colon = rest.find(':');
+  if (first_colon == std::string_view::npos) throw bad();
+  const std::string_view first = rest.substr(0, first_colon);
+  rest = rest.substr(first_colon + 1);
+  const auto second_colon = rest.find(':');
+  const std::string_view end = rest.substr(0, second_colon);
+  if (second_colon != std::string_view::npos) {
+    const std::string_view flag = rest.substr(second_colon + 1);
+    if (flag != "reverse" && flag != "r") throw bad();
+    pass.reverse = true;
+  }
+  const auto number = [&](std::string_view s, std::size_t& out) {
+    if (s.empty() || s.size() > 12 || s.find_first_not_of("0123456789") != std::string_view::npos) throw bad();
+    out = static_cast<std::size_t>(std::stoull(std::string(s)));
+  };
+  number(first, pass.first);
+  if (!end.empty()) number(end, pass.end);
+  if (pass.end <= pass.first) throw bad();
+  return pass;
+}
+
+std::string route_pass_text(const RoutePass& pass) {
+  return fmt::format("{}:{}{}", pass.first,
+                     pass.end == std::numeric_limits<std::size_t>::max() ? std::string() : std::to_string(pass.end),
+                     pass.reverse ? ":reverse" : "");
+}
+
+namespace {
+// A step between consecutive trajectory poses longer than this [m] (180
+// km/h at 10 Hz) is the jump from one pass to the next, never driven.
+constexpr double kPassJump = 5.0;
+
+/// The passes one after the other: each a stretch of the route, a reverse
+/// one driven backwards in the opposite lane (kReversePassLane to the left
+/// of the route, heading turned by 180 degrees).
+std::vector<Pose> concatenated_passes(const std::vector<Pose>& route, const std::vector<RoutePass>& passes) {
+  std::vector<Pose> out;
+  for (const RoutePass& pass : passes) {
+    const std::size_t end = std::min(pass.end, route.size());
+    if (pass.first + 1 >= end) {
+      throw ConfigError(fmt::format("pass {} selects fewer than 2 of the route's {} poses", route_pass_text(pass), route.size()));
+    }
+    std::vector<Pose> stretch(route.begin() + static_cast<std::ptrdiff_t>(pass.first),
+                              route.begin() + static_cast<std::ptrdiff_t>(end));
+    if (pass.reverse) {
+      std::reverse(stretch.begin(), stretch.end());
+      for (Pose& T : stretch) {
+        T = T * Eigen::Translation3d(0.0, kReversePassLane, 0.0) * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ());
+        T = orthonormalized(T);
+      }
+    }
+    out.insert(out.end(), stretch.begin(), stretch.end());
+  }
+  return out;
+}
+
+/// First trajectory index of each pass, and the total.
+std::vector<std::size_t> pass_offsets(const std::vector<RoutePass>& passes, std::size_t route_size) {
+  std::vector<std::size_t> offsets{0};
+  for (const RoutePass& pass : passes) offsets.push_back(offsets.back() + std::min(pass.end, route_size) - pass.first);
+  return offsets;
+}
+
+std::vector<Pose> route_trajectory(const SimulationOptions& options) {
   if (!options.camera_poses.empty()) {
     if (!options.velo_to_cam_given) throw ConfigError("a camera-frame trajectory needs its velodyne-to-camera Tr");
-    return mounted(camera_to_lidar_poses(options.camera_poses, options.velo_to_cam), dz);
+    return camera_to_lidar_poses(options.camera_poses, options.velo_to_cam);
   }
-  return mounted(preset_trajectory(options.preset, options.frame_period), dz);
+  return preset_trajectory(options.preset, options.frame_period);
+}
+}  // namespace
+
+std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options) {
+  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+  std::vector<Pose> route = route_trajectory(options);
+  if (!options.passes.empty()) {
+    if (options.pass >= options.passes.size()) {
+      throw ConfigError(fmt::format("pass {} of {} passes (passes count from 0)", options.pass, options.passes.size()));
+    }
+    route = concatenated_passes(route, options.passes);
+  }
+  return mounted(std::move(route), dz);
 }
 
 std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::size_t trajectory_size) {
   if (options.stride == 0) throw ConfigError("stride must be at least 1");
+  std::size_t offset = 0;
+  if (!options.passes.empty()) {
+    // Frames count within the rendered pass.
+    const std::size_t route_size = route_trajectory(options).size();
+    const std::vector<std::size_t> offsets = pass_offsets(options.passes, route_size);
+    if (options.pass >= options.passes.size() || offsets.back() != trajectory_size) {
+      throw ConfigError(fmt::format("pass {} of {} passes (passes count from 0)", options.pass, options.passes.size()));
+    }
+    offset = offsets[options.pass];
+    trajectory_size = offsets[options.pass + 1] - offset;
+  }
   const std::size_t end = std::min(options.end_frame, trajectory_size);
   if (options.first_frame >= end) {
     throw ConfigError(fmt::format("frame range {}:{} selects nothing (the trajectory has {} poses)", options.first_frame,
@@ -60,7 +153,7 @@ std::vector<std::size_t> selected_frames(const SimulationOptions& options, std::
                                   trajectory_size));
   }
   std::vector<std::size_t> frames;
-  for (std::size_t i = options.first_frame; i < end; i += options.stride) frames.push_back(i);
+  for (std::size_t i = options.first_frame; i < end; i += options.stride) frames.push_back(offset + i);
   return frames;
 }
 
@@ -70,9 +163,10 @@ SweepSpec sweep_for_frame(const std::vector<Pose>& traj, std::size_t i, const Si
   const double period = options.frame_period;
   // The sweep lasts one frame period whatever the stride: the sensor moves
   // from pose i towards pose i+1 while it turns.
-  if (i + 1 < traj.size()) {
+  const auto jump = [&](std::size_t a) { return (traj[a + 1].translation() - traj[a].translation()).norm() > kPassJump; };
+  if (i + 1 < traj.size() && !jump(i)) {
     s.end = traj[i + 1];
-  } else if (i >= 1) {  // last pose: continue the previous motion
+  } else if (i >= 1 && !jump(i - 1)) {  // last pose (of the route or of a pass): continue the previous motion
     s.end = orthonormalized(traj[i] * (traj[i - 1].inverse() * traj[i]));
   } else {
     s.end = traj[i];

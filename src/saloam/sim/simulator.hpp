@@ -17,6 +17,7 @@
 #include <limits>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "saloam/core/sensor_profile.hpp"
@@ -29,6 +30,19 @@
 namespace saloam {
 
 enum class LabelMode { kGroundTruth, kNoisy };
+
+/// One drive through the route's world (SimulationOptions::passes): route
+/// poses [first, end), driven backwards in the opposite lane when `reverse`.
+struct RoutePass {
+  std::size_t first = 0;
+  std::size_t end = std::numeric_limits<std::size_t>::max();
+  bool reverse = false;
+};
+/// "A:B" or "A:B:reverse" (B may be empty: to the route's end); ConfigError otherwise.
+RoutePass parse_route_pass(std::string_view text);
+std::string route_pass_text(const RoutePass& pass);
+/// [m] to the left of the route a reverse pass drives (the oncoming lane).
+inline constexpr double kReversePassLane = 3.2;
 
 struct SimulationOptions {
   /// Built-in route, used when `camera_poses` is empty (see preset_names()).
@@ -44,6 +58,13 @@ struct SimulationOptions {
   std::size_t end_frame = std::numeric_limits<std::size_t>::max();
   std::size_t stride = 1;
   std::uint64_t seed = 1;
+  /// Several drives through one world (sessions of a map, issue #28): the
+  /// world is built along all of them, one after the other in time (so other
+  /// moving objects, parked cars, label noise and sensor noise meet each),
+  /// and `pass` is rendered; first_frame, end_frame and stride then count
+  /// within that pass. Empty: the route once, as it is.
+  std::vector<RoutePass> passes;
+  std::size_t pass = 0;
   LabelMode labels = LabelMode::kGroundTruth;
   /// Lasers of the HDL-64E: all 64, or every 2nd (32) or 4th (16): the same
   /// sensor thinned out (--beams); 64 with a sensor profile.
@@ -123,6 +144,10 @@ class SimulatedSequence {
   [[nodiscard]] const Pose& velo_to_cam() const { return velo_to_cam_; }
   [[nodiscard]] const std::vector<Pose>& camera_poses() const { return camera_poses_; }  ///< poses.txt
   [[nodiscard]] const std::vector<double>& times() const { return times_; }              ///< times.txt [s]
+  /// LiDAR pose of the first frame in the world frame (the frame of the
+  /// route's first pose): the poses are re-based on it, so two passes of one
+  /// world are related by origin_a^-1 * origin_b (T_a0<-b0).
+  [[nodiscard]] const Pose& origin() const { return trajectory_[frames_.front()]; }
   /// Where each sweep really started (poses_sensor.txt's content, camera frame).
   [[nodiscard]] const std::vector<Pose>& sensor_camera_poses() const { return sensor_camera_poses_; }
 

@@ -68,6 +68,10 @@ class WorldBuilder {
  public:
   WorldBuilder(World& w, std::uint64_t seed) : w_(w), seed_(seed) {}
 
+  /// A step between consecutive trajectory poses longer than this [m] is
+  /// the jump between two passes through the world (SimulationOptions::passes), not a drive.
+  static constexpr double kPassJump = 5.0;
+
   // ------------------------------------------------------------ ground (world_ground.cpp)
   void build_path(const std::vector<Pose>& trajectory);
   void build_ground();

@@ -25,6 +25,15 @@ void WorldBuilder::build_path(const std::vector<Pose>& trajectory) {
   for (std::size_t i = 1; i < trajectory.size(); ++i) {
     const Eigen::Vector3d p = trajectory[i].translation() - Eigen::Vector3d(0, 0, h);
     const double len = (p - prev).norm();
+    if (len > kPassJump) {
+      // The jump from one pass to the next (SimulationOptions::passes):
+      // no road along it, no arc length (moving objects do not travel it).
+      w_.path_.push_back(p);
+      w_.path_s_.push_back(s);
+      w_.ego_s_.push_back(s);
+      prev = p;
+      continue;
+    }
     const int pieces = std::max(1, static_cast<int>(std::ceil(len / 0.5)));
     if (len > 1e-6) {
       for (int k = 1; k <= pieces; ++k) {

@@ -1,0 +1,174 @@
+// `saloam localize`: localisation in a map saved by `saloam slam --save-map`
+// (relocalisation without an initial guess, tracking against the map with
+// the odometry between). The outputs are listed in src/saloam/runs/localize_run.hpp.
+
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <spdlog/spdlog.h>
+
+#include "command.hpp"
+#include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/core/profiling.hpp"
+#include "saloam/eval/trajectory_metrics.hpp"
+#include "saloam/io/calibration.hpp"
+#include "saloam/io/trajectory_io.hpp"
+#include "saloam/maps/prior_map.hpp"
+#include "saloam/runs/localize_run.hpp"
+#include "saloam/runs/slam_run.hpp"
+
+namespace saloam::cli {
+namespace {
+
+struct LocalizeOptions {
+  SourceArgs source;
+  std::string map;
+  std::string out;
+  std::string model;
+  ConfigOptions config;
+};
+
+/// "origin" and "passes" of a simulated pass (simulation.yaml), when the folder has them.
+struct SimulatedPass {
+  Pose origin;
+  std::string passes;
+};
+std::optional<SimulatedPass> simulated_pass(const std::filesystem::path& folder) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(folder / "simulation.yaml", ec)) return std::nullopt;
+  std::istringstream lines(read_file(folder / "simulation.yaml", 1 << 16, "simulation record"));
+  SimulatedPass pass;
+  bool origin = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.starts_with("passes: ")) pass.passes = line.substr(8);
+    if (line.starts_with("origin: ")) {
+      std::istringstream numbers(line.substr(8));
+      double v[12];
+      origin = true;
+      for (double& x : v) origin = origin && static_cast<bool>(numbers >> x);
+      if (origin) pass.origin = orthonormalized(pose_from_3x4(v));
+    }
+  }
+  if (!origin || pass.passes.empty()) return std::nullopt;
+  return pass;
+}
+
+/// T_map<-L0 when the map and the scans are passes of one simulated world
+/// (`simulate --passes`), both from their first frame: the truth to judge
+/// relocalisations by.
+std::optional<Pose> simulated_truth(const PriorMap& map, const SourceInfo& info) {
+  const MapManifest& m = map.saved().manifest;
+  if (m.source.empty() || !info.folder || m.first_frame != 0 || info.first_frame != 0) return std::nullopt;
+  const auto map_pass = simulated_pass(m.source), run_pass = simulated_pass(*info.folder);
+  if (!map_pass || !run_pass || map_pass->passes != run_pass->passes) return std::nullopt;
+  return orthonormalized(map_pass->origin.inverse() * run_pass->origin);
+}
+
+/// The SE(3) alignment of the map's keyframes to their truth (the map
+/// source's poses), when that source can be read.
+std::optional<Pose> map_alignment(const PriorMap& map) {
+  try {
+    const std::filesystem::path source = map.saved().manifest.source;
+    std::vector<Pose> truth = read_kitti_poses(source / "poses.txt");
+    if (std::filesystem::exists(source / "poses_sensor.txt")) truth = read_kitti_poses(source / "poses_sensor.txt");
+    if (std::filesystem::exists(source / "calib.txt")) truth = camera_to_lidar_poses(truth, read_velo_to_cam(source / "calib.txt"));
+    const Pose rebase = truth.front().inverse();
+    std::vector<Eigen::Vector3d> estimated, reference;
+    for (const auto& k : map.saved().keyframes) {
+      if (k.frame >= truth.size()) return std::nullopt;
+      estimated.push_back(k.pose.translation());
+      reference.push_back((rebase * truth[k.frame]).translation());
+    }
+    if (estimated.size() < 3) return std::nullopt;
+    const SimilarityTransform s = umeyama_alignment(estimated, reference, false);
+    Pose T = Pose::Identity();
+    T.linear() = s.rotation;
+    T.translation() = s.translation;
+    return T;
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
+int run_localize_command(const LocalizeOptions& options) {
+  const StageTimer load_timer;
+  // The map's own configuration (its detector made the descriptors), a
+  // --config instead, then --set on top.
+  SavedMap saved = read_map(options.map);
+  SaloamConfig config = options.config.config_file.empty() ? saved.config
+                                                           : load_config(config_file_path(options.config.config_file));
+  apply_config_overrides(config, options.config.overrides);
+  if (config.loop.detector != saved.config.loop.detector) {
+    throw ConfigError(fmt::format("loop.detector is {}, but the map's descriptors were made for {}", config.loop.detector,
+                                  saved.config.loop.detector));
+  }
+  if (uses_sgpr(parse_place_detector(config.loop.detector))) {
+    config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
+  }
+  const std::size_t cached = static_cast<std::size_t>(config.localize.cached_keyframes);
+  const std::filesystem::path folder = options.map;
+  const PriorMap map(std::move(saved), [folder](std::size_t k) { return read_map_features(folder, k); }, cached);
+  const double load_s = load_timer.elapsed_s();
+  std::cout << fmt::format("map {}: {} keyframes, {} edges ({} loops), detector {}, loaded in {:.2f} s (features on demand)\n",
+                           options.map, map.size(), map.saved().edges.size(), map.saved().manifest.loop_edges,
+                           config.loop.detector, load_s);
+
+  const bool labels = config.odometry.use_semantics || needs_labels(parse_place_detector(config.loop.detector));
+  const std::unique_ptr<FrameSource> source = options.source.open(!labels, config);
+  LocalizeRunOptions run_options;
+  run_options.truth_map_from_source = simulated_truth(map, source->info());
+  if (run_options.truth_map_from_source) run_options.map_alignment = map_alignment(map);
+  if (run_options.truth_map_from_source) {
+    std::cout << "the map and the scans are passes of one simulated world: relocalisations are judged against the truth\n";
+  }
+  const LocalizeRunResult r = run_localize(*source, config, map, load_loop_network(config), options.out, run_options);
+
+  std::cout << fmt::format("{} frames: {} localized, {} on the odometry outside the map, {} not placed; median {:.1f} ms/frame "
+                           "({:.1f} Hz); peak memory {:.0f} MiB; {} map keyframes read\n",
+                           r.frames, r.localized, r.odometry, r.unplaced, r.median_frame_ms,
+                           r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.peak_rss_mib, r.map_loads);
+  if (r.first_placed_m) {
+    std::cout << fmt::format("relocalised after {:.1f} m (frame {}); {} hypotheses, {} refuted; left the map {} times, "
+                             "came back {} times\n",
+                             *r.first_placed_m, r.first_placed_frame.value_or(0), r.hypotheses + r.confirmed, r.refuted,
+                             r.left_map, r.reentered);
+  } else {
+    std::cout << "never relocalised: no frame was placed in the map\n";
+  }
+  if (r.false_relocalizations) {
+    std::cout << fmt::format("against the truth in the map frame: {} false relocalisations; localized frames RMSE {} m (max {} m), "
+                             "all placed frames RMSE {} m\n",
+                             *r.false_relocalizations, r.localized_rmse_m ? fmt::format("{:.3f}", *r.localized_rmse_m) : "-",
+                             r.localized_max_m ? fmt::format("{:.3f}", *r.localized_max_m) : "-",
+                             r.placed_rmse_m ? fmt::format("{:.3f}", *r.placed_rmse_m) : "-");
+  }
+  if (r.aligned_ate_m) std::cout << fmt::format("placed frames against the reference: ATE {:.3f} m (SE(3)-aligned)\n", *r.aligned_ate_m);
+  std::cout << fmt::format("wrote {} ({})\n", options.out, fmt::join(r.files, ", "));
+  if (r.interrupted) {
+    spdlog::warn("interrupted: results of the {} frames processed were written", r.frames);
+    return 130;
+  }
+  return 0;
+}
+
+const CommandRegistration kRegistration{Command{
+    "localize", "Localise a run in a saved map (slam --save-map): relocalisation, then tracking against the map", 26,
+    [](CLI::App& app) {
+      auto options = std::make_shared<LocalizeOptions>();
+      options->source.add_to(app, "Scans to localise (any layout saloam reads)");
+      app.add_option("--map", options->map, "Map folder written by `saloam slam --save-map`")->required();
+      app.add_option("--out", options->out, "Output folder")->required();
+      app.add_option("--model", options->model, "SGPR weights (.sgw) when the map's detector uses SGPR")
+          ->check(CLI::ExistingFile);
+      add_no_calib_flag(app, options->source.no_calib);
+      options->config.add_to(app);
+      return [options] { return run_localize_command(*options); };
+    }}};
+
+}  // namespace
+}  // namespace saloam::cli

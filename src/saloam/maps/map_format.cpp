@@ -1,0 +1,651 @@
+#include "saloam/maps/map_format.hpp"
+
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cerrno>
+#include <csignal>
+#include <cmath>
+#include <cstring>
+
+#include <Eigen/Cholesky>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/files.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/core/output_file.hpp"
+#include "saloam/place/semantic_graph.hpp"
+
+namespace fs = std::filesystem;
+
+namespace saloam {
+
+static_assert(std::endian::native == std::endian::little, "the map format is little-endian; this build is not");
+
+namespace {
+
+constexpr std::size_t kHeaderBytes = 24;
+constexpr std::size_t kMaxManifestBytes = std::size_t{1} << 20;
+constexpr std::size_t kMaxTableBytes = std::size_t{16} << 30;
+constexpr std::size_t kMaxGraphNodes = 100'000;
+constexpr std::size_t kMaxSscPoints = 10'000'000;
+constexpr std::uint32_t kHasScanContext = 1, kHasSsc = 2, kHasSgpr = 4;
+constexpr std::uint32_t kKnownPlaceFlags = kHasScanContext | kHasSsc | kHasSgpr;
+constexpr double kMaxTimestamp = 1e10;  // [s]
+
+// ---- writing ----
+
+class ByteWriter {
+ public:
+  template <class T>
+  void put(T value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const std::byte*>(&value);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  void put_pose(const Pose& pose) {
+    double v[12];
+    pose_to_3x4(pose, v);
+    for (const double x : v) put(x);
+  }
+  void header(MapTable table, std::uint64_t count) {
+    for (const char c : kMapMagic) put(c);
+    put(kMapFormatVersion);
+    put(static_cast<std::uint32_t>(table));
+    put(count);
+  }
+  std::vector<std::byte> take() { return std::move(bytes_); }
+
+ private:
+  std::vector<std::byte> bytes_;
+};
+
+// ---- reading ----
+
+class ByteReader {
+ public:
+  ByteReader(std::span<const std::byte> bytes, const fs::path& origin) : bytes_(bytes), origin_(origin) {}
+
+  template <class T>
+  T get(std::string_view what) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    need(sizeof(T), what);
+    T value;
+    std::memcpy(&value, bytes_.data() + at_, sizeof(T));
+    at_ += sizeof(T);
+    return value;
+  }
+  double finite(std::string_view what, double bound) {
+    const auto v = get<double>(what);
+    if (!std::isfinite(v) || std::abs(v) > bound) fail(fmt::format("{} is {} (not finite, or beyond {:g})", what, v, bound));
+    return v;
+  }
+  float finite_float(std::string_view what, float bound) {
+    const auto v = get<float>(what);
+    if (!std::isfinite(v) || std::abs(v) > bound) fail(fmt::format("{} is {} (not finite, or beyond {:g})", what, v, bound));
+    return v;
+  }
+  Pose pose(std::string_view what) {
+    double v[12];
+    for (int i = 0; i < 12; ++i) v[i] = finite(what, kMaxMapCoordinate);
+    const Pose pose = pose_from_3x4(v);
+    const double error = orthonormality_error(pose.linear());
+    if (!(error <= kRotationTolerance) || pose.linear().determinant() <= 0) {
+      fail(fmt::format("{}: the rotation is not orthonormal (error {:.3g})", what, error));
+    }
+    return orthonormalized(pose);
+  }
+  /// A count of items of at least `item_bytes` each that the rest of the file can hold.
+  std::size_t count(std::uint64_t n, std::size_t item_bytes, std::string_view what, std::size_t max) {
+    if (n > max) fail(fmt::format("{} {} exceed the limit of {}", n, what, max));
+    if (item_bytes > 0 && n > remaining() / item_bytes) {
+      fail(fmt::format("truncated: {} {} need at least {} bytes, {} are left", n, what, n * item_bytes, remaining()));
+    }
+    return static_cast<std::size_t>(n);
+  }
+  std::uint64_t header(MapTable expected) {
+    need(kHeaderBytes, "the header");
+    if (std::memcmp(bytes_.data(), kMapMagic.data(), kMapMagic.size()) != 0) {
+      fail("not a saloam map file (no SALOAMAP magic)");
+    }
+    at_ = kMapMagic.size();
+    const auto version = get<std::uint32_t>("version");
+    if (version != kMapFormatVersion) {
+      fail(fmt::format("format version {}; this saloam reads version {}", version, kMapFormatVersion));
+    }
+    const auto table = get<std::uint32_t>("table kind");
+    if (table != static_cast<std::uint32_t>(expected)) {
+      fail(fmt::format("holds table kind {}, expected {}", table, static_cast<std::uint32_t>(expected)));
+    }
+    return get<std::uint64_t>("record count");
+  }
+  void finish() {
+    if (at_ != bytes_.size()) fail(fmt::format("{} bytes of trailing data after the last record", bytes_.size() - at_));
+  }
+  [[nodiscard]] std::size_t remaining() const { return bytes_.size() - at_; }
+  [[noreturn]] void fail(const std::string& problem) const { throw InputError(origin_, problem); }
+
+ private:
+  void need(std::size_t n, std::string_view what) {
+    if (n > remaining()) fail(fmt::format("truncated: {} needs {} bytes at offset {}, {} are left", what, n, at_, remaining()));
+  }
+  std::span<const std::byte> bytes_;
+  const fs::path& origin_;
+  std::size_t at_ = 0;
+};
+
+std::string_view edge_kind_name(EdgeKind kind) { return kind == EdgeKind::kLoop ? "loop" : "odometry"; }
+
+std::vector<double> pose_numbers(const Pose& pose) {
+  std::vector<double> v(12);
+  pose_to_3x4(pose, v.data());
+  return v;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- encoders
+
+std::string encode_map_manifest(const MapManifest& m) {
+  nlohmann::ordered_json j;
+  j["format"] = kMapFormatName;
+  j["version"] = m.version;
+  j["frame"] = m.frame;
+  j["detector"] = m.detector;
+  j["sensor"] = m.sensor;
+  j["source"] = m.source;
+  j["first_frame"] = m.first_frame;
+  j["keyframes"] = m.keyframes;
+  j["edges"] = m.edges;
+  j["loop_edges"] = m.loop_edges;
+  j["camera_frame_outputs"] = m.camera_frame_outputs;
+  j["velo_to_cam"] = pose_numbers(m.velo_to_cam);
+  j["files"] = {{"config", "config.yaml"},
+                {"keyframes", "keyframes.bin"},
+                {"edges", "edges.bin"},
+                {"places", "places.bin"},
+                {"features", "features/NNNNNN.bin"}};
+  return j.dump(2) + '\n';
+}
+
+std::vector<std::byte> encode_map_keyframes(std::span<const MapKeyframe> keyframes) {
+  ByteWriter w;
+  w.header(MapTable::kKeyframes, keyframes.size());
+  for (const auto& k : keyframes) {
+    w.put(k.frame);
+    w.put(k.timestamp);
+    w.put(k.travelled);
+    w.put_pose(k.pose);
+    w.put_pose(k.odometry_pose);
+  }
+  return w.take();
+}
+
+std::vector<std::byte> encode_map_edges(std::span<const PoseGraphEdge> edges) {
+  ByteWriter w;
+  w.header(MapTable::kEdges, edges.size());
+  for (const auto& e : edges) {
+    w.put(static_cast<std::uint32_t>(e.from));
+    w.put(static_cast<std::uint32_t>(e.to));
+    w.put(static_cast<std::uint32_t>(e.kind == EdgeKind::kLoop ? 1 : 0));
+    w.put_pose(e.measured);
+    for (int r = 0; r < 6; ++r)
+      for (int c = r; c < 6; ++c) w.put(e.information(r, c));
+  }
+  return w.take();
+}
+
+std::vector<std::byte> encode_map_places(std::span<const PlaceDescriptor> places) {
+  ByteWriter w;
+  w.header(MapTable::kPlaces, places.size());
+  for (const auto& p : places) {
+    const bool sc = p.context.descriptor.size() > 0;
+    const bool ssc = !p.ssc.key_range.empty();
+    const bool sgpr = !p.graph.nodes.empty() || p.embedding.squaredNorm() > 0;
+    w.put(static_cast<std::uint32_t>((sc ? kHasScanContext : 0) | (ssc ? kHasSsc : 0) | (sgpr ? kHasSgpr : 0)));
+    if (sc) {
+      w.put(static_cast<std::uint32_t>(p.context.descriptor.rows()));
+      w.put(static_cast<std::uint32_t>(p.context.descriptor.cols()));
+      for (Eigen::Index i = 0; i < p.context.descriptor.size(); ++i) w.put(p.context.descriptor.data()[i]);
+    }
+    if (ssc) {
+      w.put(static_cast<std::uint32_t>(p.ssc.points.size()));
+      for (std::size_t i = 0; i < p.ssc.points.size(); ++i) {
+        w.put(p.ssc.points[i].x());
+        w.put(p.ssc.points[i].y());
+        w.put(p.ssc.codes[i]);
+      }
+      w.put(static_cast<std::uint32_t>(p.ssc.key_range.size()));
+      for (std::size_t i = 0; i < p.ssc.key_range.size(); ++i) {
+        w.put(p.ssc.key_range[i]);
+        w.put(p.ssc.key_points[i].x());
+        w.put(p.ssc.key_points[i].y());
+      }
+    }
+    if (sgpr) {
+      w.put(static_cast<std::uint32_t>(p.graph.nodes.size()));
+      for (std::size_t i = 0; i < p.graph.nodes.size(); ++i) {
+        w.put(static_cast<std::int32_t>(p.graph.nodes[i]));
+        for (int a = 0; a < 3; ++a) w.put(p.graph.centers[i][a]);
+      }
+      for (int i = 0; i < kSgprEmbeddingSize; ++i) w.put(p.embedding[i]);
+    }
+  }
+  return w.take();
+}
+
+std::vector<std::byte> encode_map_features(const StoredFeatures& f) {
+  ByteWriter w;
+  w.header(MapTable::kFeatures, 1);
+  w.put(static_cast<std::uint64_t>(f.edge_points.size()));
+  w.put(static_cast<std::uint64_t>(f.planar_points.size()));
+  const auto cloud = [&](const std::vector<Eigen::Vector3f>& points, const std::vector<ClassIndex>& classes) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      w.put(points[i].x());
+      w.put(points[i].y());
+      w.put(points[i].z());
+      w.put(classes[i]);
+    }
+  };
+  cloud(f.edge_points, f.edge_classes);
+  cloud(f.planar_points, f.planar_classes);
+  return w.take();
+}
+
+// ---------------------------------------------------------------- parsers
+
+MapManifest parse_map_manifest(std::string_view text, const fs::path& origin) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(origin, fmt::format("not valid JSON: {}", e.what()));
+  }
+  if (!j.is_object()) throw InputError(origin, "not a JSON object");
+  const auto field = [&](const char* key) -> const nlohmann::json& {
+    const auto it = j.find(key);
+    if (it == j.end()) throw InputError(origin, fmt::format("no \"{}\"", key));
+    return *it;
+  };
+  const auto string_of = [&](const char* key) {
+    const auto& v = field(key);
+    if (!v.is_string()) throw InputError(origin, fmt::format("\"{}\" is not a string", key));
+    return v.get<std::string>();
+  };
+  const auto count_of = [&](const char* key, std::uint64_t max) {
+    const auto& v = field(key);
+    if (!v.is_number_unsigned()) throw InputError(origin, fmt::format("\"{}\" is not a non-negative integer", key));
+    const auto n = v.get<std::uint64_t>();
+    if (n > max) throw InputError(origin, fmt::format("\"{}\" is {}, beyond {}", key, n, max));
+    return n;
+  };
+  if (string_of("format") != kMapFormatName) {
+    throw InputError(origin, fmt::format("\"format\" is not \"{}\": not a saloam map", kMapFormatName));
+  }
+  MapManifest m;
+  const auto& version = field("version");
+  if (!version.is_number_unsigned() || version.get<std::uint64_t>() != kMapFormatVersion) {
+    throw InputError(origin, fmt::format("format version {}; this saloam reads version {}", version.dump(),
+                                         kMapFormatVersion));
+  }
+  m.detector = string_of("detector");
+  try {
+    (void)parse_place_detector(m.detector);
+  } catch (const ConfigError& e) {
+    throw InputError(origin, e.what());
+  }
+  m.sensor = string_of("sensor");
+  m.source = string_of("source");
+  m.frame = string_of("frame");
+  m.first_frame = count_of("first_frame", std::uint64_t{1} << 53);
+  m.keyframes = count_of("keyframes", kMaxMapKeyframes);
+  if (m.keyframes == 0) throw InputError(origin, "the map has no keyframe");
+  m.edges = count_of("edges", 100 * kMaxMapKeyframes);
+  m.loop_edges = count_of("loop_edges", m.edges);
+  const auto& camera = field("camera_frame_outputs");
+  if (!camera.is_boolean()) throw InputError(origin, "\"camera_frame_outputs\" is not true or false");
+  m.camera_frame_outputs = camera.get<bool>();
+  const auto& tr = field("velo_to_cam");
+  if (!tr.is_array() || tr.size() != 12) throw InputError(origin, "\"velo_to_cam\" is not 12 numbers");
+  double v[12];
+  for (std::size_t i = 0; i < 12; ++i) {
+    if (!tr[i].is_number() || !std::isfinite(tr[i].get<double>()) || std::abs(tr[i].get<double>()) > 1e3) {
+      throw InputError(origin, "\"velo_to_cam\" holds a value that is not a finite number of at most 1000");
+    }
+    v[i] = tr[i].get<double>();
+  }
+  m.velo_to_cam = pose_from_3x4(v);
+  const double error = orthonormality_error(m.velo_to_cam.linear());
+  if (!(error <= kRotationTolerance) || m.velo_to_cam.linear().determinant() <= 0) {
+    throw InputError(origin, "\"velo_to_cam\": the rotation is not orthonormal");
+  }
+  m.velo_to_cam = orthonormalized(m.velo_to_cam);
+  return m;
+}
+
+std::vector<MapKeyframe> parse_map_keyframes(std::span<const std::byte> bytes, const fs::path& origin) {
+  ByteReader r(bytes, origin);
+  constexpr std::size_t kRecord = 8 + 8 + 8 + 96 + 96;
+  const std::size_t n = r.count(r.header(MapTable::kKeyframes), kRecord, "keyframes", kMaxMapKeyframes);
+  std::vector<MapKeyframe> keyframes(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    MapKeyframe& kf = keyframes[k];
+    kf.frame = r.get<std::uint64_t>("frame");
+    kf.timestamp = r.finite("timestamp", kMaxTimestamp);
+    kf.travelled = r.finite("path length", kMaxMapCoordinate * 100);
+    kf.pose = r.pose(fmt::format("keyframe {}: pose", k));
+    kf.odometry_pose = r.pose(fmt::format("keyframe {}: odometry pose", k));
+    if (k > 0 && kf.frame <= keyframes[k - 1].frame) {
+      r.fail(fmt::format("keyframe {}: frame {} does not follow frame {}", k, kf.frame, keyframes[k - 1].frame));
+    }
+    if (kf.travelled < 0 || (k > 0 && kf.travelled < keyframes[k - 1].travelled)) {
+      r.fail(fmt::format("keyframe {}: path length {} decreases or is negative", k, kf.travelled));
+    }
+  }
+  r.finish();
+  return keyframes;
+}
+
+std::vector<PoseGraphEdge> parse_map_edges(std::span<const std::byte> bytes, std::size_t nodes, const fs::path& origin) {
+  ByteReader r(bytes, origin);
+  constexpr std::size_t kRecord = 12 + 96 + 21 * 8;
+  const std::size_t n = r.count(r.header(MapTable::kEdges), kRecord, "edges", 100 * kMaxMapKeyframes);
+  std::vector<PoseGraphEdge> edges(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    PoseGraphEdge& e = edges[k];
+    const auto from = r.get<std::uint32_t>("from"), to = r.get<std::uint32_t>("to");
+    const auto kind = r.get<std::uint32_t>("kind");
+    if (from >= nodes || to >= nodes || from == to) {
+      r.fail(fmt::format("edge {}: nodes {} -> {} (the map has {} keyframes)", k, from, to, nodes));
+    }
+    if (kind > 1) r.fail(fmt::format("edge {}: kind {} (0 odometry, 1 loop)", k, kind));
+    e.from = from;
+    e.to = to;
+    e.kind = kind == 1 ? EdgeKind::kLoop : EdgeKind::kOdometry;
+    e.measured = r.pose(fmt::format("edge {}: measurement", k));
+    for (int row = 0; row < 6; ++row) {
+      for (int c = row; c < 6; ++c) {
+        e.information(row, c) = e.information(c, row) = r.finite(fmt::format("edge {}: information", k), kMaxInformation);
+      }
+    }
+    const Eigen::LLT<Matrix6d> llt(e.information);
+    if (llt.info() != Eigen::Success || !(llt.matrixL().toDenseMatrix().diagonal().minCoeff() > 1e-12)) {
+      r.fail(fmt::format("edge {} ({} edge {} -> {}): the information is not positive definite", k,
+                         edge_kind_name(e.kind), from, to));
+    }
+  }
+  r.finish();
+  return edges;
+}
+
+std::vector<PlaceDescriptor> parse_map_places(std::span<const std::byte> bytes, const SaloamConfig& config,
+                                              const fs::path& origin) {
+  ByteReader r(bytes, origin);
+  const std::size_t n = r.count(r.header(MapTable::kPlaces), 4, "place descriptors", kMaxMapKeyframes);
+  const ScanContextConfig sc_config;
+  const SscConfig& ssc_config = config.loop.ssc;
+  std::vector<PlaceDescriptor> places(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    PlaceDescriptor& p = places[k];
+    const std::string at = fmt::format("place {}", k);
+    const auto flags = r.get<std::uint32_t>("descriptor flags");
+    if ((flags & ~kKnownPlaceFlags) != 0) r.fail(fmt::format("{}: unknown descriptor flags {:#x}", at, flags));
+    if (flags & kHasScanContext) {
+      const auto rows = r.get<std::uint32_t>("Scan Context rows"), cols = r.get<std::uint32_t>("Scan Context sectors");
+      if (rows != static_cast<std::uint32_t>(sc_config.num_rings) || cols != static_cast<std::uint32_t>(sc_config.num_sectors)) {
+        r.fail(fmt::format("{}: Scan Context of {} x {} cells; this saloam makes {} x {}", at, rows, cols,
+                           sc_config.num_rings, sc_config.num_sectors));
+      }
+      Eigen::MatrixXf descriptor(rows, cols);
+      for (Eigen::Index i = 0; i < descriptor.size(); ++i) {
+        descriptor.data()[i] = r.finite_float("a Scan Context cell", 1.0e4F);
+      }
+      p.context = scan_context_from_descriptor(std::move(descriptor));
+    }
+    if (flags & kHasSsc) {
+      const std::size_t points = r.count(r.get<std::uint32_t>("SSC point count"), 9, "SSC points", kMaxSscPoints);
+      p.ssc.points.resize(points);
+      p.ssc.codes.resize(points);
+      for (std::size_t i = 0; i < points; ++i) {
+        const float x = r.finite_float("an SSC point", kMaxFeatureCoordinate);
+        const float y = r.finite_float("an SSC point", kMaxFeatureCoordinate);
+        p.ssc.points[i] = {x, y};
+        p.ssc.codes[i] = r.get<std::uint8_t>("an SSC class code");
+        if (p.ssc.codes[i] == 0 || p.ssc.codes[i] >= kSscNumCodes) {
+          r.fail(fmt::format("{}: SSC class code {} (1..{})", at, p.ssc.codes[i], kSscNumCodes - 1));
+        }
+      }
+      const auto keys = r.get<std::uint32_t>("SSC key sectors");
+      if (keys != static_cast<std::uint32_t>(ssc_config.key_sectors)) {
+        r.fail(fmt::format("{}: {} SSC key sectors; the map's loop.ssc.key_sectors is {}", at, keys, ssc_config.key_sectors));
+      }
+      r.count(keys, 12, "SSC key sectors", keys);
+      p.ssc.key_range.resize(keys);
+      p.ssc.key_points.resize(keys);
+      for (std::size_t i = 0; i < keys; ++i) {
+        p.ssc.key_range[i] = r.finite_float("an SSC key range", kMaxFeatureCoordinate);
+        if (p.ssc.key_range[i] < 0) r.fail(fmt::format("{}: negative SSC key range", at));
+        const float x = r.finite_float("an SSC key point", kMaxFeatureCoordinate);
+        const float y = r.finite_float("an SSC key point", kMaxFeatureCoordinate);
+        p.ssc.key_points[i] = {x, y};
+      }
+      p.ssc.cells = ssc_cells(p.ssc.points, p.ssc.codes, SscAlignment{}, ssc_config);
+    }
+    if (flags & kHasSgpr) {
+      const std::size_t nodes = r.count(r.get<std::uint32_t>("graph node count"), 28, "graph nodes", kMaxGraphNodes);
+      p.graph.nodes.resize(nodes);
+      p.graph.centers.resize(nodes);
+      for (std::size_t i = 0; i < nodes; ++i) {
+        const auto c = r.get<std::int32_t>("a node class");
+        if (c < 0 || c >= kNumNodeClasses) r.fail(fmt::format("{}: node class {} (0..{})", at, c, kNumNodeClasses - 1));
+        p.graph.nodes[i] = c;
+        for (int a = 0; a < 3; ++a) p.graph.centers[i][a] = r.finite("a node centre", kMaxGraphCoordinate);
+      }
+      for (int i = 0; i < kSgprEmbeddingSize; ++i) p.embedding[i] = r.finite_float("an SGPR embedding value", 1.0e6F);
+    }
+  }
+  r.finish();
+  return places;
+}
+
+StoredFeatures parse_map_features(std::span<const std::byte> bytes, const fs::path& origin) {
+  ByteReader r(bytes, origin);
+  if (r.header(MapTable::kFeatures) != 1) r.fail("a feature file holds one record");
+  StoredFeatures f;
+  const std::uint64_t edges = r.get<std::uint64_t>("edge count"), planars = r.get<std::uint64_t>("planar count");
+  if (edges > kMaxKeyframeFeatures || planars > kMaxKeyframeFeatures) {
+    r.fail(fmt::format("{} edge and {} planar points exceed the limit of {}", edges, planars, kMaxKeyframeFeatures));
+  }
+  r.count(edges + planars, 13, "feature points", 2 * kMaxKeyframeFeatures);
+  const auto cloud = [&](std::uint64_t n, std::vector<Eigen::Vector3f>& points, std::vector<ClassIndex>& classes) {
+    points.resize(n);
+    classes.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int a = 0; a < 3; ++a) points[i][a] = r.finite_float("a feature coordinate", kMaxFeatureCoordinate);
+      classes[i] = r.get<ClassIndex>("a feature class");
+      if (classes[i] >= kNumClassIndices) r.fail(fmt::format("feature class index {} (0..{})", classes[i], kNumClassIndices - 1));
+    }
+  };
+  cloud(edges, f.edge_points, f.edge_classes);
+  cloud(planars, f.planar_points, f.planar_classes);
+  r.finish();
+  return f;
+}
+
+// ---------------------------------------------------------------- files
+
+fs::path map_features_path(const fs::path& folder, std::size_t keyframe) {
+  return folder / "features" / fmt::format("{:06d}.bin", keyframe);
+}
+
+namespace {
+
+std::vector<std::byte> read_table(const fs::path& file) {
+  const std::string text = read_file(file, kMaxTableBytes, "map file");
+  std::vector<std::byte> bytes(text.size());
+  if (!text.empty()) std::memcpy(bytes.data(), text.data(), text.size());
+  return bytes;
+}
+
+bool is_saloam_map(const fs::path& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) return false;
+  try {
+    parse_map_manifest(read_file(folder / "map.json", kMaxManifestBytes, "map manifest"), folder / "map.json");
+    return true;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+// Temporary folders of killed writers of `target` ("NAME.partial-PID.N"
+// whose process is gone) are removed.
+void remove_stale_partials(const fs::path& target) {
+  std::error_code ec;
+  const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+  const std::string prefix = target.filename().string() + ".partial-";
+  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (!name.starts_with(prefix) || !is_partial_output_name(name) || !it->is_directory(ec)) continue;
+    const std::string pid_text = name.substr(prefix.size(), name.find('.', prefix.size()) - prefix.size());
+    const long pid = std::strtol(pid_text.c_str(), nullptr, 10);
+    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(it->path(), ec);
+  }
+}
+
+}  // namespace
+
+void check_map_destination(const fs::path& folder) {
+  if (path_taken(folder) && !is_saloam_map(folder)) {
+    throw InputError(folder, "exists and is not a saloam map: it is left as it is (choose another --save-map)");
+  }
+}
+
+void write_map(const fs::path& folder, const SavedMap& map,
+               const std::function<const StoredFeatures&(std::size_t)>& features) {
+  std::error_code ec;
+  check_map_destination(folder);
+  if (map.keyframes.empty()) throw InputError(folder, "no keyframe to save: the map would be empty");
+  if (map.places.size() != map.keyframes.size()) throw InputError(folder, "one place descriptor per keyframe is needed");
+  if (!folder.parent_path().empty()) create_folder(folder.parent_path());
+  remove_stale_partials(folder);
+  static std::atomic<unsigned> counter{0};
+  const fs::path temporary =
+      folder.string() + fmt::format(".partial-{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
+  struct RemoveOnFailure {
+    const fs::path& path;
+    bool armed = true;
+    ~RemoveOnFailure() {
+      std::error_code ignored;
+      if (armed) fs::remove_all(path, ignored);
+    }
+  } cleanup{temporary};
+  create_folder(temporary / "features");
+
+  MapManifest manifest = map.manifest;
+  manifest.version = kMapFormatVersion;
+  manifest.keyframes = map.keyframes.size();
+  manifest.edges = map.edges.size();
+  manifest.loop_edges = static_cast<std::uint64_t>(
+      std::count_if(map.edges.begin(), map.edges.end(), [](const PoseGraphEdge& e) { return e.kind == EdgeKind::kLoop; }));
+  manifest.detector = map.config.loop.detector;
+  write_file_atomically(temporary / "config.yaml", config_to_yaml(map.config));
+  {
+    const auto put = [&](const fs::path& file, const std::vector<std::byte>& bytes) {
+      write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    };
+    put(temporary / "keyframes.bin", encode_map_keyframes(map.keyframes));
+    put(temporary / "edges.bin", encode_map_edges(map.edges));
+    put(temporary / "places.bin", encode_map_places(map.places));
+    for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+      put(map_features_path(temporary, k), encode_map_features(features(k)));
+    }
+  }
+  // The manifest last: a folder without one is no map.
+  write_file_atomically(temporary / "map.json", encode_map_manifest(manifest));
+
+  // An earlier map of this name goes aside first, and away once the new one is in place.
+  fs::path previous;
+  if (path_taken(folder)) {
+    previous = folder.string() + fmt::format(".partial-{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
+    fs::rename(folder, previous, ec);
+    if (ec) throw InputError(folder, fmt::format("cannot move the earlier map aside: {}", ec.message()));
+  }
+  fs::rename(temporary, folder, ec);
+  if (ec) {
+    std::error_code ignored;
+    if (!previous.empty()) fs::rename(previous, folder, ignored);
+    throw InputError(folder, fmt::format("cannot put the map in place: {}", ec.message()));
+  }
+  cleanup.armed = false;
+  if (!previous.empty()) fs::remove_all(previous, ec);
+}
+
+SavedMap read_map(const fs::path& folder) {
+  std::error_code ec;
+  if (!fs::is_directory(folder, ec)) {
+    throw InputError(folder, path_taken(folder) ? "is not a folder: a saved map is a folder (map.json, ...)"
+                                                : "not found");
+  }
+  SavedMap map;
+  map.folder = folder;
+  const fs::path manifest_file = folder / "map.json";
+  map.manifest = parse_map_manifest(read_file(manifest_file, kMaxManifestBytes, "map manifest"), manifest_file);
+  const fs::path config_file = folder / "config.yaml";
+  try {
+    map.config = load_config(config_file);
+  } catch (const ConfigError& e) {
+    throw InputError(config_file, e.what());
+  }
+  if (map.config.loop.detector != map.manifest.detector) {
+    throw InputError(manifest_file, fmt::format("detector \"{}\", but config.yaml says loop.detector \"{}\"",
+                                                map.manifest.detector, map.config.loop.detector));
+  }
+  const fs::path keyframes_file = folder / "keyframes.bin";
+  map.keyframes = parse_map_keyframes(read_table(keyframes_file), keyframes_file);
+  if (map.keyframes.size() != map.manifest.keyframes) {
+    throw InputError(keyframes_file, fmt::format("{} keyframes, map.json says {}", map.keyframes.size(), map.manifest.keyframes));
+  }
+  const fs::path edges_file = folder / "edges.bin";
+  map.edges = parse_map_edges(read_table(edges_file), map.keyframes.size(), edges_file);
+  if (map.edges.size() != map.manifest.edges) {
+    throw InputError(edges_file, fmt::format("{} edges, map.json says {}", map.edges.size(), map.manifest.edges));
+  }
+  const fs::path places_file = folder / "places.bin";
+  map.places = parse_map_places(read_table(places_file), map.config, places_file);
+  if (map.places.size() != map.keyframes.size()) {
+    throw InputError(places_file, fmt::format("{} descriptors for {} keyframes", map.places.size(), map.keyframes.size()));
+  }
+  const PlaceDetector detector = parse_place_detector(map.manifest.detector);
+  for (std::size_t k = 0; k < map.places.size(); ++k) {
+    const PlaceDescriptor& p = map.places[k];
+    const bool ok = (!uses_scan_context(detector) || p.context.descriptor.size() > 0) &&
+                    (!uses_ssc(detector) || !p.ssc.key_range.empty()) && (!uses_sgpr(detector) || p.graph.nodes.size() > 0 ||
+                                                                          p.embedding.squaredNorm() > 0);
+    if (!ok) {
+      throw InputError(places_file, fmt::format("place {} lacks the descriptor of the map's detector {}", k, map.manifest.detector));
+    }
+  }
+  return map;
+}
+
+StoredFeatures read_map_features(const fs::path& folder, std::size_t keyframe) {
+  const fs::path file = map_features_path(folder, keyframe);
+  return parse_map_features(read_table(file), file);
+}
+
+std::uintmax_t map_disk_bytes(const fs::path& folder) {
+  std::uintmax_t bytes = 0;
+  std::error_code ec;
+  for (fs::recursive_directory_iterator it(folder, ec), end; !ec && it != end; it.increment(ec)) {
+    if (it->is_regular_file(ec)) bytes += it->file_size(ec);
+  }
+  return bytes;
+}
+
+}  // namespace saloam

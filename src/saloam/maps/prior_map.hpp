@@ -1,0 +1,56 @@
+#pragma once
+// A saved map as a localisation run uses it: the keyframes' poses and place
+// descriptors in memory, their feature clouds read on demand and kept in a
+// bounded cache (least recently used leave first), so memory follows the
+// part of the map in use, not the whole map. Keyframes near a position are
+// found through a 2D grid of their positions.
+
+#include <cstddef>
+#include <functional>
+#include <list>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "saloam/core/types.hpp"
+#include "saloam/maps/map_format.hpp"
+
+namespace saloam {
+
+class PriorMap {
+ public:
+  /// `load_features(k)` gives keyframe k's features (read_map_features for a
+  /// map on disk); at most `cached` of them are held at once.
+  PriorMap(SavedMap map, std::function<StoredFeatures(std::size_t)> load_features, std::size_t cached);
+  /// A map on disk: read_map(folder), features read from it when needed.
+  static PriorMap open(const std::filesystem::path& folder, std::size_t cached);
+
+  [[nodiscard]] const SavedMap& saved() const { return map_; }
+  [[nodiscard]] std::size_t size() const { return map_.keyframes.size(); }
+  [[nodiscard]] const Pose& pose(std::size_t k) const { return map_.keyframes[k].pose; }
+  [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const { return map_.places[k]; }
+  /// Keyframe k's features (read when not cached).
+  [[nodiscard]] std::shared_ptr<const StoredFeatures> features(std::size_t k) const;
+
+  /// Keyframes whose position lies within `radius` of `position` (x-y and
+  /// z), ascending.
+  [[nodiscard]] std::vector<std::size_t> near(const Eigen::Vector3d& position, double radius) const;
+
+  [[nodiscard]] std::size_t loads() const { return loads_; }   ///< feature files read so far
+  [[nodiscard]] std::size_t cached() const { return lru_.size(); }
+  [[nodiscard]] std::size_t cached_bytes() const;
+
+ private:
+  SavedMap map_;
+  std::function<StoredFeatures(std::size_t)> load_;
+  std::size_t capacity_;
+  double cell_ = 20.0;
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> grid_;
+  mutable std::list<std::pair<std::size_t, std::shared_ptr<const StoredFeatures>>> lru_;
+  mutable std::unordered_map<std::size_t, decltype(lru_)::iterator> index_;
+  mutable std::size_t loads_ = 0;
+};
+
+}  // namespace saloam

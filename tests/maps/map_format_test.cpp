@@ -1,0 +1,242 @@
+// The saved map's format (docs/map_format.md): what is written reads back
+// the same, and the reader refuses broken maps, naming the file.
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
+#include "saloam/maps/map_format.hpp"
+#include "saloam/maps/prior_map.hpp"
+#include "testing/test_support.hpp"
+
+namespace saloam {
+namespace {
+
+Pose random_pose(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Pose T = Pose::Identity();
+  T.linear() = Eigen::AngleAxisd(3 * u(rng), Eigen::Vector3d(u(rng), u(rng), 1).normalized()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(100 * u(rng), 100 * u(rng), 5 * u(rng));
+  return orthonormalized(T);
+}
+
+StoredFeatures random_features(std::mt19937& rng, std::size_t n) {
+  std::uniform_real_distribution<float> u(-50, 50);
+  StoredFeatures f;
+  for (std::size_t i = 0; i < n; ++i) {
+    f.edge_points.emplace_back(u(rng), u(rng), u(rng) / 10);
+    f.edge_classes.push_back(static_cast<ClassIndex>(i % kNumClassIndices));
+    f.planar_points.emplace_back(u(rng), u(rng), u(rng) / 10);
+    f.planar_classes.push_back(static_cast<ClassIndex>((3 * i) % kNumClassIndices));
+  }
+  return f;
+}
+
+// A map with every kind of descriptor part, odometry and loop edges.
+struct TestMap {
+  SavedMap map;
+  std::vector<StoredFeatures> features;
+};
+
+TestMap make_map(std::size_t keyframes) {
+  std::mt19937 rng(7);
+  TestMap t;
+  t.map.config.loop.detector = "ssc";
+  t.map.manifest.sensor = "vlp16";
+  t.map.manifest.source = "/data/run";
+  t.map.manifest.first_frame = 12;
+  t.map.manifest.camera_frame_outputs = true;
+  t.map.manifest.velo_to_cam = random_pose(rng);
+  std::uniform_real_distribution<float> u(0, 10);
+  for (std::size_t k = 0; k < keyframes; ++k) {
+    MapKeyframe kf;
+    kf.frame = 3 * k;
+    kf.timestamp = 0.3 * static_cast<double>(k);
+    kf.travelled = 1.5 * static_cast<double>(k);
+    kf.pose = random_pose(rng);
+    kf.odometry_pose = random_pose(rng);
+    t.map.keyframes.push_back(kf);
+    PlaceDescriptor p;
+    Eigen::MatrixXf sc(20, 60);
+    for (Eigen::Index i = 0; i < sc.size(); ++i) sc.data()[i] = u(rng) - 1;
+    p.context = scan_context_from_descriptor(sc);
+    for (int i = 0; i < 30; ++i) {
+      p.ssc.points.emplace_back(u(rng) * 3, u(rng) * 3);
+      p.ssc.codes.push_back(static_cast<std::uint8_t>(1 + i % 11));
+    }
+    p.ssc.key_range.assign(static_cast<std::size_t>(t.map.config.loop.ssc.key_sectors), 0.0F);
+    p.ssc.key_points.assign(p.ssc.key_range.size(), Eigen::Vector2f::Zero());
+    p.ssc.key_range[2] = 4.5F;
+    p.ssc.key_points[2] = {4.0F, 2.0F};
+    p.ssc.cells = ssc_cells(p.ssc.points, p.ssc.codes, SscAlignment{}, t.map.config.loop.ssc);
+    p.graph.nodes = {1, 5, 11};
+    p.graph.centers = {{1, 2, 3}, {-4, 5, 0.5}, {7, -8, 1}};
+    for (int i = 0; i < kSgprEmbeddingSize; ++i) p.embedding[i] = static_cast<float>(i) / 7.0F;
+    t.map.places.push_back(p);
+    t.features.push_back(random_features(rng, 5 + k));
+    if (k > 0) {
+      PoseGraphEdge e;
+      e.from = k - 1;
+      e.to = k;
+      e.measured = random_pose(rng);
+      Matrix6d a = Matrix6d::Random();
+      e.information = a * a.transpose() + Matrix6d::Identity();
+      t.map.edges.push_back(e);
+    }
+  }
+  PoseGraphEdge loop;
+  loop.from = 0;
+  loop.to = keyframes - 1;
+  loop.kind = EdgeKind::kLoop;
+  loop.measured = random_pose(rng);
+  loop.information = 3 * Matrix6d::Identity();
+  t.map.edges.push_back(loop);
+  return t;
+}
+
+void write_test_map(const std::filesystem::path& folder, const TestMap& t) {
+  write_map(folder, t.map, [&](std::size_t k) -> const StoredFeatures& { return t.features[k]; });
+}
+
+TEST(MapFormat, RoundTripIsExact) {
+  testing::TempDir dir("saloam_map_roundtrip");
+  const TestMap t = make_map(6);
+  write_test_map(dir / "map", t);
+  const SavedMap read = read_map(dir / "map");
+  EXPECT_EQ(read.manifest.version, kMapFormatVersion);
+  EXPECT_EQ(read.manifest.detector, "ssc");
+  EXPECT_EQ(read.manifest.sensor, "vlp16");
+  EXPECT_EQ(read.manifest.source, "/data/run");
+  EXPECT_EQ(read.manifest.first_frame, 12u);
+  EXPECT_EQ(read.manifest.loop_edges, 1u);
+  EXPECT_TRUE(read.manifest.camera_frame_outputs);
+  EXPECT_TRUE(read.manifest.velo_to_cam.isApprox(t.map.manifest.velo_to_cam, 1e-12));
+  EXPECT_EQ(read.config.loop.detector, "ssc");
+  ASSERT_EQ(read.keyframes.size(), t.map.keyframes.size());
+  for (std::size_t k = 0; k < read.keyframes.size(); ++k) {
+    EXPECT_EQ(read.keyframes[k].frame, t.map.keyframes[k].frame);
+    EXPECT_EQ(read.keyframes[k].timestamp, t.map.keyframes[k].timestamp);
+    EXPECT_EQ(read.keyframes[k].travelled, t.map.keyframes[k].travelled);
+    EXPECT_TRUE(read.keyframes[k].pose.isApprox(t.map.keyframes[k].pose, 1e-12));
+    EXPECT_TRUE(read.keyframes[k].odometry_pose.isApprox(t.map.keyframes[k].odometry_pose, 1e-12));
+    const PlaceDescriptor &a = read.places[k], &b = t.map.places[k];
+    EXPECT_EQ(a.context.descriptor, b.context.descriptor);
+    EXPECT_EQ(a.context.ring_key, b.context.ring_key);
+    EXPECT_EQ(a.context.unit_columns, b.context.unit_columns);
+    EXPECT_EQ(a.ssc.points, b.ssc.points);
+    EXPECT_EQ(a.ssc.codes, b.ssc.codes);
+    EXPECT_EQ(a.ssc.cells, b.ssc.cells);
+    EXPECT_EQ(a.ssc.key_range, b.ssc.key_range);
+    EXPECT_EQ(a.ssc.key_points, b.ssc.key_points);
+    EXPECT_EQ(a.graph.nodes, b.graph.nodes);
+    EXPECT_EQ(a.graph.centers, b.graph.centers);
+    EXPECT_EQ(a.embedding, b.embedding);
+    const StoredFeatures f = read_map_features(dir / "map", k);
+    EXPECT_EQ(f.edge_points, t.features[k].edge_points);
+    EXPECT_EQ(f.edge_classes, t.features[k].edge_classes);
+    EXPECT_EQ(f.planar_points, t.features[k].planar_points);
+    EXPECT_EQ(f.planar_classes, t.features[k].planar_classes);
+  }
+  ASSERT_EQ(read.edges.size(), t.map.edges.size());
+  for (std::size_t e = 0; e < read.edges.size(); ++e) {
+    EXPECT_EQ(read.edges[e].from, t.map.edges[e].from);
+    EXPECT_EQ(read.edges[e].to, t.map.edges[e].to);
+    EXPECT_EQ(read.edges[e].kind, t.map.edges[e].kind);
+    EXPECT_TRUE(read.edges[e].measured.isApprox(t.map.edges[e].measured, 1e-12));
+    EXPECT_TRUE(read.edges[e].information.isApprox(t.map.edges[e].information, 1e-12));
+  }
+}
+
+TEST(MapFormat, PriorMapReadsFeaturesOnDemandWithinItsCache) {
+  testing::TempDir dir("saloam_map_lazy");
+  const TestMap t = make_map(8);
+  write_test_map(dir / "map", t);
+  const PriorMap map = PriorMap::open(dir / "map", 3);
+  EXPECT_EQ(map.loads(), 0u);
+  for (std::size_t k = 0; k < 8; ++k) EXPECT_EQ(map.features(k)->edge_points, t.features[k].edge_points);
+  EXPECT_EQ(map.loads(), 8u);
+  EXPECT_EQ(map.cached(), 3u);
+  (void)map.features(7);  // cached: not read again
+  EXPECT_EQ(map.loads(), 8u);
+  (void)map.features(0);  // evicted: read again
+  EXPECT_EQ(map.loads(), 9u);
+  const auto near = map.near(t.map.keyframes[4].pose.translation(), 0.01);
+  ASSERT_EQ(near.size(), 1u);
+  EXPECT_EQ(near[0], 4u);
+}
+
+TEST(MapFormat, ReplacesAnEarlierMapButNothingElse) {
+  testing::TempDir dir("saloam_map_replace");
+  write_test_map(dir / "map", make_map(4));
+  const TestMap bigger = make_map(7);
+  write_test_map(dir / "map", bigger);
+  EXPECT_EQ(read_map(dir / "map").keyframes.size(), 7u);
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+    EXPECT_EQ(entry.path().filename(), "map") << "left behind: " << entry.path();
+  }
+  std::filesystem::create_directories(dir / "other");
+  std::ofstream(dir / "other" / "notes.txt") << "mine\n";
+  const std::string error = testing::input_error_of([&] { write_test_map(dir / "other", bigger); });
+  EXPECT_NE(error.find("is not a saloam map"), std::string::npos) << error;
+  EXPECT_TRUE(std::filesystem::exists(dir / "other" / "notes.txt"));
+}
+
+// Rewrites `file` with one change made by `edit` on its bytes.
+void edit_file(const std::filesystem::path& file, const std::function<void(std::string&)>& edit) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  in.close();
+  edit(bytes);
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+TEST(MapFormat, ReaderNamesTheFileAndTheProblem) {
+  testing::TempDir dir("saloam_map_broken");
+  const TestMap t = make_map(4);
+  const auto broken = [&](const std::string& name, const std::string& file,
+                          const std::function<void(std::string&)>& edit, std::string named = "") {
+    const std::filesystem::path folder = dir / name;
+    write_test_map(folder, t);
+    edit_file(folder / file, edit);
+    std::string error = testing::input_error_of([&] {
+      (void)read_map(folder);
+      if (file.starts_with("features")) (void)read_map_features(folder, 0);
+    });
+    EXPECT_NE(error.find((folder / (named.empty() ? file : named)).string()), std::string::npos) << error;
+    return error;
+  };
+  const auto put_double = [](std::string& bytes, std::size_t at, double v) { std::memcpy(bytes.data() + at, &v, 8); };
+  EXPECT_NE(broken("version", "keyframes.bin", [](std::string& b) { b[8] = 2; }).find("format version 2"),
+            std::string::npos);
+  EXPECT_NE(broken("magic", "edges.bin", [](std::string& b) { b[0] = 'X'; }).find("magic"), std::string::npos);
+  EXPECT_NE(broken("truncated", "places.bin", [](std::string& b) { b.resize(b.size() - 3); }).find("truncated"),
+            std::string::npos);
+  EXPECT_NE(broken("trailing", "keyframes.bin", [](std::string& b) { b += "x"; }).find("trailing"), std::string::npos);
+  // Keyframe 1's first pose value (after the header, keyframe 0's 216 bytes and 24 bytes of frame, time, length).
+  EXPECT_NE(broken("nan", "keyframes.bin", [&](std::string& b) { put_double(b, 24 + 216 + 24, std::nan("")); })
+                .find("not finite"),
+            std::string::npos);
+  EXPECT_NE(broken("rotation", "keyframes.bin", [&](std::string& b) { put_double(b, 24 + 24, 3.0); }).find("orthonormal"),
+            std::string::npos);
+  EXPECT_NE(broken("node", "edges.bin", [](std::string& b) { b[24] = 99; }).find("nodes 99"), std::string::npos);
+  EXPECT_NE(broken("information", "edges.bin", [&](std::string& b) { put_double(b, 24 + 12 + 96, -5.0); })
+                .find("positive definite"),
+            std::string::npos);
+  EXPECT_NE(broken("count", "map.json",
+                   [](std::string& b) { b.replace(b.find("\"keyframes\": 4"), 14, "\"keyframes\": 5"); }, "keyframes.bin")
+                .find("map.json says 5"),
+            std::string::npos);
+  EXPECT_NE(broken("format", "map.json", [](std::string& b) { b.replace(b.find("saloam-map"), 10, "other-map!"); })
+                .find("not a saloam map"),
+            std::string::npos);
+  EXPECT_NE(broken("class", "features/000000.bin", [](std::string& b) { b[24 + 16 + 12] = 100; }).find("class index 100"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace saloam
