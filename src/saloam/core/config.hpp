@@ -75,6 +75,13 @@ struct FeatureConfig {
   /// sensor, and as edges they shortened every route (docs/odometry.md,
   /// "Scale bias").
   double ground_edge_alpha = kInf;
+  /// [m] Without labels, points less than this above the ground are no edge
+  /// features (label-free twin of ground_edge_alpha = .inf). The ground's
+  /// height is the median height of the lowest ring's returns within 20 m.
+  /// Without it, the rings' footprints on the ground become edges; they move
+  /// with the sensor, and with 16 beams they held a moving start back to a
+  /// tenth of its speed (docs/odometry.md, "Scale bias"). 0: off.
+  double unlabelled_ground_margin = 0.3;
   /// With labels, an edge feature of a pole or tree trunk stands for the
   /// object's axis (ThinObjectAxis): the returns on a round object's near side
   /// move with the viewpoint and shorten every route (docs/odometry.md,
@@ -358,6 +365,7 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
   v("edges_per_sector", c.edges_per_sector, "N_e: edge features per sector", AtLeast{1});
   v("planars_per_sector", c.planars_per_sector, "N_p: planar features per sector", AtLeast{1});
   v("ground_edge_alpha", c.ground_edge_alpha, "with labels, min roughness of a ground edge (.inf: none)", Range{0, kInf});
+  v("unlabelled_ground_margin", c.unlabelled_ground_margin, "[m] without labels, points this close above the ground are no edges (0: off)", Range{0, 5});
   v("thin_object_axes", c.thin_object_axes, "with labels, pole and trunk edges stand for the object's axis");
   v("thin_object_max_radius", c.thin_object_max_radius, "[m] widest pole or trunk crossing kept as an edge", Range{0.01, 5});
   v("roughness_half_window", c.roughness_half_window, "ring neighbours each side in Eq. 1", AtLeast{1});

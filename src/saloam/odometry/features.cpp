@@ -619,6 +619,46 @@ std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, c
   return rings_from_times(cloud, point_sweep_times(cloud, config, false), config);
 }
 
+namespace {
+/// [m] the lowest ring's returns horizontally nearer than this measure the ground.
+constexpr double kGroundEstimateRange = 20.0;
+/// Fewer of them measure nothing.
+constexpr std::size_t kMinGroundReturns = 20;
+
+/// The ground's height in the sensor frame [m]: the median z of the lowest
+/// ring's returns within kGroundEstimateRange (that ring looks down most
+/// steeply, so near the car it mostly hits the road), or nothing when too
+/// few are there.
+std::optional<double> ground_height(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& rings) {
+  const std::vector<std::uint32_t>* lowest = nullptr;
+  double lowest_slope = kInf;
+  for (const auto& ring : rings) {
+    if (ring.size() < kMinGroundReturns) continue;
+    double slope = 0.0;  // mean z / horizontal range, over a sample of the ring
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < ring.size(); k += 8, ++n) {
+      const Eigen::Vector3f& p = cloud.points[ring[k]];
+      slope += p.z() / std::max(1e-3f, p.head<2>().norm());
+    }
+    slope /= static_cast<double>(n);
+    if (slope < lowest_slope) {
+      lowest_slope = slope;
+      lowest = &ring;
+    }
+  }
+  if (lowest == nullptr) return std::nullopt;
+  std::vector<double> heights;
+  for (const auto i : *lowest) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (p.head<2>().norm() < kGroundEstimateRange) heights.push_back(p.z());
+  }
+  if (heights.size() < kMinGroundReturns) return std::nullopt;
+  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
+  std::nth_element(heights.begin(), middle, heights.end());
+  return *middle;
+}
+}  // namespace
+
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
                               bool parallel) {
   ScanFeatures out;
@@ -634,6 +674,11 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   // are concatenated in ring order so the output does not depend on threads.
   std::vector<ScanFeatures> per_ring(rings.size());
   const OdometryClassTable& class_table = odometry_class_table();
+  // Without labels, the ground is what lies near the lowest ring's height.
+  std::optional<double> no_edges_below;
+  if (!use_labels && config.unlabelled_ground_margin > 0.0) {
+    if (const auto ground = ground_height(cloud, rings)) no_edges_below = *ground + config.unlabelled_ground_margin;
+  }
   auto process_ring = [&](std::size_t r) {
     const auto& ring = rings[r];
     std::vector<Eigen::Vector3d> ring_points(ring.size());
@@ -655,6 +700,10 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
           not_edge[k] = 1;
         }
       }
+    }
+    if (no_edges_below) {
+      not_edge.assign(ring.size(), 0);
+      for (std::size_t k = 0; k < ring.size(); ++k) not_edge[k] = ring_points[k].z() < *no_edges_below;
     }
     const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
     // An edge of a thin round object stands for its axis (ThinObjectAxis).
