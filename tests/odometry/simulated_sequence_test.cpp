@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -28,6 +29,19 @@ struct Drift {
   double max_rotation_deg;
   double forward_bias_percent;  // ScaleBias
 };
+
+/// Every frame-to-frame motion of `gt` is longer than `min_step` [m], and
+/// the estimate's matches it to within `tolerance` [m].
+void expect_every_step_kept(const std::vector<Pose>& gt, const std::vector<Pose>& estimated, double min_step,
+                            double tolerance) {
+  ASSERT_EQ(estimated.size(), gt.size());
+  for (std::size_t i = 1; i < gt.size(); ++i) {
+    const Pose truth = gt[i - 1].inverse() * gt[i];
+    const Pose estimate = estimated[i - 1].inverse() * estimated[i];
+    ASSERT_GT(truth.translation().norm(), min_step) << "frame " << i;
+    EXPECT_LT((truth.inverse() * estimate).translation().norm(), tolerance) << "frame " << i;
+  }
+}
 
 Drift run(const std::filesystem::path& dir, bool semantics, bool deskew) {
   OdometryConfig config;
@@ -128,13 +142,7 @@ TEST(SimulatedSequence, FastStandingStartAlongAHedgedStreet) {
   const SequenceReader reader(dir.path());
   SemanticOdometry odometry{OdometryConfig{}};
   register_all(odometry, reader);
-  const auto gt = reader.lidar_poses();
-  for (std::size_t i = 1; i < gt.size(); ++i) {
-    const Pose truth = gt[i - 1].inverse() * gt[i];
-    const Pose estimate = odometry.poses()[i - 1].inverse() * odometry.poses()[i];
-    ASSERT_GT(truth.translation().norm(), 1.2) << "frame " << i;
-    EXPECT_LT((truth.inverse() * estimate).translation().norm(), 0.1) << "frame " << i;
-  }
+  expect_every_step_kept(reader.lidar_poses(), odometry.poses(), 1.2, 0.1);
 }
 
 // A 16-beam sensor without labels on a straight street: the rings'
@@ -155,13 +163,7 @@ TEST(SimulatedSequence, SixteenBeamsWithoutLabelsKeepTheirSpeed) {
   config.use_semantics = false;
   SemanticOdometry odometry(config);
   register_all(odometry, reader);
-  const auto gt = reader.lidar_poses();
-  for (std::size_t i = 1; i < gt.size(); ++i) {
-    const Pose truth = gt[i - 1].inverse() * gt[i];
-    const Pose estimate = odometry.poses()[i - 1].inverse() * odometry.poses()[i];
-    ASSERT_GT(truth.translation().norm(), 0.5) << "frame " << i;
-    EXPECT_LT((truth.inverse() * estimate).translation().norm(), 0.05) << "frame " << i;
-  }
+  expect_every_step_kept(reader.lidar_poses(), odometry.poses(), 0.5, 0.05);
 }
 
 // Adaptive class weights (inverse residual variance per class group) on a
