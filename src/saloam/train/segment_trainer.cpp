@@ -16,9 +16,9 @@
 #include "saloam/core/files.hpp"
 #include "saloam/core/output_file.hpp"
 #include "saloam/core/progress.hpp"
+#include "saloam/eval/segmentation_score.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/segmentation/torch/segnet.hpp"
-#include "saloam/sim/label_noise.hpp"
 #include "saloam/train/training_run.hpp"
 #include "saloam/viz/canvas.hpp"
 
