@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/semantic_classes.hpp"
@@ -10,7 +11,6 @@
 namespace saloam {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // How far the sensor may sit below / above its nominal height over the ground
 // (suspension, load, a curb under one wheel, the smoothing of the ground).
@@ -172,36 +172,71 @@ float Primitive::footprint_radius() const {
   return std::hypot(half_x, half_y);
 }
 
+// ---------------------------------------------------------------- construction
+
+World::World(const WorldOptions& options, std::uint64_t seed, WorldPath path, Ground ground)
+    : options_(options), seed_(seed), path_(std::move(path)), ground_(std::move(ground)) {
+  const std::size_t n = ground_.distance.size();
+  packed_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) packed_[i] = {ground_.distance[i], ground_.height[i], ground_.bump[i], 0.0f};
+}
+
+void World::index_objects() {
+  const double cell = options_.object_cell;
+  gx_ = static_cast<int>(std::ceil(ground_.nx * options_.ground_cell / cell));
+  gy_ = static_cast<int>(std::ceil(ground_.ny * options_.ground_cell / cell));
+  const std::size_t n = static_cast<std::size_t>(gx_) * static_cast<std::size_t>(gy_);
+  std::vector<std::uint32_t> count(n + 1, 0);
+  auto cells = [&](const Primitive& p, auto&& f) {
+    const double r = p.footprint_radius();
+    const int x0 = std::max(0, static_cast<int>((p.center.x() - r - ground_.origin.x()) / cell));
+    const int x1 = std::min(gx_ - 1, static_cast<int>((p.center.x() + r - ground_.origin.x()) / cell));
+    const int y0 = std::max(0, static_cast<int>((p.center.y() - r - ground_.origin.y()) / cell));
+    const int y1 = std::min(gy_ - 1, static_cast<int>((p.center.y() + r - ground_.origin.y()) / cell));
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) f(static_cast<std::size_t>(iy) * static_cast<std::size_t>(gx_) + static_cast<std::size_t>(ix));
+    }
+  };
+  for (const auto& p : primitives_) cells(p, [&](std::size_t c) { ++count[c + 1]; });
+  for (std::size_t i = 1; i <= n; ++i) count[i] += count[i - 1];
+  cell_start_ = count;
+  cell_items_.assign(count[n], 0);
+  std::vector<std::uint32_t> fill(count.begin(), count.end() - 1);
+  for (std::size_t k = 0; k < primitives_.size(); ++k) {
+    cells(primitives_[k], [&](std::size_t c) { cell_items_[fill[c]++] = static_cast<std::uint32_t>(k); });
+  }
+}
+
 // ---------------------------------------------------------------- ground
 
 std::size_t World::cell_index(double x, double y) const {
-  const int ix = std::clamp(static_cast<int>((x - origin_.x()) / options_.ground_cell), 0, nx_ - 1);
-  const int iy = std::clamp(static_cast<int>((y - origin_.y()) / options_.ground_cell), 0, ny_ - 1);
-  return static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const int ix = std::clamp(static_cast<int>((x - ground_.origin.x()) / options_.ground_cell), 0, ground_.nx - 1);
+  const int iy = std::clamp(static_cast<int>((y - ground_.origin.y()) / options_.ground_cell), 0, ground_.ny - 1);
+  return static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
 }
 
 double World::bilinear(const std::vector<float>& field, double x, double y) const {
-  const double gx = (x - origin_.x()) / options_.ground_cell - 0.5;
-  const double gy = (y - origin_.y()) / options_.ground_cell - 0.5;
-  const double fx = std::clamp(gx, 0.0, nx_ - 1.001), fy = std::clamp(gy, 0.0, ny_ - 1.001);
+  const double gx = (x - ground_.origin.x()) / options_.ground_cell - 0.5;
+  const double gy = (y - ground_.origin.y()) / options_.ground_cell - 0.5;
+  const double fx = std::clamp(gx, 0.0, ground_.nx - 1.001), fy = std::clamp(gy, 0.0, ground_.ny - 1.001);
   const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
   const double tx = fx - ix, ty = fy - iy;
-  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
   const double a = field[i], b = field[i + 1];
-  const double c = field[i + static_cast<std::size_t>(nx_)], e = field[i + static_cast<std::size_t>(nx_) + 1];
+  const double c = field[i + static_cast<std::size_t>(ground_.nx)], e = field[i + static_cast<std::size_t>(ground_.nx) + 1];
   return (a + (b - a) * tx) * (1 - ty) + (c + (e - c) * tx) * ty;
 }
 
-double World::path_distance(double x, double y) const { return bilinear(distance_, x, y); }
+double World::path_distance(double x, double y) const { return bilinear(ground_.distance, x, y); }
 
-World::Zone World::zone_at(double x, double y) const { return zones_[cell_index(x, y)]; }
+World::Zone World::zone_at(double x, double y) const { return ground_.zones[cell_index(x, y)]; }
 
 double World::path_lateral(double x, double y) const {
   // The side comes from the nearest cell, the magnitude from the continuous
   // distance field: interpolating the signed field across a Voronoi edge
   // between two centre lines would make a thin false road there.
   const double d = path_distance(x, y);
-  return lateral_[cell_index(x, y)] >= 0 ? d : -d;
+  return ground_.lateral[cell_index(x, y)] >= 0 ? d : -d;
 }
 
 double World::road_margin(double x, double y) const {
@@ -212,29 +247,29 @@ double World::road_margin(double x, double y) const {
 
 World::FieldSample World::sample(double x, double y) const {
   const double inv = 1.0 / options_.ground_cell;
-  const double ux = (x - origin_.x()) * inv, uy = (y - origin_.y()) * inv;
-  const int cx = std::clamp(static_cast<int>(ux), 0, nx_ - 1), cy = std::clamp(static_cast<int>(uy), 0, ny_ - 1);
-  const double fx = std::clamp(ux - 0.5, 0.0, nx_ - 1.001), fy = std::clamp(uy - 0.5, 0.0, ny_ - 1.001);
+  const double ux = (x - ground_.origin.x()) * inv, uy = (y - ground_.origin.y()) * inv;
+  const int cx = std::clamp(static_cast<int>(ux), 0, ground_.nx - 1), cy = std::clamp(static_cast<int>(uy), 0, ground_.ny - 1);
+  const double fx = std::clamp(ux - 0.5, 0.0, ground_.nx - 1.001), fy = std::clamp(uy - 0.5, 0.0, ground_.ny - 1.001);
   const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
   const double tx = fx - ix, ty = fy - iy;
-  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
   const PackedCell& a = packed_[i];
   const PackedCell& b = packed_[i + 1];
-  const PackedCell& c = packed_[i + static_cast<std::size_t>(nx_)];
-  const PackedCell& e = packed_[i + static_cast<std::size_t>(nx_) + 1];
+  const PackedCell& c = packed_[i + static_cast<std::size_t>(ground_.nx)];
+  const PackedCell& e = packed_[i + static_cast<std::size_t>(ground_.nx) + 1];
   const double wa = (1 - tx) * (1 - ty), wb = tx * (1 - ty), wc = (1 - tx) * ty, we = tx * ty;
   return {wa * a.distance + wb * b.distance + wc * c.distance + we * e.distance,
           wa * a.height + wb * b.height + wc * c.height + we * e.height,
           wa * a.bump + wb * b.bump + wc * c.bump + we * e.bump,
-          static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(cx)};
+          static_cast<std::size_t>(cy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(cx)};
 }
 
 GroundInfo World::ground_at(double x, double y) const { return ground_from(sample(x, y)); }
 
 GroundInfo World::ground_from(const FieldSample& s) const {
   // Side from the nearest cell, magnitude from the continuous distance (see path_lateral).
-  const double lat = lateral_[s.cell] >= 0 ? s.distance : -s.distance;
-  const Zone& z = zones_[s.cell];
+  const double lat = ground_.lateral[s.cell] >= 0 ? s.distance : -s.distance;
+  const Zone& z = ground_.zones[s.cell];
   const double d = lat >= 0 ? lat - z.road_left : -lat - z.road_right;  // beyond the road edge
   const double base = s.height;
   GroundInfo g;
@@ -343,7 +378,7 @@ class World::GroundMarch {
     double next_y = t_ + (d_.y() >= 0 ? ty + 1 - here.uy : here.uy - ty) * dt_y;
     double t = t_;
     while (t < max_t_ && in_tiles(tx, ty)) {
-      const double top = world_.ground_top_[tile_index(tx, ty)];
+      const double top = world_.ground_.top[tile_index(tx, ty)];
       const double exit = std::min({next_x, next_y, max_t_});
       const double lowest = o_.z() + (d_.z() < 0.0 ? exit : t) * d_.z();  // the ray's lowest point in the tile
       if (lowest <= top) {
@@ -372,7 +407,7 @@ class World::GroundMarch {
     const double tile = tile_size();
     const int tx = here.x, ty = here.y;
     if (!in_tiles(tx, ty)) return 0.0;
-    const double rise = world_.ground_rise_[tile_index(tx, ty)];
+    const double rise = world_.ground_.rise[tile_index(tx, ty)];
     // Distance along the ray to the tile's edge.
     double exit = max_t_;
     if (std::abs(d_.x()) > 1e-12) exit = std::min(exit, ((d_.x() > 0 ? tx + 1 - here.ux : here.ux - tx) * tile) / std::abs(d_.x()));
@@ -381,7 +416,7 @@ class World::GroundMarch {
     const double clear = closing > 0.0 ? 0.9 * (f - World::kGroundStep) / closing : max_t_;
     return std::min(clear, exit);
   }
-  // The rise tiles (World::ground_rise_, World::ground_top_): the ray's
+  // The rise tiles (Ground::rise, Ground::top): the ray's
   // point at t_ in tile units and the tile it lies in.
   struct TilePosition {
     double ux, uy;
@@ -391,12 +426,12 @@ class World::GroundMarch {
   TilePosition tile_here() const {
     const double tile = tile_size();
     const Eigen::Vector3d p = o_ + t_ * d_;
-    const double ux = (p.x() - world_.origin_.x()) / tile, uy = (p.y() - world_.origin_.y()) / tile;
+    const double ux = (p.x() - world_.ground_.origin.x()) / tile, uy = (p.y() - world_.ground_.origin.y()) / tile;
     return {ux, uy, static_cast<int>(std::floor(ux)), static_cast<int>(std::floor(uy))};
   }
-  bool in_tiles(int x, int y) const { return x >= 0 && y >= 0 && x < world_.rise_nx_ && y < world_.rise_ny_; }
+  bool in_tiles(int x, int y) const { return x >= 0 && y >= 0 && x < world_.ground_.rise_nx && y < world_.ground_.rise_ny; }
   std::size_t tile_index(int x, int y) const {
-    return static_cast<std::size_t>(y) * static_cast<std::size_t>(world_.rise_nx_) + static_cast<std::size_t>(x);
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(world_.ground_.rise_nx) + static_cast<std::size_t>(x);
   }
   // Illinois variant of regula falsi on [t_prev (above), t (below)].
   double refine(double f_below) const {
@@ -468,7 +503,7 @@ RayHit World::cast_ray(const RayOrigin& origin, const Eigen::Vector3d& d, double
 
   // 2D DDA over the object grid (Amanatides & Woo), mailboxing repeated primitives.
   const double cell = options_.object_cell;
-  double gxf = (o.x() - origin_.x()) / cell, gyf = (o.y() - origin_.y()) / cell;
+  double gxf = (o.x() - ground_.origin.x()) / cell, gyf = (o.y() - ground_.origin.y()) / cell;
   int ix = static_cast<int>(std::floor(gxf)), iy = static_cast<int>(std::floor(gyf));
   const int step_x = d.x() >= 0 ? 1 : -1, step_y = d.y() >= 0 ? 1 : -1;
   const double inv_x = std::abs(d.x()) > 1e-12 ? 1.0 / std::abs(d.x()) : kInf;
@@ -521,122 +556,6 @@ RayHit World::cast_ray(const RayOrigin& origin, const Eigen::Vector3d& d, double
     best.remission = static_cast<float>(g.remission * (0.6 + 0.4 * std::min(1.0, std::abs(d.z()) * 4.0)));
   }
   return best;
-}
-
-// ---------------------------------------------------------------- path & agents
-
-double World::ego_arc_length(double t) const {
-  if (ego_s_.empty()) return 0.0;
-  const double f = t / options_.frame_period;
-  if (f <= 0) return ego_s_.front();
-  const auto i = static_cast<std::size_t>(f);
-  if (i + 1 >= ego_s_.size()) return ego_s_.back();
-  const double a = f - static_cast<double>(i);
-  return ego_s_[i] + a * (ego_s_[i + 1] - ego_s_[i]);
-}
-
-void World::path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const {
-  if (path_.size() < 2) {
-    position = path_.empty() ? Eigen::Vector3d::Zero() : path_.front();
-    direction = {1, 0};
-    return;
-  }
-  s = std::clamp(s, 0.0, path_s_.back());
-  auto it = std::upper_bound(path_s_.begin(), path_s_.end(), s);
-  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, it - path_s_.begin())) - 1;
-  i = std::min(i, path_.size() - 2);
-  const double len = path_s_[i + 1] - path_s_[i];
-  const double a = len > 1e-9 ? (s - path_s_[i]) / len : 0.0;
-  position = path_[i] + a * (path_[i + 1] - path_[i]);
-  // Direction smoothed over a few metres so cars do not jitter at kinks.
-  const std::size_t i0 = i >= 3 ? i - 3 : 0, i1 = std::min(path_.size() - 1, i + 4);
-  direction = (path_[i1] - path_[i0]).head<2>();
-  if (direction.norm() < 1e-9) direction = {1, 0};
-  direction.normalize();
-}
-
-void World::agents_at(double t, const Eigen::Vector2d& near, double radius, std::vector<Primitive>& out) const {
-  out.clear();
-  for (const Agent& a : agents_) {
-    if (t < a.t_begin || t >= a.t_end) continue;
-    double s = 0;
-    if (a.motion == Agent::Motion::kLeadsEgo) {
-      s = ego_arc_length(t) + a.gap + a.gap_amplitude * std::sin(2 * kPi * t / a.gap_period + a.gap_phase);
-    } else {
-      s = a.s_ref + a.speed * (t - a.t_ref);
-    }
-    if (s < 0 || s > path_length()) continue;
-    Eigen::Vector3d pos;
-    Eigen::Vector2d dir;
-    path_point(s, pos, dir);
-    const Eigen::Vector2d left(-dir.y(), dir.x());
-    double lateral = a.lateral;
-    const Zone z = zone_at(pos.x(), pos.y());
-    if (a.sidewalk_side != 0) {
-      // Rural roads have no sidewalk: walk on the verge beside the road.
-      lateral = a.sidewalk_side * (z.road(a.sidewalk_side) + z.parking + (z.sidewalk > 0 ? 0.5 * z.sidewalk : 1.2));
-    }
-    const Eigen::Vector2d xy = pos.head<2>() + lateral * left;
-    if ((xy - near).norm() > radius) continue;
-    const Eigen::Vector2d heading = a.speed < 0 ? Eigen::Vector2d(-dir) : dir;
-    Primitive p;
-    p.label = a.label;
-    p.instance = a.instance;
-    p.center = xy.cast<float>();
-    p.cos_yaw = static_cast<float>(heading.x());
-    p.sin_yaw = static_cast<float>(heading.y());
-    p.remission = a.remission;
-    const double ground = ground_height(xy.x(), xy.y());
-    if (a.label == cls::kMovingPerson) {
-      // Body and head; legs swing with the gait.
-      p.shape = Shape::kCylinder;
-      p.half_x = 0.5f * a.width;
-      p.z_min = static_cast<float>(ground + 0.75);
-      p.z_max = static_cast<float>(ground + a.height - 0.25);
-      out.push_back(p);
-      Primitive head = p;
-      head.shape = Shape::kEllipsoid;
-      head.half_x = head.half_y = 0.11f;
-      head.z_min = static_cast<float>(ground + a.height - 0.24);
-      head.z_max = static_cast<float>(ground + a.height);
-      out.push_back(head);
-      const double swing = 0.25 * std::sin(2 * kPi * 1.8 * t + a.gap_phase);
-      for (int leg = -1; leg <= 1; leg += 2) {
-        Primitive l = p;
-        l.half_x = 0.08f;
-        l.center = (xy + leg * swing * heading + leg * 0.1 * Eigen::Vector2d(-heading.y(), heading.x())).cast<float>();
-        l.z_min = static_cast<float>(ground);
-        l.z_max = static_cast<float>(ground + 0.8);
-        out.push_back(l);
-      }
-    } else {
-      p.shape = Shape::kBox;
-      p.half_x = 0.5f * a.length;
-      p.half_y = 0.5f * a.width;
-      p.z_min = static_cast<float>(ground + 0.3);
-      p.z_max = static_cast<float>(ground + 0.55 * a.height);
-      out.push_back(p);
-      Primitive cabin = p;  // greenhouse, set back a little
-      cabin.half_x = 0.28f * a.length;
-      cabin.half_y = 0.45f * a.width;
-      cabin.center = (xy - 0.08 * a.length * heading).cast<float>();
-      cabin.z_min = p.z_max;
-      cabin.z_max = static_cast<float>(ground + a.height);
-      out.push_back(cabin);
-      for (int w = 0; w < 4; ++w) {  // wheels below the body
-        Primitive wheel = p;
-        wheel.shape = Shape::kBox;
-        wheel.half_x = 0.32f;
-        wheel.half_y = 0.12f;
-        const double fx = (w < 2 ? 0.33 : -0.33) * a.length, fy = (w % 2 == 0 ? 0.42 : -0.42) * a.width;
-        wheel.center = (xy + fx * heading + fy * Eigen::Vector2d(-heading.y(), heading.x())).cast<float>();
-        wheel.z_min = static_cast<float>(ground);
-        wheel.z_max = static_cast<float>(ground + 0.3);
-        wheel.remission = 0.08f;
-        out.push_back(wheel);
-      }
-    }
-  }
 }
 
 }  // namespace saloam
