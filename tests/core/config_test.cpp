@@ -77,7 +77,6 @@ TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
   expected.odometry.local_map_point = "newest";
   expected.odometry.match_class_groups = false;
   expected.odometry.adaptive_class_weights = false;
-  expected.odometry.vehicle_confirmation_distance = 0;
   expected.odometry.features.ground_edge_alpha = 0.1;
   expected.odometry.features.thin_object_axes = false;
   expected.loop.acceptance = "loss";

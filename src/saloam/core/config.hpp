@@ -173,14 +173,6 @@ struct OdometryConfig {
   /// leaves to future work. On by default: lower drift on every simulated
   /// sequence measured (docs/odometry.md, "Per-class weights").
   bool adaptive_class_weights = true;
-  /// [m] With labels, a vehicle feature (car, bicycle, motorcycle, truck,
-  /// other-vehicle) enters the local map only when the previous frame saw a
-  /// vehicle within this distance of it: driving vehicles, which a single
-  /// scan's labels do not mark as moving, stay out of the map
-  /// (odometry/vehicle_filter.hpp). Above the car voxel size, so that a
-  /// parked car's points, sampled anew by each scan, confirm each other.
-  /// 0: off.
-  double vehicle_confirmation_distance = 0.5;
   int threads = 1;               ///< worker threads for association (0 = all cores)
   /// A registration direction whose eigenvalue of the Hessian per
   /// correspondence (rotations as the displacement they cause at the
@@ -409,8 +401,6 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("class_voxel_size", c.class_voxel_size, "[m] per-class voxel size", Above{0});
   v("class_weight", c.class_weight, "w^l: per-class residual weight", AtLeast{0});
   v("adaptive_class_weights", c.adaptive_class_weights, "scale w^l by inverse residual variance per class");
-  v("vehicle_confirmation_distance", c.vehicle_confirmation_distance,
-    "[m] a vehicle enters the map only when the previous frame saw one this close (0: off)", Range{0, 5});
   v("degeneracy_eigenvalue", c.degeneracy_eigenvalue, "below it a registration direction is degenerate (0: off)", Range{0, 1});
   v("threads", c.threads, "threads (0 = all cores)", AtLeast{0});
 }

@@ -29,7 +29,6 @@ SemanticOdometry::SemanticOdometry(OdometryConfig config)
       settings_(RegistrationSettings::from_config(config_)),
       voxel_sizes_(class_voxel_sizes(config_)),
       map_(SemanticLocalMap::from_config(config_)),
-      vehicles_(config_.use_semantics ? config_.vehicle_confirmation_distance : 0.0),
       start_up_(std::in_place, config_, voxel_sizes_) {
   configured_weights_ = settings_.class_weight;
   if (config_.threads != 1) {
@@ -151,9 +150,7 @@ FeatureRefresh SemanticOdometry::deskew_refresh(const ScanFeatures& measured, co
 }
 
 void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& sweep_pose) {
-  ScanFeatures world{transformed(features.edges, sweep_pose), transformed(features.planars, sweep_pose)};
-  vehicles_.keep_confirmed(world);
-  map_.add_frame(world.edges, world.planars);
+  map_.add_frame(transformed(features.edges, sweep_pose), transformed(features.planars, sweep_pose));
   if (sweep_poses_.empty()) start_up_->keep_first_frame(features, sweep_pose);  // as measured: its motion is unknown
   last_stats_.map_edge_points = map_.num_edge_points();
   last_stats_.map_planar_points = map_.num_planar_points();

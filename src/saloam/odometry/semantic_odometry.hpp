@@ -18,7 +18,6 @@
 #include "saloam/core/types.hpp"
 #include "saloam/odometry/features.hpp"
 #include "saloam/odometry/local_map.hpp"
-#include "saloam/odometry/vehicle_filter.hpp"
 #include "saloam/odometry/registration.hpp"
 #include "saloam/odometry/start_up.hpp"
 
@@ -108,7 +107,6 @@ class SemanticOdometry {
   std::array<double, kNumClassIndices> class_squared_residuals_{}, class_dof_{};
   ClassVoxelSizes voxel_sizes_;
   SemanticLocalMap map_;
-  VehicleFilter vehicles_;  ///< driving vehicles stay out of map_
   std::unique_ptr<tbb::task_arena> arena_;
   std::vector<Pose> poses_;        ///< reported: at pose_time_in_sweep, world = first pose
   std::vector<Pose> sweep_poses_;  ///< internal: mid-sweep poses (de-skew reference)
