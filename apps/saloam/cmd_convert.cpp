@@ -68,8 +68,7 @@ const CommandRegistration kRegistration{Command{
     "convert", "Write a scan source in another layout (SemanticKITTI, KITTI raw, PCD, PLY, ROS bag)", 16,
     [](CLI::App& app) {
       auto args = std::make_shared<ConvertArgs>();
-      args->source.add_to(app, "A SemanticKITTI sequence folder");
-      add_no_calib_flag(app, args->source.no_calib);
+      args->source.add_with_no_calib_to(app);
       app.add_option("--out", args->out, "The new folder (or .bag file); must not exist or be an empty folder")
           ->required();
       app.add_option("--to", args->to, "Layout to write: semantickitti, kitti-raw, pcd, ply, rosbag")

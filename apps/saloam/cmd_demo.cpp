@@ -26,12 +26,13 @@
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/slam_run.hpp"
-#include "saloam/sim/render.hpp"
+#include "saloam/sim/lidar.hpp"
 #include "saloam/sim/simulated_source.hpp"
 #include "saloam/sim/simulation_record.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sources/open_source.hpp"
 #include "saloam/viewer/viewer_page.hpp"
+#include "saloam/viz/range_image.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -222,10 +223,11 @@ int run_demo(const DemoOptions& options) {
     baseline.emplace(without_semantics(config.odometry), out / "odometry_baseline", info.velo_to_cam);
   }
   const std::size_t shown = info.size() / 2;
+  const std::vector<double> range_image_rows = LidarModel::hdl64e().elevation_deg;
   SlamRunOptions run_options;
   run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
     if (baseline) baseline->add(scan, t, info.first_frame + i);
-    if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown));
+    if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown), range_image_rows);
   };
   OutputFolder slam_folder = open_slam_folder(out / "slam", info);
   const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), slam_folder, run_options);

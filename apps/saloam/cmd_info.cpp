@@ -61,8 +61,7 @@ const CommandRegistration kRegistration{Command{
     "info", "What a scan source holds: format, frames, rate, fields, beams, duration, calibration, reference", 15,
     [](CLI::App& app) {
       auto args = std::make_shared<InfoArgs>();
-      args->source.add_to(app, "A SemanticKITTI sequence folder");
-      add_no_calib_flag(app, args->source.no_calib);
+      args->source.add_with_no_calib_to(app);
       app.add_option("--scans", args->scans, "Scans to read for fields, points and beams (default 3)")
           ->check(positive_number());
       return [args] { return run_info(*args); };

@@ -10,7 +10,9 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/io/sequence.hpp"
+#include "saloam/sim/lidar.hpp"
 #include "saloam/sim/render.hpp"
+#include "saloam/viz/range_image.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -33,7 +35,7 @@ int run_render(const RenderArgs& args) {
     throw InputError(args.sequence, fmt::format("--frame {} out of range: the sequence has {} scans", args.frame, reader.size()));
   }
   const auto range_png = out / fmt::format("range_{}.png", frame_name(args.frame));
-  render_range_image(reader.load_scan(args.frame), range_png);
+  render_range_image(reader.load_scan(args.frame), range_png, LidarModel::hdl64e().elevation_deg);
   std::cout << "range image: " << range_png.string() << '\n';
 
   MapRenderOptions options = args.map;

@@ -13,6 +13,7 @@
 #include "command.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/runs/segment_run.hpp"
+#include "saloam/sim/lidar.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -55,6 +56,7 @@ int run_segment(SegmentArgs args) {
   SegmentRunOptions options;
   options.truth = truth_folder(args);
   options.picture_frame = args.picture;
+  options.picture_elevations_deg = LidarModel::hdl64e().elevation_deg;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
   const SegmentRunResult result = run_segmentation(*source, args.out, options);
 

@@ -191,6 +191,11 @@ void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
   segment.add_to(app);
 }
 
+void SourceArgs::add_with_no_calib_to(CLI::App& app) {
+  add_to(app, "A SemanticKITTI sequence folder");
+  add_no_calib_flag(app, no_calib);
+}
+
 namespace {
 SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
   SourceOptions options;

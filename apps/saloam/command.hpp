@@ -96,6 +96,10 @@ struct SourceArgs {
   bool no_calib = false;
   SegmentOptions segment;  ///< --segment, --segmenter, --projection
   void add_to(CLI::App& app, const std::string& path_help);
+  /// add_to() and --no-calib for the commands that take a source as it is
+  /// (info, convert): SEQ_DIR is "A SemanticKITTI sequence folder" or any
+  /// other layout.
+  void add_with_no_calib_to(CLI::App& app);
   /// open_source() with these options; whether labels are read is the
   /// command's choice (ConfigError when it ignores them but --segment asks
   /// for them). The sensor (--sensor, chosen on the reader and said in one

@@ -63,6 +63,22 @@ int run_guarded(const std::function<int()>& command) {
   return 2;
 }
 
+int run_program(int argc, char** argv, const std::string& description, const std::string& name,
+                const std::function<std::function<int()>(CLI::App&)>& add_options) {
+  setup_logging();
+  CLI::App app{description, name};
+  Verbosity verbosity;
+  verbosity.add_to(app);
+  const auto run = add_options(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  verbosity.apply();
+  return run_guarded(run);
+}
+
 std::string describe_exception(const std::exception& e) {
   std::string_view text = e.what();
   if (dynamic_cast<const nlohmann::json::exception*>(&e)) {

@@ -27,6 +27,12 @@ struct Verbosity {
 /// logged as one message naming what failed (2).
 int run_guarded(const std::function<int()>& command);
 
+/// The whole main() of a program with one command (the trainers): logging,
+/// the app with -v / -q, `add_options` (which adds the command's options and
+/// returns what runs it), parsing, then run_guarded.
+int run_program(int argc, char** argv, const std::string& description, const std::string& name,
+                const std::function<std::function<int()>(CLI::App&)>& add_options);
+
 /// An exception's text as an error message: plain and short
 /// (plain_error_text), without a library's tags ("[json.exception...]") or
 /// bare function names ("stoul").

@@ -168,18 +168,7 @@ std::function<int()> add_segment_train_options(CLI::App& app) {
 }  // namespace saloam::cli
 
 int main(int argc, char** argv) {
-  using namespace saloam::cli;
-  setup_logging();
-  CLI::App app{"Train the segmentation network SegNet (libtorch, CPU) on labelled simulated or real sequences",
-               "saloam segment-train"};
-  Verbosity verbosity;
-  verbosity.add_to(app);
-  const auto run = add_segment_train_options(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-  verbosity.apply();
-  return run_guarded(run);
+  return saloam::cli::run_program(
+      argc, argv, "Train the segmentation network SegNet (libtorch, CPU) on labelled simulated or real sequences",
+      "saloam segment-train", saloam::cli::add_segment_train_options);
 }

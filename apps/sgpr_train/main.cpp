@@ -217,18 +217,7 @@ std::function<int()> add_sgpr_train_options(CLI::App& app) {
 }  // namespace saloam::cli
 
 int main(int argc, char** argv) {
-  using namespace saloam::cli;
-  setup_logging();
-  CLI::App app{"Train or fine-tune the SGPR network (libtorch, CPU) on simulated or real sequences",
-               "saloam sgpr-train"};
-  Verbosity verbosity;
-  verbosity.add_to(app);
-  const auto run = add_sgpr_train_options(app);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
-  verbosity.apply();
-  return run_guarded(run);
+  return saloam::cli::run_program(
+      argc, argv, "Train or fine-tune the SGPR network (libtorch, CPU) on simulated or real sequences",
+      "saloam sgpr-train", saloam::cli::add_sgpr_train_options);
 }

@@ -9,27 +9,23 @@
 
 #include <gtest/gtest.h>
 
-#include "testing/test_support.hpp"
+#include "cli/cli_fixture.hpp"
 
 namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::cli_path;
 using testing::quoted;
 using testing::run_command;
+using testing::saloam_cmd;
+using testing::file_text;
 using testing::TempDir;
-
-std::string read_text(const fs::path& file) {
-  std::ifstream in(file);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 TEST(DemoCli, ShortRunWritesEveryOutputAndAReadableTable) {
   TempDir dir;
   const fs::path out = dir / "demo";
   std::string output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " demo --out " + quoted(out) + " --frames 0:8 --beams 16", &output), 0)
+  ASSERT_EQ(run_command(saloam_cmd("demo --out ") + quoted(out) + " --frames 0:8 --beams 16", &output), 0)
       << output;
   for (const char* file : {"slam/poses.txt",
                            "slam/poses_odometry.txt", "slam/loops.csv", "slam/eval_slam.json", "slam/eval_odometry.png",
@@ -51,7 +47,7 @@ TEST(DemoCli, ShortRunWritesEveryOutputAndAReadableTable) {
 TEST(DemoCli, KeepsTheSequenceWhenAskedAndReusesIt) {
   TempDir dir;
   const fs::path out = dir / "demo";
-  const std::string demo = quoted(cli_path()) + " demo --out " + quoted(out) + " --frames 0:6 --beams 16 --no-baseline";
+  const std::string demo = saloam_cmd("demo --out ") + quoted(out) + " --frames 0:6 --beams 16 --no-baseline";
   std::string output;
   ASSERT_EQ(run_command(demo + " --keep-sequence", &output), 0) << output;
   for (const char* file : {"sequence/velodyne/000005.bin", "sequence/labels/000005.label",
@@ -60,20 +56,20 @@ TEST(DemoCli, KeepsTheSequenceWhenAskedAndReusesIt) {
   }
   EXPECT_FALSE(fs::exists(out / "odometry_baseline")) << output;
   const auto lines = [](const std::string& text) { return std::count(text.begin(), text.end(), '\n'); };
-  EXPECT_EQ(lines(read_text(out / "slam/poses.txt")), 6);
+  EXPECT_EQ(lines(file_text(out / "slam/poses.txt")), 6);
 
   ASSERT_EQ(run_command(demo + " --reuse", &output), 0) << output;
   EXPECT_NE(output.find("reusing"), std::string::npos) << output;
-  EXPECT_EQ(lines(read_text(out / "slam/poses.txt")), 6);
+  EXPECT_EQ(lines(file_text(out / "slam/poses.txt")), 6);
 
   // The kept sequence is reused only for the options it was simulated with.
-  EXPECT_EQ(run_command(quoted(cli_path()) + " demo --out " + quoted(out) + " --frames 0:6 --beams 32 --seed 5 --reuse",
+  EXPECT_EQ(run_command(saloam_cmd("demo --out ") + quoted(out) + " --frames 0:6 --beams 32 --seed 5 --reuse",
                         &output),
             2)
       << output;
   EXPECT_NE(output.find("was simulated otherwise (beams: 16, asked for 32; seed: 1, asked for 5)"), std::string::npos)
       << output;
-  EXPECT_EQ(run_command(quoted(cli_path()) + " demo --reuse --out " + quoted(dir / "none"), &output), 2) << output;
+  EXPECT_EQ(run_command(saloam_cmd("demo --reuse --out ") + quoted(dir / "none"), &output), 2) << output;
   EXPECT_NE(output.find("holds no kept sequence; run the demo once with --keep-sequence"), std::string::npos) << output;
   EXPECT_FALSE(fs::exists(dir / "none/slam")) << output;
 }

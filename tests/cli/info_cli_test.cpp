@@ -8,25 +8,25 @@
 #include "saloam/io/pcd.hpp"
 #include "saloam/sources/open_source.hpp"
 #include "saloam/sources/sequence_writer.hpp"
-#include "testing/test_support.hpp"
+#include "cli/cli_fixture.hpp"
 
 namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::cli_path;
 using testing::quoted;
 using testing::run_command;
+using testing::saloam_cmd;
 using testing::TempDir;
 
 std::string info(const fs::path& path, const std::string& extra = "") {
-  return quoted(cli_path()) + " info " + quoted(path) + " " + extra;
+  return saloam_cmd("info ") + quoted(path) + " " + extra;
 }
 
 TEST(InfoCli, SaysWhatEachSourceHolds) {
   TempDir dir;
   std::string output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " simulate --out " + quoted(dir / "seq") +
+  ASSERT_EQ(run_command(saloam_cmd("simulate --out ") + quoted(dir / "seq") +
                             " --preset straight --frames 0:3 --beams 16 --azimuth-steps 600",
                         &output),
             0)
@@ -62,7 +62,7 @@ TEST(InfoCli, SaysWhatEachSourceHolds) {
 TEST(InfoCli, ASimulatedVlp16InPcdFilesHasRingsTimesAndItsSensor) {
   TempDir dir;
   std::string output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " simulate --out " + quoted(dir / "vlp") +
+  ASSERT_EQ(run_command(saloam_cmd("simulate --out ") + quoted(dir / "vlp") +
                             " --preset straight --frames 0:4 --sensor vlp16 --azimuth-steps 900 --format pcd",
                         &output),
             0)
@@ -79,7 +79,7 @@ TEST(InfoCli, ASimulatedVlp16InPcdFilesHasRingsTimesAndItsSensor) {
   EXPECT_NE(output.find("sensor:      os1-64 (Ouster OS1-64), as given (--sensor os1-64)"), std::string::npos) << output;
   EXPECT_NE(run_command(info(dir / "vlp", "--sensor vlp99"), &output), 0);
   EXPECT_NE(output.find("--sensor vlp99: no such profile file, nor a shipped profile"), std::string::npos) << output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " odom " + quoted(dir / "vlp") + " --out " + quoted(dir / "odom"), &output), 0)
+  ASSERT_EQ(run_command(saloam_cmd("odom ") + quoted(dir / "vlp") + " --out " + quoted(dir / "odom"), &output), 0)
       << output;
   EXPECT_NE(output.find("sensor: vlp16 (Velodyne VLP-16), guessed"), std::string::npos) << output;
   EXPECT_NE(output.find("4 frames, 0 registration failures"), std::string::npos) << output;

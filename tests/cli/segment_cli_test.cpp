@@ -12,22 +12,22 @@
 #include <nlohmann/json.hpp>
 
 #include "saloam/io/scan_io.hpp"
-#include "testing/test_support.hpp"
+#include "cli/cli_fixture.hpp"
 
 namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::cli_path;
 using testing::quoted;
 using testing::run_command;
+using testing::saloam_cmd;
 using testing::TempDir;
 
 /// A simulated 16-beam sequence of the urban loop (noisy labels, truth in labels_gt).
 fs::path simulate(const TempDir& dir) {
   const fs::path seq = dir / "seq";
   std::string output;
-  EXPECT_EQ(run_command(quoted(cli_path()) + " -q simulate --preset urban-loop --frames 0:6 --beams 16 --labels noisy --out " +
+  EXPECT_EQ(run_command(saloam_cmd("-q simulate --preset urban-loop --frames 0:6 --beams 16 --labels noisy --out ") +
                             quoted(seq),
                         &output),
             0)
@@ -43,7 +43,7 @@ TEST(SegmentCli, TrainsLabelsScoresAndRunsInProcess) {
                                         "train: [{simulate: 'preset:urban-loop', frames: '0:60', seed: 3}]\n"
                                         "validation: [{simulate: 'preset:urban-loop', frames: '0:40', seed: 4}]\n";
   std::string output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q segment-train --data " + quoted(dir / "recipe.yaml") +
+  ASSERT_EQ(run_command(saloam_cmd("-q segment-train --data ") + quoted(dir / "recipe.yaml") +
                             " --out " + quoted(dir / "model") +
                             " --epochs 1 --samples-per-epoch 4 --batch 2 --widths 4,8,8 --stem-stride 2 --columns 512",
                         &output),
@@ -54,7 +54,7 @@ TEST(SegmentCli, TrainsLabelsScoresAndRunsInProcess) {
 
   const fs::path seq = simulate(dir);
   const std::string model = " --segmenter " + quoted(dir / "model" / "best.yaml");
-  ASSERT_EQ(run_command(quoted(cli_path()) + " segment " + quoted(seq) + " --out " + quoted(dir / "pred") + model, &output), 0)
+  ASSERT_EQ(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(dir / "pred") + model, &output), 0)
       << output;
   EXPECT_NE(output.find("against " + (seq / "labels_gt").string() + ": mIoU"), std::string::npos) << output;
   for (int i = 0; i < 6; ++i) {
@@ -63,21 +63,21 @@ TEST(SegmentCli, TrainsLabelsScoresAndRunsInProcess) {
   }
   EXPECT_TRUE(fs::is_regular_file(dir / "pred" / "segment_000003.png"));
   // Never over an input.
-  EXPECT_NE(run_command(quoted(cli_path()) + " segment " + quoted(seq) + " --out " + quoted(seq / "labels") + model, &output), 0);
+  EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(seq / "labels") + model, &output), 0);
   EXPECT_NE(output.find("labels folder"), std::string::npos) << output;
 
   // In-process, the stage's time in timing.json; --segment with --labels or --no-semantics is refused.
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q odom " + quoted(seq) + " --out " + quoted(dir / "odom") + model, &output), 0)
+  ASSERT_EQ(run_command(saloam_cmd("-q odom ") + quoted(seq) + " --out " + quoted(dir / "odom") + model, &output), 0)
       << output;
   std::ifstream timing(dir / "odom" / "timing.json");
   const std::string text((std::istreambuf_iterator<char>(timing)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"segmentation\""), std::string::npos) << text;
-  EXPECT_NE(run_command(quoted(cli_path()) + " odom " + quoted(seq) + " --out " + quoted(dir / "o2") + model +
+  EXPECT_NE(run_command(saloam_cmd("odom ") + quoted(seq) + " --out " + quoted(dir / "o2") + model +
                             " --no-semantics",
                         &output),
             0);
   EXPECT_NE(output.find("does not use labels"), std::string::npos) << output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " odom " + quoted(seq) + " --out " + quoted(dir / "o3") + model + " --labels " +
+  EXPECT_NE(run_command(saloam_cmd("odom ") + quoted(seq) + " --out " + quoted(dir / "o3") + model + " --labels " +
                             quoted(dir / "pred"),
                         &output),
             0);
@@ -91,7 +91,7 @@ struct RouteError {
 
 RouteError route_error(const fs::path& seq, const fs::path& run) {
   std::string output;
-  EXPECT_EQ(run_command(quoted(cli_path()) + " -q eval --gt " + quoted(seq / "poses.txt") + " --est " +
+  EXPECT_EQ(run_command(saloam_cmd("-q eval --gt ") + quoted(seq / "poses.txt") + " --est " +
                             quoted(run / "poses.txt") + " --json " + quoted(run / "eval.json"),
                         &output),
             0)
@@ -107,16 +107,16 @@ TEST(SegmentCli, ShippedModelMakesTheSemanticOdometryBeatTheLabelAgnosticOne) {
   TempDir dir;
   const fs::path seq = dir / "seq";
   std::string output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q simulate --preset urban-loop --frames 0:200 --seed 12 --labels gt --out " +
+  ASSERT_EQ(run_command(saloam_cmd("-q simulate --preset urban-loop --frames 0:200 --seed 12 --labels gt --out ") +
                             quoted(seq),
                         &output),
             0)
       << output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q odom " + quoted(seq) + " --segment --out " + quoted(dir / "segmented"),
+  ASSERT_EQ(run_command(saloam_cmd("-q odom ") + quoted(seq) + " --segment --out " + quoted(dir / "segmented"),
                         &output),
             0)
       << output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q odom " + quoted(seq) + " --no-semantics --out " + quoted(dir / "agnostic"),
+  ASSERT_EQ(run_command(saloam_cmd("-q odom ") + quoted(seq) + " --no-semantics --out " + quoted(dir / "agnostic"),
                         &output),
             0)
       << output;
@@ -135,12 +135,12 @@ TEST(SegmentCli, AModelThatIsNotThereIsNamed) {
   TempDir dir;
   const fs::path seq = simulate(dir);
   std::string output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " segment " + quoted(seq) + " --out " + quoted(dir / "pred") +
+  EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(dir / "pred") +
                             " --segmenter " + quoted(dir / "missing.yaml"),
                         &output),
             0);
   EXPECT_NE(output.find("missing.yaml: segmentation model description not found"), std::string::npos) << output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " segment " + quoted(seq) + " --out " + quoted(dir / "pred") +
+  EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(dir / "pred") +
                             " --segmenter " + quoted(dir / "net.pt"),
                         &output),
             0);
@@ -152,7 +152,7 @@ TEST(SegmentCli, AModelThatIsNotThereIsNamed) {
 TEST(SegmentCli, SaysItWasBuiltWithoutLibtorch) {
   TempDir dir;
   std::string output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " segment-train --data x.yaml --out " + quoted(dir / "run"), &output), 0);
+  EXPECT_NE(run_command(saloam_cmd("segment-train --data x.yaml --out ") + quoted(dir / "run"), &output), 0);
   EXPECT_NE(output.find("built without libtorch"), std::string::npos) << output;
   std::ofstream(dir / "m.yaml") << "format: saloam-segmenter 1\n"
                                    "network: {type: torchscript, file: m.pt}\n"
@@ -161,7 +161,7 @@ TEST(SegmentCli, SaysItWasBuiltWithoutLibtorch) {
                                    "classes: semantickitti\nknn: {k: 5, window: 5, cutoff: 1.0, sigma: 1.0}\n";
   std::ofstream(dir / "m.pt") << "x";
   const fs::path seq = simulate(dir);
-  EXPECT_NE(run_command(quoted(cli_path()) + " segment " + quoted(seq) + " --out " + quoted(dir / "pred") +
+  EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(dir / "pred") +
                             " --segmenter " + quoted(dir / "m.yaml"),
                         &output),
             0);

@@ -8,15 +8,15 @@
 #include <string>
 
 #include "saloam/place/sgpr_network.hpp"
-#include "testing/test_support.hpp"
+#include "cli/cli_fixture.hpp"
 
 namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::cli_path;
 using testing::quoted;
 using testing::run_command;
+using testing::saloam_cmd;
 using testing::TempDir;
 
 #ifdef SALOAM_HAVE_TORCH
@@ -30,7 +30,7 @@ TEST(SgprTrainCli, TrainsOnASimulatedRecipeAndResumes) {
               "validation:\n  - {simulate: 'preset:urban-loop', frames: '0:12', seed: 4}\n";
   }
   const fs::path out = dir / "run";
-  const std::string base = quoted(cli_path()) + " -q sgpr-train --data " + quoted(dir / "recipe.yaml") +
+  const std::string base = saloam_cmd("-q sgpr-train --data ") + quoted(dir / "recipe.yaml") +
                            " --batch 4 --pairs-per-epoch 8 --seed 2";
   std::string output;
   ASSERT_EQ(run_command(base + " --epochs 1 --out " + quoted(out), &output), 0) << output;
@@ -41,7 +41,7 @@ TEST(SgprTrainCli, TrainsOnASimulatedRecipeAndResumes) {
   // A second run into the same folder is refused; --resume continues it (graphs from the cache).
   EXPECT_NE(run_command(base + " --epochs 2 --out " + quoted(out), &output), 0);
   EXPECT_NE(output.find("--resume"), std::string::npos) << output;
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q sgpr-train --batch 4 --pairs-per-epoch 8 --seed 2 --epochs 2 --resume " +
+  ASSERT_EQ(run_command(saloam_cmd("-q sgpr-train --batch 4 --pairs-per-epoch 8 --seed 2 --epochs 2 --resume ") +
                             quoted(out),
                         &output),
             0)
@@ -49,9 +49,9 @@ TEST(SgprTrainCli, TrainsOnASimulatedRecipeAndResumes) {
   EXPECT_NE(output.find("epoch   2/2: loss"), std::string::npos) << output;
   EXPECT_EQ(output.find("epoch   1/2"), std::string::npos) << output;
   // Options left out take the run's own; options that differ are refused.
-  ASSERT_EQ(run_command(quoted(cli_path()) + " -q sgpr-train --epochs 3 --resume " + quoted(out), &output), 0) << output;
+  ASSERT_EQ(run_command(saloam_cmd("-q sgpr-train --epochs 3 --resume ") + quoted(out), &output), 0) << output;
   EXPECT_NE(output.find("epoch   3/3: loss"), std::string::npos) << output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " -q sgpr-train --epochs 4 --batch 8 --resume " + quoted(out), &output), 0);
+  EXPECT_NE(run_command(saloam_cmd("-q sgpr-train --epochs 4 --batch 8 --resume ") + quoted(out), &output), 0);
   EXPECT_NE(output.find("options differ"), std::string::npos) << output;
 }
 
@@ -59,7 +59,7 @@ TEST(SgprTrainCli, BadRecipeNamesTheFile) {
   TempDir dir;
   std::ofstream(dir / "recipe.yaml") << "train: [{simulate: missing.txt}]\nvalidation: [{folder: nowhere}]\n";
   std::string output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " sgpr-train --data " + quoted(dir / "recipe.yaml") + " --out " +
+  EXPECT_NE(run_command(saloam_cmd("sgpr-train --data ") + quoted(dir / "recipe.yaml") + " --out " +
                             quoted(dir / "run"),
                         &output),
             0);
@@ -71,7 +71,7 @@ TEST(SgprTrainCli, BadRecipeNamesTheFile) {
 TEST(SgprTrainCli, SaysItWasBuiltWithoutLibtorch) {
   TempDir dir;
   std::string output;
-  EXPECT_NE(run_command(quoted(cli_path()) + " sgpr-train --data x.yaml --out " + quoted(dir / "run"), &output), 0);
+  EXPECT_NE(run_command(saloam_cmd("sgpr-train --data x.yaml --out ") + quoted(dir / "run"), &output), 0);
   EXPECT_NE(output.find("built without libtorch"), std::string::npos) << output;
 }
 

@@ -260,12 +260,7 @@ DecodedCloud parse_pcd(std::span<const std::byte> bytes, const std::filesystem::
   } else {
     decode_binary(decompress_fields(data, header, file), header, out, file);
   }
-  DecodedCloud decoded;
-  decoded.points_in_file = header.points;
-  decoded.fields = roles.describe(header.fields);
-  decoded.cloud = out.finish(scan_stamp, file);
-  decoded.time_reference = out.absolute_reference();
-  return decoded;
+  return out.decoded(header.points, scan_stamp, file);
 }
 
 DecodedCloud read_pcd(const std::filesystem::path& file, std::optional<double> scan_stamp) {
@@ -273,36 +268,6 @@ DecodedCloud read_pcd(const std::filesystem::path& file, std::optional<double> s
 }
 
 namespace {
-
-/// The fields write_pcd writes for `cloud`, packed.
-std::vector<PointField> pcd_fields_for(const LabelledCloud& cloud, std::size_t& stride) {
-  std::vector<PointField> fields{{"x", ScalarType::kFloat32, 0, 1},
-                                 {"y", ScalarType::kFloat32, 4, 1},
-                                 {"z", ScalarType::kFloat32, 8, 1},
-                                 {"intensity", ScalarType::kFloat32, 12, 1}};
-  stride = 16;
-  if (cloud.has_rings()) {
-    fields.push_back({"ring", ScalarType::kUint16, stride, 1});
-    stride += 2;
-  }
-  if (cloud.has_times()) {
-    fields.push_back({"time", ScalarType::kFloat32, stride, 1});
-    stride += 4;
-  }
-  return fields;
-}
-
-double field_value(const LabelledCloud& cloud, std::size_t i, std::size_t field) {
-  switch (field) {
-    case 0: return cloud.points[i].x();
-    case 1: return cloud.points[i].y();
-    case 2: return cloud.points[i].z();
-    case 3: return cloud.remission[i];
-    default: break;
-  }
-  if (field == 4 && cloud.has_rings()) return cloud.ring[i];
-  return cloud.time[i];
-}
 
 char pcd_type_letter(ScalarType t) {
   if (is_floating(t)) return 'F';
@@ -325,8 +290,9 @@ std::string pcd_header(const std::vector<PointField>& fields, std::size_t points
 }  // namespace
 
 void write_pcd(const std::filesystem::path& file, const LabelledCloud& cloud, PcdEncoding encoding) {
-  std::size_t stride = 0;
-  const auto fields = pcd_fields_for(cloud, stride);
+  const ScanRecordLayout layout = ScanRecordLayout::of(cloud);
+  const std::vector<PointField>& fields = layout.fields;
+  const std::size_t stride = layout.stride;
   const std::size_t n = cloud.size();
   std::string text;
   std::vector<std::byte> body;
@@ -335,7 +301,7 @@ void write_pcd(const std::filesystem::path& file, const LabelledCloud& cloud, Pc
     for (std::size_t i = 0; i < n; ++i) {
       for (std::size_t f = 0; f < fields.size(); ++f) {
         if (f > 0) text += ' ';
-        fmt::format_to(std::back_inserter(text), "{}", static_cast<float>(field_value(cloud, i, f)));
+        fmt::format_to(std::back_inserter(text), "{}", static_cast<float>(ScanRecordLayout::value(cloud, i, f)));
       }
       text += '\n';
     }
@@ -348,7 +314,7 @@ void write_pcd(const std::filesystem::path& file, const LabelledCloud& cloud, Pc
         // binary: point after point; binary_compressed: field after field.
         std::byte* at = compressed ? packed.data() + fields[f].offset * n + i * scalar_size(fields[f].type)
                                    : packed.data() + i * stride + fields[f].offset;
-        write_scalar(at, fields[f].type, field_value(cloud, i, f), false);
+        write_scalar(at, fields[f].type, ScanRecordLayout::value(cloud, i, f), false);
       }
     }
     if (!compressed) {

@@ -200,12 +200,7 @@ DecodedCloud parse_ply(std::span<const std::byte> bytes, const std::filesystem::
   } else {
     decode_binary(data, header, vertex, out, file);
   }
-  DecodedCloud decoded;
-  decoded.points_in_file = v.count;
-  decoded.fields = roles.describe(v.properties);
-  decoded.cloud = out.finish(scan_stamp, file);
-  decoded.time_reference = out.absolute_reference();
-  return decoded;
+  return out.decoded(v.count, scan_stamp, file);
 }
 
 DecodedCloud read_ply_cloud(const std::filesystem::path& file, std::optional<double> scan_stamp) {
@@ -243,27 +238,9 @@ void write_ply(const std::filesystem::path& file, const LabelledCloud& cloud, co
 }
 
 void write_ply_scan(const std::filesystem::path& file, const LabelledCloud& cloud, PlyEncoding encoding) {
-  std::vector<PointField> fields{{"x", ScalarType::kFloat32, 0, 1},
-                                 {"y", ScalarType::kFloat32, 4, 1},
-                                 {"z", ScalarType::kFloat32, 8, 1},
-                                 {"intensity", ScalarType::kFloat32, 12, 1}};
-  std::size_t stride = 16;
-  if (cloud.has_rings()) {
-    fields.push_back({"ring", ScalarType::kUint16, stride, 1});
-    stride += 2;
-  }
-  if (cloud.has_times()) {
-    fields.push_back({"time", ScalarType::kFloat32, stride, 1});
-    stride += 4;
-  }
-  const auto value = [&](std::size_t i, const PointField& f) -> double {
-    if (f.name == "x") return cloud.points[i].x();
-    if (f.name == "y") return cloud.points[i].y();
-    if (f.name == "z") return cloud.points[i].z();
-    if (f.name == "intensity") return cloud.remission[i];
-    if (f.name == "ring") return cloud.ring[i];
-    return cloud.time[i];
-  };
+  const ScanRecordLayout layout = ScanRecordLayout::of(cloud);
+  const std::vector<PointField>& fields = layout.fields;
+  const std::size_t stride = layout.stride;
   const char* format = encoding == PlyEncoding::kAscii                ? "ascii"
                        : encoding == PlyEncoding::kBinaryLittleEndian ? "binary_little_endian"
                                                                       : "binary_big_endian";
@@ -275,15 +252,16 @@ void write_ply_scan(const std::filesystem::path& file, const LabelledCloud& clou
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       for (std::size_t f = 0; f < fields.size(); ++f) {
         if (f > 0) text += ' ';
-        fmt::format_to(std::back_inserter(text), "{}", static_cast<float>(value(i, fields[f])));
+        fmt::format_to(std::back_inserter(text), "{}", static_cast<float>(ScanRecordLayout::value(cloud, i, f)));
       }
       text += '\n';
     }
   } else {
     body.resize(cloud.size() * stride);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-      for (const auto& f : fields) {
-        write_scalar(body.data() + i * stride + f.offset, f.type, value(i, f), encoding == PlyEncoding::kBinaryBigEndian);
+      for (std::size_t f = 0; f < fields.size(); ++f) {
+        write_scalar(body.data() + i * stride + fields[f].offset, fields[f].type, ScanRecordLayout::value(cloud, i, f),
+                     encoding == PlyEncoding::kBinaryBigEndian);
       }
     }
   }

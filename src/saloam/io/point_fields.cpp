@@ -201,6 +201,46 @@ void CloudAssembler::add(double x, double y, double z, double intensity, double 
   if (roles_.time) raw_times_.push_back(time * time_scale_);
 }
 
+DecodedCloud CloudAssembler::decoded(std::size_t points_in_file, std::optional<double> scan_stamp,
+                                     const std::filesystem::path& file) {
+  DecodedCloud decoded;
+  decoded.points_in_file = points_in_file;
+  decoded.fields = roles_.describe(fields_);
+  decoded.cloud = finish(scan_stamp, file);
+  decoded.time_reference = absolute_reference_;
+  return decoded;
+}
+
+ScanRecordLayout ScanRecordLayout::of(const LabelledCloud& cloud) {
+  ScanRecordLayout layout;
+  layout.fields = {{"x", ScalarType::kFloat32, 0, 1},
+                   {"y", ScalarType::kFloat32, 4, 1},
+                   {"z", ScalarType::kFloat32, 8, 1},
+                   {"intensity", ScalarType::kFloat32, 12, 1}};
+  layout.stride = 16;
+  if (cloud.has_rings()) {
+    layout.fields.push_back({"ring", ScalarType::kUint16, layout.stride, 1});
+    layout.stride += 2;
+  }
+  if (cloud.has_times()) {
+    layout.fields.push_back({"time", ScalarType::kFloat32, layout.stride, 1});
+    layout.stride += 4;
+  }
+  return layout;
+}
+
+double ScanRecordLayout::value(const LabelledCloud& cloud, std::size_t i, std::size_t field) {
+  switch (field) {
+    case 0: return cloud.points[i].x();
+    case 1: return cloud.points[i].y();
+    case 2: return cloud.points[i].z();
+    case 3: return cloud.remission[i];
+    default: break;
+  }
+  if (field == 4 && cloud.has_rings()) return cloud.ring[i];
+  return cloud.time[i];
+}
+
 LabelledCloud CloudAssembler::finish(std::optional<double> scan_stamp, const std::filesystem::path& file) {
   if (cloud_.empty()) {
     throw InputError(file, dropped_ > 0 ? fmt::format("no finite point among {} points", dropped_)

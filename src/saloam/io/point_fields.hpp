@@ -53,6 +53,25 @@ void write_scalar(std::byte* p, ScalarType type, double value, bool big_endian);
 /// which is the scan's timestamp.
 inline constexpr double kAbsoluteTimeThreshold = 1e5;
 
+/// A point cloud file's content: the cloud and what was found in it.
+struct DecodedCloud {
+  LabelledCloud cloud;
+  std::string fields;                   ///< the fields taken, as named in the file ("x y z intensity ring t")
+  std::size_t points_in_file = 0;       ///< before dropping non-finite points
+  std::optional<double> time_reference; ///< absolute per-point times were made relative to this [s]
+};
+
+/// The record the writers (PCD, PLY scans, PointCloud2) write for a cloud,
+/// packed: x y z intensity (float32), then ring (uint16) when the cloud has
+/// rings and time (float32, [s] relative to the scan) when it has times.
+struct ScanRecordLayout {
+  std::vector<PointField> fields;
+  std::size_t stride = 0;  ///< bytes of one record
+  [[nodiscard]] static ScanRecordLayout of(const LabelledCloud& cloud);
+  /// The value of field `field` (an index into `fields`) for point `i` of `cloud`.
+  [[nodiscard]] static double value(const LabelledCloud& cloud, std::size_t i, std::size_t field);
+};
+
 /// Which fields of a record layout a LabelledCloud takes (indices into the
 /// field list), found by name as above.
 struct FieldRoles {
@@ -84,6 +103,9 @@ class CloudAssembler {
   /// were absolute (after finish()).
   [[nodiscard]] std::optional<double> absolute_reference() const { return absolute_reference_; }
   [[nodiscard]] std::size_t dropped_nonfinite() const { return dropped_; }
+  /// finish() with what a file's reader reports: the fields taken and the
+  /// number of records in the file.
+  DecodedCloud decoded(std::size_t points_in_file, std::optional<double> scan_stamp, const std::filesystem::path& file);
 
  private:
   void add(double x, double y, double z, double intensity, double ring, double time, double label, double instance);
@@ -97,13 +119,6 @@ class CloudAssembler {
   std::optional<double> absolute_reference_;
 };
 
-/// A point cloud file's content: the cloud and what was found in it.
-struct DecodedCloud {
-  LabelledCloud cloud;
-  std::string fields;                   ///< the fields taken, as named in the file ("x y z intensity ring t")
-  std::size_t points_in_file = 0;       ///< before dropping non-finite points
-  std::optional<double> time_reference; ///< absolute per-point times were made relative to this [s]
-};
 
 /// Parses a decimal number as written in ASCII PCD and PLY ("nan", "inf" accepted).
 [[nodiscard]] std::optional<double> parse_number(std::string_view token);

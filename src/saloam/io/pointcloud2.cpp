@@ -167,14 +167,11 @@ PointCloud2Scan parse_pointcloud2(std::span<const std::byte> message, const std:
   for (std::size_t r = 0; r < scan.height && scan.width > 0; ++r) {
     for (std::size_t c = 0; c < scan.width; ++c) out.add_binary(data.data() + r * row_step + c * point_step, big_endian);
   }
-  scan.decoded.points_in_file = scan.width * scan.height;
-  scan.decoded.fields = roles.describe(fields);
   try {
-    scan.decoded.cloud = out.finish(scan.header.stamp, file);
+    scan.decoded = out.decoded(scan.width * scan.height, scan.header.stamp, file);
   } catch (const InputError& e) {
     throw in.error(std::string(e.what()).substr(file.string().size() + 2));
   }
-  scan.decoded.time_reference = out.absolute_reference();
   return scan;
 }
 
@@ -197,19 +194,9 @@ void put_string(std::vector<std::byte>& out, std::string_view s) {
 
 std::vector<std::byte> serialize_pointcloud2(const LabelledCloud& cloud, double stamp, std::string_view frame_id,
                                              std::uint32_t seq) {
-  std::vector<PointField> fields{{"x", ScalarType::kFloat32, 0, 1},
-                                 {"y", ScalarType::kFloat32, 4, 1},
-                                 {"z", ScalarType::kFloat32, 8, 1},
-                                 {"intensity", ScalarType::kFloat32, 12, 1}};
-  std::size_t step = 16;
-  if (cloud.has_rings()) {
-    fields.push_back({"ring", ScalarType::kUint16, step, 1});
-    step += 2;
-  }
-  if (cloud.has_times()) {
-    fields.push_back({"time", ScalarType::kFloat32, step, 1});
-    step += 4;
-  }
+  const ScanRecordLayout layout = ScanRecordLayout::of(cloud);
+  const std::vector<PointField>& fields = layout.fields;
+  const std::size_t step = layout.stride;
   std::vector<std::byte> out;
   const double sec = std::floor(stamp);
   put_u32(out, seq);
@@ -233,11 +220,8 @@ std::vector<std::byte> serialize_pointcloud2(const LabelledCloud& cloud, double 
   out.resize(data_at + step * cloud.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     std::byte* rec = out.data() + data_at + i * step;
-    const double values[] = {cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z(), cloud.remission[i]};
-    for (std::size_t f = 0; f < 4; ++f) write_scalar(rec + fields[f].offset, fields[f].type, values[f], false);
-    for (std::size_t f = 4; f < fields.size(); ++f) {
-      const double v = fields[f].name == "ring" ? cloud.ring[i] : cloud.time[i];
-      write_scalar(rec + fields[f].offset, fields[f].type, v, false);
+    for (std::size_t f = 0; f < fields.size(); ++f) {
+      write_scalar(rec + fields[f].offset, fields[f].type, ScanRecordLayout::value(cloud, i, f), false);
     }
   }
   out.push_back(std::byte{1});  // is_dense

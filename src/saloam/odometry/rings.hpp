@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
 
 namespace saloam {
@@ -29,5 +30,16 @@ RingIndices rings_from_ring_field(const LabelledCloud& cloud, const std::vector<
 /// laser spacing beyond the top or bottom laser are left out.
 RingIndices rings_from_laser_elevations(const LabelledCloud& cloud, const std::vector<float>& times,
                                         const std::vector<double>& elevation_deg);
+
+/// Each point's time in the sweep [s] from its azimuth (the sweep model of
+/// `config`), -1 for a point on the sensor axis; points are independent, so
+/// with `parallel` blocks of them go to the threads (same output).
+std::vector<float> point_sweep_times(const LabelledCloud& cloud, const FeatureConfig& config, bool parallel);
+
+/// scan_rings() (features.hpp) with the points' sweep times at hand: from the
+/// ring field when the scan has one, else from the storage order when it is
+/// ring by ring, else from the elevation: the sensor profile's lasers when
+/// known, else the layout of config.num_beams.
+RingIndices rings_from_times(const LabelledCloud& cloud, const std::vector<float>& times, const FeatureConfig& config);
 
 }  // namespace saloam

@@ -11,7 +11,7 @@
 // restarts from frame 0 de-skewed, and frame 1 is registered again. From
 // frame 2 on, the constant-velocity prediction takes over.
 //
-// Measured on simulated sequences (issue #27): without the coarse stage a
+// Measured on simulated sequences: without the coarse stage a
 // standing start at 1.4 m per frame along a hedge-lined street stays behind
 // (SimulatedSequence.FastStandingStartAlongAHedgedStreet); without frame 0's
 // de-skew the first-point local map keeps frame 0's distorted points, and the

@@ -49,7 +49,7 @@ struct SemanticGraph {
   [[nodiscard]] std::size_t size() const { return nodes.size(); }
 };
 
-/// The clustering recipe SGPR's weights were trained with (issue #4).
+/// The clustering recipe SGPR's weights were trained with.
 struct GraphBuilderConfig {
   /// Euclidean clustering tolerance per node class [m]: neighbours closer than this join.
   std::array<double, kNumNodeClasses> tolerance{0.5, 0.5, 0.5, 2.0, 2.0, 2.0, 0.5, 2.0, 0.2, 2.0, 0.2, 0.2};

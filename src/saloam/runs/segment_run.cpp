@@ -10,7 +10,7 @@
 #include "saloam/core/progress.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/sim/render.hpp"
+#include "saloam/viz/range_image.hpp"
 
 namespace saloam {
 namespace {
@@ -64,7 +64,7 @@ SegmentRunResult run_segmentation(FrameSource& source, const fs::path& out_dir, 
     if (result.score) result.score->add(truth_labels(*options.truth, frame, cloud.size()), cloud.label);
     if (frame == picture) {
       result.picture = out_dir / fmt::format("segment_{}.png", frame_name(frame));
-      render_range_image(cloud, result.picture);
+      render_range_image(cloud, result.picture, options.picture_elevations_deg);
     }
     ++result.frames;
     result.points += cloud.size();

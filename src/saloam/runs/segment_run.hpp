@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "saloam/io/frame_source.hpp"
-#include "saloam/sim/label_noise.hpp"
+#include "saloam/eval/segmentation_score.hpp"
 
 namespace saloam {
 
@@ -23,6 +23,8 @@ struct SegmentRunOptions {
   /// Frame (the folder's number) drawn as a range image coloured by predicted
   /// class (none: the middle frame of the source).
   std::optional<std::size_t> picture_frame;
+  /// The picture's rows: beam elevations [deg], top first (viz/range_image.hpp).
+  std::vector<double> picture_elevations_deg;
   bool show_progress = true;
 };
 

@@ -26,8 +26,8 @@ struct ReferenceShare {
 /// 95 % of all points; the simulator's world is tuned to these.
 std::span<const ReferenceShare> semantic_kitti_shares();
 
-/// Relative band within which a simulated share counts as KITTI-like
-/// (issue #10: within +-30 % of SemanticKITTI's share).
+/// Relative band within which a simulated share counts as KITTI-like:
+/// within +-30 % of SemanticKITTI's share.
 inline constexpr double kShareTolerance = 0.30;
 
 /// Point counts per raw label (0..259), accumulated over scans.

@@ -1,7 +1,7 @@
 #include "saloam/sim/label_noise.hpp"
 
+#include <array>
 #include <cmath>
-#include <limits>
 
 #include "saloam/core/error.hpp"
 
@@ -125,54 +125,6 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
   std::vector<std::uint16_t> labels(n);
   for (std::size_t i = 0; i < n; ++i) labels[i] = from_learning_class(out[i]);
   return labels;
-}
-
-void SegmentationScore::add(const std::vector<std::uint16_t>& truth, const std::vector<std::uint16_t>& predicted) {
-  if (truth.size() != predicted.size()) throw ConfigError("label vectors of different sizes");
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    ++confusion_[to_learning_class(truth[i])][to_learning_class(predicted[i])];
-  }
-}
-
-std::uint64_t SegmentationScore::truth_count(int c) const {
-  std::uint64_t sum = 0;
-  for (int p = 0; p < kNumLearningClasses; ++p) sum += confusion_[static_cast<std::size_t>(c)][static_cast<std::size_t>(p)];
-  return sum;
-}
-
-double SegmentationScore::iou(int c) const {
-  // As in the SemanticKITTI API: points whose truth is ignored (0) do not count.
-  const auto uc = static_cast<std::size_t>(c);
-  const std::uint64_t tp = confusion_[uc][uc];
-  std::uint64_t fn = 0, fp = 0;
-  for (std::size_t k = 1; k < static_cast<std::size_t>(kNumLearningClasses); ++k) {
-    if (k == uc) continue;
-    fn += confusion_[uc][k];
-    fp += confusion_[k][uc];
-  }
-  fn += confusion_[uc][0];
-  const std::uint64_t denom = tp + fp + fn;
-  return denom == 0 ? std::numeric_limits<double>::quiet_NaN() : static_cast<double>(tp) / static_cast<double>(denom);
-}
-
-double SegmentationScore::miou() const {
-  double sum = 0;
-  int count = 0;
-  for (int c = 1; c < kNumLearningClasses; ++c) {
-    if (truth_count(c) == 0) continue;
-    sum += iou(c);
-    ++count;
-  }
-  return count == 0 ? std::numeric_limits<double>::quiet_NaN() : sum / count;
-}
-
-double SegmentationScore::accuracy() const {
-  std::uint64_t ok = 0, all = 0;
-  for (std::size_t c = 1; c < static_cast<std::size_t>(kNumLearningClasses); ++c) {
-    for (std::size_t p = 0; p < static_cast<std::size_t>(kNumLearningClasses); ++p) all += confusion_[c][p];
-    ok += confusion_[c][c];
-  }
-  return all == 0 ? 0.0 : static_cast<double>(ok) / static_cast<double>(all);
 }
 
 }  // namespace saloam

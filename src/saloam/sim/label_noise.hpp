@@ -1,13 +1,13 @@
 #pragma once
 // Emulated semantic segmentation: turns ground-truth labels into what a
 // range-image network (RangeNet++-like, ~52 % mIoU on SemanticKITTI) would
-// output, and scores labels with the SemanticKITTI mIoU.
+// output (scored with eval/segmentation_score.hpp).
 
-#include <array>
 #include <cstdint>
 #include <vector>
 
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/eval/segmentation_score.hpp"
 #include "saloam/sim/lidar.hpp"
 
 namespace saloam {
@@ -24,22 +24,5 @@ struct LabelNoiseOptions {
 /// classes, no moving-* classes, instance 0), deterministic for a seed.
 std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int beams, int columns,
                                                 std::uint64_t seed, const LabelNoiseOptions& options = {});
-
-/// Confusion matrix over the SemanticKITTI learning classes (0 = ignored).
-class SegmentationScore {
- public:
-  /// Adds raw-id labels (ground truth, prediction) of one scan.
-  void add(const std::vector<std::uint16_t>& truth, const std::vector<std::uint16_t>& predicted);
-  /// IoU of learning class c (NaN when the class appears in neither).
-  [[nodiscard]] double iou(int learning_class) const;
-  /// Mean IoU over the classes present in the ground truth.
-  [[nodiscard]] double miou() const;
-  /// Fraction of (non-ignored) points labelled correctly.
-  [[nodiscard]] double accuracy() const;
-  [[nodiscard]] std::uint64_t truth_count(int learning_class) const;
-
- private:
-  std::array<std::array<std::uint64_t, kNumLearningClasses>, kNumLearningClasses> confusion_{};
-};
 
 }  // namespace saloam

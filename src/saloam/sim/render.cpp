@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
@@ -10,7 +9,6 @@
 #include "saloam/core/progress.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/sequence.hpp"
-#include "saloam/sim/lidar.hpp"
 #include "saloam/viz/canvas.hpp"
 
 namespace fs = std::filesystem;
@@ -74,45 +72,6 @@ MapRenderStats render_map(const SequenceReader& reader, const fs::path& png, con
   static_cast<TopDownStats&>(stats) = canvas.save(png, poses);
   stats.scans_used = scans_used;
   return stats;
-}
-
-void render_range_image(const LabelledCloud& cloud, const fs::path& png, int columns) {
-  const LidarModel lidar = LidarModel::hdl64e(64);
-  const int rows = lidar.beams();
-  // Beam row from the elevation: nearest HDL-64E beam.
-  auto row_of = [&](double elevation_deg) {
-    int best = 0;
-    double best_d = 1e9;
-    for (int b = 0; b < rows; ++b) {
-      const double d = std::abs(lidar.elevation_deg[static_cast<std::size_t>(b)] - elevation_deg);
-      if (d < best_d) {
-        best_d = d;
-        best = b;
-      }
-    }
-    return best_d < 1.0 ? best : -1;
-  };
-  RasterImage img(columns, 2 * rows + 2, {0, 0, 0});
-  std::vector<float> depth(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows), std::numeric_limits<float>::infinity());
-  for (std::size_t k = 0; k < cloud.size(); ++k) {
-    const Eigen::Vector3f& p = cloud.points[k];
-    const double r = p.norm();
-    if (r < 1e-3) continue;
-    const double el = std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / kPi;
-    const int row = row_of(el);
-    if (row < 0) continue;
-    // Front in the middle, left of the car on the left of the picture.
-    const double az = std::atan2(p.y(), p.x());
-    int col = static_cast<int>((0.5 - az / (2 * kPi)) * columns);
-    col = std::clamp(col, 0, columns - 1);
-    const std::size_t idx = static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(col);
-    if (r >= depth[idx]) continue;
-    depth[idx] = static_cast<float>(r);
-    const std::uint16_t lab = cloud.has_labels ? cloud.label[k] : 0;
-    img.set(col, row, lab == 0 ? Rgb{160, 160, 160} : class_color(lab));
-    img.set(col, rows + 2 + row, viridis(1.0 - std::min(1.0, std::log1p(r) / std::log1p(80.0))));
-  }
-  img.save_png(png, 1, 4);
 }
 
 }  // namespace saloam

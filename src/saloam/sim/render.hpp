@@ -1,7 +1,8 @@
 #pragma once
-// Pictures of a (simulated or real) SemanticKITTI sequence for judging it by
+// A picture of a (simulated or real) SemanticKITTI sequence for judging it by
 // eye: a top-down map of all scans accumulated with the ground-truth poses,
-// coloured by class with the trajectory drawn, and a range image of one scan.
+// coloured by class with the trajectory drawn. A scan's range image is
+// viz/range_image.hpp.
 
 #include <cstddef>
 #include <filesystem>
@@ -33,9 +34,5 @@ struct MapRenderStats : TopDownStats {
 /// trees show over the ground as in an aerial view).
 MapRenderStats render_map(const SequenceReader& reader, const std::filesystem::path& png,
                           const MapRenderOptions& options = {});
-
-/// Range image of one scan (rows = HDL-64E beams by elevation, columns =
-/// azimuth, front in the middle): class colours on top, range below.
-void render_range_image(const LabelledCloud& cloud, const std::filesystem::path& png, int columns = 1040);
 
 }  // namespace saloam

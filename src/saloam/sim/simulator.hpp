@@ -58,7 +58,7 @@ struct SimulationOptions {
   std::size_t end_frame = std::numeric_limits<std::size_t>::max();
   std::size_t stride = 1;
   std::uint64_t seed = 1;
-  /// Several drives through one world (sessions of a map, issue #28): the
+  /// Several drives through one world (sessions of a map): the
   /// world is built along all of them, one after the other in time (so other
   /// moving objects, parked cars, label noise and sensor noise meet each),
   /// and `pass` is rendered; first_frame, end_frame and stride then count

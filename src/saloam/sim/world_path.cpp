@@ -1,0 +1,132 @@
+// The world's driven path and ego timeline (arc length, points along the
+// path) and its moving agents at a given time; the ground and the ray caster
+// are world.cpp.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/sim/world.hpp"
+
+namespace saloam {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+}  // namespace
+
+double World::ego_arc_length(double t) const {
+  if (ego_s_.empty()) return 0.0;
+  const double f = t / options_.frame_period;
+  if (f <= 0) return ego_s_.front();
+  const auto i = static_cast<std::size_t>(f);
+  if (i + 1 >= ego_s_.size()) return ego_s_.back();
+  const double a = f - static_cast<double>(i);
+  return ego_s_[i] + a * (ego_s_[i + 1] - ego_s_[i]);
+}
+
+void World::path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const {
+  if (path_.size() < 2) {
+    position = path_.empty() ? Eigen::Vector3d::Zero() : path_.front();
+    direction = {1, 0};
+    return;
+  }
+  s = std::clamp(s, 0.0, path_s_.back());
+  auto it = std::upper_bound(path_s_.begin(), path_s_.end(), s);
+  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, it - path_s_.begin())) - 1;
+  i = std::min(i, path_.size() - 2);
+  const double len = path_s_[i + 1] - path_s_[i];
+  const double a = len > 1e-9 ? (s - path_s_[i]) / len : 0.0;
+  position = path_[i] + a * (path_[i + 1] - path_[i]);
+  // Direction smoothed over a few metres so cars do not jitter at kinks.
+  const std::size_t i0 = i >= 3 ? i - 3 : 0, i1 = std::min(path_.size() - 1, i + 4);
+  direction = (path_[i1] - path_[i0]).head<2>();
+  if (direction.norm() < 1e-9) direction = {1, 0};
+  direction.normalize();
+}
+
+void World::agents_at(double t, const Eigen::Vector2d& near, double radius, std::vector<Primitive>& out) const {
+  out.clear();
+  for (const Agent& a : agents_) {
+    if (t < a.t_begin || t >= a.t_end) continue;
+    double s = 0;
+    if (a.motion == Agent::Motion::kLeadsEgo) {
+      s = ego_arc_length(t) + a.gap + a.gap_amplitude * std::sin(2 * kPi * t / a.gap_period + a.gap_phase);
+    } else {
+      s = a.s_ref + a.speed * (t - a.t_ref);
+    }
+    if (s < 0 || s > path_length()) continue;
+    Eigen::Vector3d pos;
+    Eigen::Vector2d dir;
+    path_point(s, pos, dir);
+    const Eigen::Vector2d left(-dir.y(), dir.x());
+    double lateral = a.lateral;
+    const Zone z = zone_at(pos.x(), pos.y());
+    if (a.sidewalk_side != 0) {
+      // Rural roads have no sidewalk: walk on the verge beside the road.
+      lateral = a.sidewalk_side * (z.road(a.sidewalk_side) + z.parking + (z.sidewalk > 0 ? 0.5 * z.sidewalk : 1.2));
+    }
+    const Eigen::Vector2d xy = pos.head<2>() + lateral * left;
+    if ((xy - near).norm() > radius) continue;
+    const Eigen::Vector2d heading = a.speed < 0 ? Eigen::Vector2d(-dir) : dir;
+    Primitive p;
+    p.label = a.label;
+    p.instance = a.instance;
+    p.center = xy.cast<float>();
+    p.cos_yaw = static_cast<float>(heading.x());
+    p.sin_yaw = static_cast<float>(heading.y());
+    p.remission = a.remission;
+    const double ground = ground_height(xy.x(), xy.y());
+    if (a.label == cls::kMovingPerson) {
+      // Body and head; legs swing with the gait.
+      p.shape = Shape::kCylinder;
+      p.half_x = 0.5f * a.width;
+      p.z_min = static_cast<float>(ground + 0.75);
+      p.z_max = static_cast<float>(ground + a.height - 0.25);
+      out.push_back(p);
+      Primitive head = p;
+      head.shape = Shape::kEllipsoid;
+      head.half_x = head.half_y = 0.11f;
+      head.z_min = static_cast<float>(ground + a.height - 0.24);
+      head.z_max = static_cast<float>(ground + a.height);
+      out.push_back(head);
+      const double swing = 0.25 * std::sin(2 * kPi * 1.8 * t + a.gap_phase);
+      for (int leg = -1; leg <= 1; leg += 2) {
+        Primitive l = p;
+        l.half_x = 0.08f;
+        l.center = (xy + leg * swing * heading + leg * 0.1 * Eigen::Vector2d(-heading.y(), heading.x())).cast<float>();
+        l.z_min = static_cast<float>(ground);
+        l.z_max = static_cast<float>(ground + 0.8);
+        out.push_back(l);
+      }
+    } else {
+      p.shape = Shape::kBox;
+      p.half_x = 0.5f * a.length;
+      p.half_y = 0.5f * a.width;
+      p.z_min = static_cast<float>(ground + 0.3);
+      p.z_max = static_cast<float>(ground + 0.55 * a.height);
+      out.push_back(p);
+      Primitive cabin = p;  // greenhouse, set back a little
+      cabin.half_x = 0.28f * a.length;
+      cabin.half_y = 0.45f * a.width;
+      cabin.center = (xy - 0.08 * a.length * heading).cast<float>();
+      cabin.z_min = p.z_max;
+      cabin.z_max = static_cast<float>(ground + a.height);
+      out.push_back(cabin);
+      for (int w = 0; w < 4; ++w) {  // wheels below the body
+        Primitive wheel = p;
+        wheel.shape = Shape::kBox;
+        wheel.half_x = 0.32f;
+        wheel.half_y = 0.12f;
+        const double fx = (w < 2 ? 0.33 : -0.33) * a.length, fy = (w % 2 == 0 ? 0.42 : -0.42) * a.width;
+        wheel.center = (xy + fx * heading + fy * Eigen::Vector2d(-heading.y(), heading.x())).cast<float>();
+        wheel.z_min = static_cast<float>(ground);
+        wheel.z_max = static_cast<float>(ground + 0.3);
+        wheel.remission = 0.08f;
+        out.push_back(wheel);
+      }
+    }
+  }
+}
+
+}  // namespace saloam
