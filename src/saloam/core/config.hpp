@@ -141,8 +141,8 @@ struct OdometryConfig {
   /// labels (ground gives none) cross the rings upright; a level line is
   /// mostly one ring's footprint seen by several frames, whose height moves
   /// with the sensor (z = range * tan(elevation)): fitted as a line, it pulls
-  /// the pitch (16 beams along simulated KITTI 05: t_err 0.53 % -> 0.07 %,
-  /// docs/real_sensors.md). 0: off; without semantics always off.
+  /// the pitch, most with 16 beams (docs/odometry.md, "Level edge lines").
+  /// 0: off; without semantics always off.
   double level_line_max_rise = 0.5;
   bool use_semantics = true;     ///< false: label-agnostic FLOAM-style baseline
   /// Match within groups of classes that networks confuse and that share a
