@@ -75,4 +75,12 @@ inline void expect_has(const std::string& output, const std::string& fragment) {
   EXPECT_NE(output.find(fragment), std::string::npos) << "missing '" << fragment << "' in:\n" << output;
 }
 
+/// Runs `saloam ARGS` (a command that needs libtorch, in a build without it):
+/// expects a failure that says so.
+inline void expect_needs_libtorch(const std::string& args) {
+  std::string output;
+  EXPECT_NE(run_command(saloam_cmd(args), &output), 0) << args;
+  expect_has(output, "built without libtorch");
+}
+
 }  // namespace saloam::testing

@@ -15,11 +15,7 @@ namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::quoted;
-using testing::run_command;
-using testing::saloam_cmd;
-using testing::file_text;
-using testing::TempDir;
+using namespace testing;
 
 TEST(DemoCli, ShortRunWritesEveryOutputAndAReadableTable) {
   TempDir dir;

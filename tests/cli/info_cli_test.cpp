@@ -14,10 +14,7 @@ namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::quoted;
-using testing::run_command;
-using testing::saloam_cmd;
-using testing::TempDir;
+using namespace testing;
 
 std::string info(const fs::path& path, const std::string& extra = "") {
   return saloam_cmd("info ") + quoted(path) + " " + extra;

@@ -14,10 +14,7 @@ namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::quoted;
-using testing::run_command;
-using testing::saloam_cmd;
-using testing::TempDir;
+using namespace testing;
 
 #ifdef SALOAM_HAVE_TORCH
 
@@ -70,9 +67,7 @@ TEST(SgprTrainCli, BadRecipeNamesTheFile) {
 
 TEST(SgprTrainCli, SaysItWasBuiltWithoutLibtorch) {
   TempDir dir;
-  std::string output;
-  EXPECT_NE(run_command(saloam_cmd("sgpr-train --data x.yaml --out ") + quoted(dir / "run"), &output), 0);
-  EXPECT_NE(output.find("built without libtorch"), std::string::npos) << output;
+  expect_needs_libtorch("sgpr-train --data x.yaml --out " + quoted(dir / "run"));
 }
 
 #endif

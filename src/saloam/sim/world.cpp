@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/semantic_classes.hpp"
@@ -171,36 +172,71 @@ float Primitive::footprint_radius() const {
   return std::hypot(half_x, half_y);
 }
 
+// ---------------------------------------------------------------- construction
+
+World::World(const WorldOptions& options, std::uint64_t seed, WorldPath path, Ground ground)
+    : options_(options), seed_(seed), path_(std::move(path)), ground_(std::move(ground)) {
+  const std::size_t n = ground_.distance.size();
+  packed_.resize(n);
+  for (std::size_t i = 0; i < n; ++i) packed_[i] = {ground_.distance[i], ground_.height[i], ground_.bump[i], 0.0f};
+}
+
+void World::index_objects() {
+  const double cell = options_.object_cell;
+  gx_ = static_cast<int>(std::ceil(ground_.nx * options_.ground_cell / cell));
+  gy_ = static_cast<int>(std::ceil(ground_.ny * options_.ground_cell / cell));
+  const std::size_t n = static_cast<std::size_t>(gx_) * static_cast<std::size_t>(gy_);
+  std::vector<std::uint32_t> count(n + 1, 0);
+  auto cells = [&](const Primitive& p, auto&& f) {
+    const double r = p.footprint_radius();
+    const int x0 = std::max(0, static_cast<int>((p.center.x() - r - ground_.origin.x()) / cell));
+    const int x1 = std::min(gx_ - 1, static_cast<int>((p.center.x() + r - ground_.origin.x()) / cell));
+    const int y0 = std::max(0, static_cast<int>((p.center.y() - r - ground_.origin.y()) / cell));
+    const int y1 = std::min(gy_ - 1, static_cast<int>((p.center.y() + r - ground_.origin.y()) / cell));
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) f(static_cast<std::size_t>(iy) * static_cast<std::size_t>(gx_) + static_cast<std::size_t>(ix));
+    }
+  };
+  for (const auto& p : primitives_) cells(p, [&](std::size_t c) { ++count[c + 1]; });
+  for (std::size_t i = 1; i <= n; ++i) count[i] += count[i - 1];
+  cell_start_ = count;
+  cell_items_.assign(count[n], 0);
+  std::vector<std::uint32_t> fill(count.begin(), count.end() - 1);
+  for (std::size_t k = 0; k < primitives_.size(); ++k) {
+    cells(primitives_[k], [&](std::size_t c) { cell_items_[fill[c]++] = static_cast<std::uint32_t>(k); });
+  }
+}
+
 // ---------------------------------------------------------------- ground
 
 std::size_t World::cell_index(double x, double y) const {
-  const int ix = std::clamp(static_cast<int>((x - origin_.x()) / options_.ground_cell), 0, nx_ - 1);
-  const int iy = std::clamp(static_cast<int>((y - origin_.y()) / options_.ground_cell), 0, ny_ - 1);
-  return static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const int ix = std::clamp(static_cast<int>((x - ground_.origin.x()) / options_.ground_cell), 0, ground_.nx - 1);
+  const int iy = std::clamp(static_cast<int>((y - ground_.origin.y()) / options_.ground_cell), 0, ground_.ny - 1);
+  return static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
 }
 
 double World::bilinear(const std::vector<float>& field, double x, double y) const {
-  const double gx = (x - origin_.x()) / options_.ground_cell - 0.5;
-  const double gy = (y - origin_.y()) / options_.ground_cell - 0.5;
-  const double fx = std::clamp(gx, 0.0, nx_ - 1.001), fy = std::clamp(gy, 0.0, ny_ - 1.001);
+  const double gx = (x - ground_.origin.x()) / options_.ground_cell - 0.5;
+  const double gy = (y - ground_.origin.y()) / options_.ground_cell - 0.5;
+  const double fx = std::clamp(gx, 0.0, ground_.nx - 1.001), fy = std::clamp(gy, 0.0, ground_.ny - 1.001);
   const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
   const double tx = fx - ix, ty = fy - iy;
-  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
   const double a = field[i], b = field[i + 1];
-  const double c = field[i + static_cast<std::size_t>(nx_)], e = field[i + static_cast<std::size_t>(nx_) + 1];
+  const double c = field[i + static_cast<std::size_t>(ground_.nx)], e = field[i + static_cast<std::size_t>(ground_.nx) + 1];
   return (a + (b - a) * tx) * (1 - ty) + (c + (e - c) * tx) * ty;
 }
 
-double World::path_distance(double x, double y) const { return bilinear(distance_, x, y); }
+double World::path_distance(double x, double y) const { return bilinear(ground_.distance, x, y); }
 
-World::Zone World::zone_at(double x, double y) const { return zones_[cell_index(x, y)]; }
+World::Zone World::zone_at(double x, double y) const { return ground_.zones[cell_index(x, y)]; }
 
 double World::path_lateral(double x, double y) const {
   // The side comes from the nearest cell, the magnitude from the continuous
   // distance field: interpolating the signed field across a Voronoi edge
   // between two centre lines would make a thin false road there.
   const double d = path_distance(x, y);
-  return lateral_[cell_index(x, y)] >= 0 ? d : -d;
+  return ground_.lateral[cell_index(x, y)] >= 0 ? d : -d;
 }
 
 double World::road_margin(double x, double y) const {
@@ -211,29 +247,29 @@ double World::road_margin(double x, double y) const {
 
 World::FieldSample World::sample(double x, double y) const {
   const double inv = 1.0 / options_.ground_cell;
-  const double ux = (x - origin_.x()) * inv, uy = (y - origin_.y()) * inv;
-  const int cx = std::clamp(static_cast<int>(ux), 0, nx_ - 1), cy = std::clamp(static_cast<int>(uy), 0, ny_ - 1);
-  const double fx = std::clamp(ux - 0.5, 0.0, nx_ - 1.001), fy = std::clamp(uy - 0.5, 0.0, ny_ - 1.001);
+  const double ux = (x - ground_.origin.x()) * inv, uy = (y - ground_.origin.y()) * inv;
+  const int cx = std::clamp(static_cast<int>(ux), 0, ground_.nx - 1), cy = std::clamp(static_cast<int>(uy), 0, ground_.ny - 1);
+  const double fx = std::clamp(ux - 0.5, 0.0, ground_.nx - 1.001), fy = std::clamp(uy - 0.5, 0.0, ground_.ny - 1.001);
   const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
   const double tx = fx - ix, ty = fy - iy;
-  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(ix);
+  const std::size_t i = static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
   const PackedCell& a = packed_[i];
   const PackedCell& b = packed_[i + 1];
-  const PackedCell& c = packed_[i + static_cast<std::size_t>(nx_)];
-  const PackedCell& e = packed_[i + static_cast<std::size_t>(nx_) + 1];
+  const PackedCell& c = packed_[i + static_cast<std::size_t>(ground_.nx)];
+  const PackedCell& e = packed_[i + static_cast<std::size_t>(ground_.nx) + 1];
   const double wa = (1 - tx) * (1 - ty), wb = tx * (1 - ty), wc = (1 - tx) * ty, we = tx * ty;
   return {wa * a.distance + wb * b.distance + wc * c.distance + we * e.distance,
           wa * a.height + wb * b.height + wc * c.height + we * e.height,
           wa * a.bump + wb * b.bump + wc * c.bump + we * e.bump,
-          static_cast<std::size_t>(cy) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(cx)};
+          static_cast<std::size_t>(cy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(cx)};
 }
 
 GroundInfo World::ground_at(double x, double y) const { return ground_from(sample(x, y)); }
 
 GroundInfo World::ground_from(const FieldSample& s) const {
   // Side from the nearest cell, magnitude from the continuous distance (see path_lateral).
-  const double lat = lateral_[s.cell] >= 0 ? s.distance : -s.distance;
-  const Zone& z = zones_[s.cell];
+  const double lat = ground_.lateral[s.cell] >= 0 ? s.distance : -s.distance;
+  const Zone& z = ground_.zones[s.cell];
   const double d = lat >= 0 ? lat - z.road_left : -lat - z.road_right;  // beyond the road edge
   const double base = s.height;
   GroundInfo g;
@@ -342,7 +378,7 @@ class World::GroundMarch {
     double next_y = t_ + (d_.y() >= 0 ? ty + 1 - here.uy : here.uy - ty) * dt_y;
     double t = t_;
     while (t < max_t_ && in_tiles(tx, ty)) {
-      const double top = world_.ground_top_[tile_index(tx, ty)];
+      const double top = world_.ground_.top[tile_index(tx, ty)];
       const double exit = std::min({next_x, next_y, max_t_});
       const double lowest = o_.z() + (d_.z() < 0.0 ? exit : t) * d_.z();  // the ray's lowest point in the tile
       if (lowest <= top) {
@@ -371,7 +407,7 @@ class World::GroundMarch {
     const double tile = tile_size();
     const int tx = here.x, ty = here.y;
     if (!in_tiles(tx, ty)) return 0.0;
-    const double rise = world_.ground_rise_[tile_index(tx, ty)];
+    const double rise = world_.ground_.rise[tile_index(tx, ty)];
     // Distance along the ray to the tile's edge.
     double exit = max_t_;
     if (std::abs(d_.x()) > 1e-12) exit = std::min(exit, ((d_.x() > 0 ? tx + 1 - here.ux : here.ux - tx) * tile) / std::abs(d_.x()));
@@ -380,7 +416,7 @@ class World::GroundMarch {
     const double clear = closing > 0.0 ? 0.9 * (f - World::kGroundStep) / closing : max_t_;
     return std::min(clear, exit);
   }
-  // The rise tiles (World::ground_rise_, World::ground_top_): the ray's
+  // The rise tiles (Ground::rise, Ground::top): the ray's
   // point at t_ in tile units and the tile it lies in.
   struct TilePosition {
     double ux, uy;
@@ -390,12 +426,12 @@ class World::GroundMarch {
   TilePosition tile_here() const {
     const double tile = tile_size();
     const Eigen::Vector3d p = o_ + t_ * d_;
-    const double ux = (p.x() - world_.origin_.x()) / tile, uy = (p.y() - world_.origin_.y()) / tile;
+    const double ux = (p.x() - world_.ground_.origin.x()) / tile, uy = (p.y() - world_.ground_.origin.y()) / tile;
     return {ux, uy, static_cast<int>(std::floor(ux)), static_cast<int>(std::floor(uy))};
   }
-  bool in_tiles(int x, int y) const { return x >= 0 && y >= 0 && x < world_.rise_nx_ && y < world_.rise_ny_; }
+  bool in_tiles(int x, int y) const { return x >= 0 && y >= 0 && x < world_.ground_.rise_nx && y < world_.ground_.rise_ny; }
   std::size_t tile_index(int x, int y) const {
-    return static_cast<std::size_t>(y) * static_cast<std::size_t>(world_.rise_nx_) + static_cast<std::size_t>(x);
+    return static_cast<std::size_t>(y) * static_cast<std::size_t>(world_.ground_.rise_nx) + static_cast<std::size_t>(x);
   }
   // Illinois variant of regula falsi on [t_prev (above), t (below)].
   double refine(double f_below) const {
@@ -467,7 +503,7 @@ RayHit World::cast_ray(const RayOrigin& origin, const Eigen::Vector3d& d, double
 
   // 2D DDA over the object grid (Amanatides & Woo), mailboxing repeated primitives.
   const double cell = options_.object_cell;
-  double gxf = (o.x() - origin_.x()) / cell, gyf = (o.y() - origin_.y()) / cell;
+  double gxf = (o.x() - ground_.origin.x()) / cell, gyf = (o.y() - ground_.origin.y()) / cell;
   int ix = static_cast<int>(std::floor(gxf)), iy = static_cast<int>(std::floor(gyf));
   const int step_x = d.x() >= 0 ? 1 : -1, step_y = d.y() >= 0 ? 1 : -1;
   const double inv_x = std::abs(d.x()) > 1e-12 ? 1.0 / std::abs(d.x()) : kInf;

@@ -97,13 +97,78 @@ struct GroundInfo {
   float remission = 0;
 };
 
-class WorldBuilder;
+/// The driven path: ground points (sensor_height below the poses) at most
+/// 0.5 m apart with their arc length, and the arc length at each trajectory
+/// pose (the ego timeline). Built first (build_world), then handed to World.
+struct WorldPath {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<double> s;      ///< arc length of points[i] [m]
+  std::vector<double> ego_s;  ///< arc length of trajectory pose i [m]
 
+  [[nodiscard]] double length() const { return s.empty() ? 0.0 : s.back(); }
+  /// The point on the path at arc length `at` (clamped to the path): position
+  /// (on the ground) and heading, smoothed over a few metres.
+  void point(double at, Eigen::Vector3d& position, Eigen::Vector2d& direction) const;
+};
+
+/// The street world. build_world() makes it in three steps, each through
+/// this interface: the path and the ground raster (the constructor), the
+/// static objects and moving agents (add_object, add_agent), and last the
+/// ray-casting grid over the static objects (index_objects).
 class World {
  public:
+  /// Street layout of one ground raster cell.
+  struct Zone {
+    float road_right = 2;  ///< road extent right of the path
+    float road_left = 5;   ///< road extent left of the path (oncoming lane)
+    float parking = 0;   ///< parking width beyond the road
+    /// Width of the strip along each road edge, inside road_left/right and
+    /// labelled road, where cars park at the curb (0 = none).
+    float curb_parking = 0;
+    float sidewalk = 3;  ///< sidewalk width (0 = rural, no curb)
+    std::uint8_t verge = 0;  ///< 0 terrain, 1 paved (sidewalk), 2 other-ground
+    [[nodiscard]] double road(int side) const { return side > 0 ? road_left : road_right; }
+  };
+
+  /// Within each tile of kRiseTile x kRiseTile raster cells, the ground
+  /// rises at most Ground::rise[tile] per metre along any horizontal
+  /// direction, plus steps of at most kGroundStep (curbs, zone edges).
+  static constexpr int kRiseTile = 8;
+  static constexpr double kGroundStep = 0.5;  ///< [m]
+  /// Height of the curb (sidewalks and verges) and of parking lanes above
+  /// the road surface [m].
+  static constexpr double kCurbHeight = 0.13, kParkingRise = 0.02;
+
+  /// The ground raster: nx x ny cells of options.ground_cell from `origin`
+  /// (row-major, x fastest), with the distance and signed side to the path,
+  /// the height, the bump and the zone of each cell, and per tile of
+  /// kRiseTile cells a bound on the ground's rise and its highest point.
+  struct Ground {
+    Eigen::Vector2d origin{0, 0};
+    int nx = 0, ny = 0;
+    std::vector<float> distance, lateral, height, bump;
+    int rise_nx = 0, rise_ny = 0;
+    std::vector<float> rise;  ///< per tile: rise per metre
+    std::vector<float> top;   ///< per tile: the highest the ground gets [m] (an upper bound)
+    std::vector<Zone> zones;
+  };
+
+  /// An empty world (nothing to cast against).
+  World() = default;
+  /// A world of the driven path and the ground, without objects yet.
+  World(const WorldOptions& options, std::uint64_t seed, WorldPath path, Ground ground);
+  /// Adds a static object (before index_objects).
+  void add_object(const Primitive& primitive) { primitives_.push_back(primitive); }
+  void add_agent(const Agent& agent) { agents_.push_back(agent); }
+  /// Builds the ray-casting grid over the static objects added so far.
+  void index_objects();
+
   [[nodiscard]] const WorldOptions& options() const { return options_; }
   [[nodiscard]] std::uint64_t seed() const { return seed_; }
-
+  [[nodiscard]] const Ground& ground() const { return ground_; }
+  /// Index of the ground raster cell at (x, y) (clamped to the raster).
+  [[nodiscard]] std::size_t cell_index(double x, double y) const;
+  [[nodiscard]] Zone zone_at(double x, double y) const;
   /// Distance from (x, y) to the driven path (bilinear on the raster) [m].
   [[nodiscard]] double path_distance(double x, double y) const;
   /// Signed lateral offset from the driven path (positive = left of the
@@ -134,7 +199,7 @@ class World {
   void path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const;
   /// Ego arc length at time t.
   [[nodiscard]] double ego_arc_length(double t) const;
-  [[nodiscard]] double path_length() const { return path_s_.empty() ? 0.0 : path_s_.back(); }
+  [[nodiscard]] double path_length() const { return path_.length(); }
 
   /// Where rays start and how high that is above the ground (positive =
   /// above), shared by every ray cast from there.
@@ -148,21 +213,8 @@ class World {
   [[nodiscard]] RayHit cast_ray(const RayOrigin& origin, const Eigen::Vector3d& direction, double max_range, double t,
                                 std::span<const Primitive> dynamic, Rng& rng) const;
 
+
  private:
-  friend class WorldBuilder;
-  friend World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options);
-  struct Zone {
-    float road_right = 2;  ///< road extent right of the path
-    float road_left = 5;   ///< road extent left of the path (oncoming lane)
-    float parking = 0;   ///< parking width beyond the road
-    /// Width of the strip along each road edge, inside road_left/right and
-    /// labelled road, where cars park at the curb (0 = none).
-    float curb_parking = 0;
-    float sidewalk = 3;  ///< sidewalk width (0 = rural, no curb)
-    std::uint8_t verge = 0;  ///< 0 terrain, 1 paved (sidewalk), 2 other-ground
-    [[nodiscard]] double road(int side) const { return side > 0 ? road_left : road_right; }
-  };
-  [[nodiscard]] Zone zone_at(double x, double y) const;
   [[nodiscard]] double bilinear(const std::vector<float>& field, double x, double y) const;
   /// Distance, height and bump interpolated together, plus the cell index
   /// (the ray marcher's hot path: one set of weights for all three).
@@ -172,41 +224,21 @@ class World {
   };
   [[nodiscard]] FieldSample sample(double x, double y) const;
   [[nodiscard]] GroundInfo ground_from(const FieldSample& s) const;
-  [[nodiscard]] std::size_t cell_index(double x, double y) const;
   /// The ray's first ground crossing, marched only as far as a caller needs it.
   class GroundMarch;
 
   WorldOptions options_;
   std::uint64_t seed_ = 0;
-  // Ground raster.
-  Eigen::Vector2d origin_{0, 0};
-  int nx_ = 0, ny_ = 0;
-  std::vector<float> distance_, lateral_, height_, bump_;
+  WorldPath path_;
+  Ground ground_;
   struct PackedCell {
     float distance, height, bump, pad;
   };
-  std::vector<PackedCell> packed_;  ///< distance_, height_, bump_ interleaved
-  /// Within each tile of kRiseTile x kRiseTile raster cells, the ground
-  /// rises at most ground_rise_[tile] per metre along any horizontal
-  /// direction, plus steps of at most kGroundStep (curbs, zone edges).
-  static constexpr int kRiseTile = 8;
-  static constexpr double kGroundStep = 0.5;  ///< [m]
-  /// Height of the curb (sidewalks and verges) and of parking lanes above
-  /// the road surface [m].
-  static constexpr double kCurbHeight = 0.13, kParkingRise = 0.02;
-  int rise_nx_ = 0, rise_ny_ = 0;
-  std::vector<float> ground_rise_;
-  /// The highest the ground gets anywhere in each tile [m] (an upper bound).
-  std::vector<float> ground_top_;
-  std::vector<Zone> zones_;
+  std::vector<PackedCell> packed_;  ///< ground_.distance, height, bump interleaved
   // Static objects and their 2D grid (CSR).
   std::vector<Primitive> primitives_;
   int gx_ = 0, gy_ = 0;
   std::vector<std::uint32_t> cell_start_, cell_items_;
-  // The driven path (ground points) with arc length, and the ego timeline.
-  std::vector<Eigen::Vector3d> path_;
-  std::vector<double> path_s_;
-  std::vector<double> ego_s_;  ///< arc length of trajectory pose i
   std::vector<Agent> agents_;
 };
 

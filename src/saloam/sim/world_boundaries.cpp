@@ -27,7 +27,7 @@ void WorldBuilder::place_boundaries() {
 double WorldBuilder::boundary_run(const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double s, int side, Rng& rng) {
   const Eigen::Vector2d left(-dir.y(), dir.x());
   const Eigen::Vector2d probe = p + side * left * 7.0;
-  const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
+  const bool rural = w_->zone_at(probe.x(), probe.y()).sidewalk == 0;
   const double length = rng.uniform(6, 30);
   const double pick = rng.uniform();
   if (pick < (rural ? 0.03 : 0.04)) return length;  // open
@@ -66,7 +66,7 @@ bool WorldBuilder::add_hedge_piece(const Eigen::Vector2d& c, const Eigen::Vector
   const double g = ground(c);
   Primitive h = box(cls::kVegetation, c, axis, half_length, half_width, g - 0.1, g + height, rng.uniform(0.38, 0.5));
   h.mean_free_path = 0.3f;
-  w_.primitives_.push_back(h);
+  w_->add_object(h);
   mark_rect(c, axis, half_length, half_width);
   return true;
 }
@@ -95,7 +95,7 @@ bool WorldBuilder::add_fence_piece(const Eigen::Vector2d& c, const Eigen::Vector
     f.half_y = 0.2f;
     f.mean_free_path = 1.0f;
   }
-  w_.primitives_.push_back(f);
+  w_->add_object(f);
   mark_rect(c, axis, half_length, kFenceCheckHalfWidth);
   return true;
 }

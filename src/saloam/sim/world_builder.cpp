@@ -1,9 +1,9 @@
 // The street world's construction (see world_builder.hpp for its parts):
-// the order of the steps, the placement helpers every part uses, and the
-// ray-casting grid.
+// the order of the steps and the placement helpers every part uses.
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "saloam/core/error.hpp"
 #include "saloam/sim/world_builder.hpp"
@@ -14,44 +14,53 @@ using namespace world_building;
 
 World build_world(const std::vector<Pose>& lidar_trajectory, std::uint64_t seed, const WorldOptions& options) {
   if (lidar_trajectory.empty()) throw ConfigError("cannot build a world along an empty trajectory");
-  World world;
-  world.options_ = options;
-  world.seed_ = seed;
-  WorldBuilder builder(world, seed);
+  WorldBuilder builder(options, seed);
   builder.build_path(lidar_trajectory);
   builder.build_ground();
-  const double total_time = static_cast<double>(lidar_trajectory.size() - 1) * options.frame_period;
-  builder.place_buildings(total_time);
-  builder.place_parked_vehicles(total_time);
-  builder.place_street_furniture();
-  builder.place_boundaries();
-  builder.place_trees();
-  builder.place_structures();
-  builder.plant_verges();
-  builder.place_agents(total_time);
-  builder.build_grid();
+  World world = builder.take_world();
+  builder.place_objects(world, static_cast<double>(lidar_trajectory.size() - 1) * options.frame_period);
+  world.index_objects();
   return world;
 }
 
+World WorldBuilder::take_world() {
+  origin_ = ground_.origin;
+  nx_ = ground_.nx;
+  ny_ = ground_.ny;
+  return World(options_, seed_, std::move(path_), std::move(ground_));
+}
+
+void WorldBuilder::place_objects(World& world, double total_time) {
+  w_ = &world;
+  place_buildings(total_time);
+  place_parked_vehicles(total_time);
+  place_street_furniture();
+  place_boundaries();
+  place_trees();
+  place_structures();
+  plant_verges();
+  place_agents(total_time);
+}
+
 double WorldBuilder::street_edge(const Eigen::Vector2d& p, int side) const {
-  const World::Zone z = w_.zone_at(p.x(), p.y());
+  const World::Zone z = w_->zone_at(p.x(), p.y());
   return z.road(side) + z.parking + z.sidewalk;
 }
 
 bool WorldBuilder::inside_grid(const Eigen::Vector2d& p) const {
-  return p.x() > w_.origin_.x() + 1 && p.y() > w_.origin_.y() + 1 &&
-         p.x() < w_.origin_.x() + (w_.nx_ - 1) * w_.options_.ground_cell &&
-         p.y() < w_.origin_.y() + (w_.ny_ - 1) * w_.options_.ground_cell;
+  return p.x() > origin_.x() + 1 && p.y() > origin_.y() + 1 &&
+         p.x() < origin_.x() + (nx_ - 1) * options_.ground_cell &&
+         p.y() < origin_.y() + (ny_ - 1) * options_.ground_cell;
 }
 
 bool WorldBuilder::rect_free(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double hx, double hy, double clearance,
                              bool road_only) const {
   return for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
     if (!inside_grid(p)) return false;
-    const World::Zone z = w_.zone_at(p.x(), p.y());
+    const World::Zone z = w_->zone_at(p.x(), p.y());
     // Off the street: a margin from the road even where there is no sidewalk.
     const double limit = road_only ? clearance : std::max(z.parking + z.sidewalk + clearance, kRoadsideMargin);
-    return w_.road_margin(p.x(), p.y()) >= limit && occupied_[w_.cell_index(p.x(), p.y())] == 0;
+    return w_->road_margin(p.x(), p.y()) >= limit && occupied_[w_->cell_index(p.x(), p.y())] == 0;
   });
 }
 
@@ -61,14 +70,14 @@ void WorldBuilder::mark_rect(const Eigen::Vector2d& c, const Eigen::Vector2d& ax
     return;
   }
   for_rect(c, axis, hx, hy, [&](const Eigen::Vector2d& p) {
-    if (inside_grid(p)) occupied_[w_.cell_index(p.x(), p.y())] = 1;
+    if (inside_grid(p)) occupied_[w_->cell_index(p.x(), p.y())] = 1;
     return true;
   });
 }
 
 bool WorldBuilder::clear_of_road(const Eigen::Vector2d& c, double r, double clearance) const {
   return for_rect(c, {1, 0}, r, r, [&](const Eigen::Vector2d& p) {
-    return inside_grid(p) && w_.road_margin(p.x(), p.y()) >= clearance;
+    return inside_grid(p) && w_->road_margin(p.x(), p.y()) >= clearance;
   });
 }
 
@@ -118,32 +127,6 @@ bool WorldBuilder::far_from(const PointSet& set, const Eigen::Vector2d& c, doubl
     }
   }
   return true;
-}
-
-void WorldBuilder::build_grid() {
-  const double cell = w_.options_.object_cell;
-  w_.gx_ = static_cast<int>(std::ceil(w_.nx_ * w_.options_.ground_cell / cell));
-  w_.gy_ = static_cast<int>(std::ceil(w_.ny_ * w_.options_.ground_cell / cell));
-  const std::size_t n = static_cast<std::size_t>(w_.gx_) * static_cast<std::size_t>(w_.gy_);
-  std::vector<std::uint32_t> count(n + 1, 0);
-  auto cells = [&](const Primitive& p, auto&& f) {
-    const double r = p.footprint_radius();
-    const int x0 = std::max(0, static_cast<int>((p.center.x() - r - w_.origin_.x()) / cell));
-    const int x1 = std::min(w_.gx_ - 1, static_cast<int>((p.center.x() + r - w_.origin_.x()) / cell));
-    const int y0 = std::max(0, static_cast<int>((p.center.y() - r - w_.origin_.y()) / cell));
-    const int y1 = std::min(w_.gy_ - 1, static_cast<int>((p.center.y() + r - w_.origin_.y()) / cell));
-    for (int iy = y0; iy <= y1; ++iy) {
-      for (int ix = x0; ix <= x1; ++ix) f(static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.gx_) + static_cast<std::size_t>(ix));
-    }
-  };
-  for (const auto& p : w_.primitives_) cells(p, [&](std::size_t c) { ++count[c + 1]; });
-  for (std::size_t i = 1; i <= n; ++i) count[i] += count[i - 1];
-  w_.cell_start_ = count;
-  w_.cell_items_.assign(count[n], 0);
-  std::vector<std::uint32_t> fill(count.begin(), count.end() - 1);
-  for (std::size_t k = 0; k < w_.primitives_.size(); ++k) {
-    cells(w_.primitives_[k], [&](std::size_t c) { w_.cell_items_[fill[c]++] = static_cast<std::uint32_t>(k); });
-  }
 }
 
 }  // namespace saloam

@@ -14,7 +14,7 @@
 // Static objects are placed greedily with collision checks on a raster of
 // occupied cells (so a revisited street is filled once, not twice); the
 // placement helpers are here and in world_builder.cpp. Last comes the
-// ray-casting grid.
+// ray-casting grid (World::index_objects).
 
 #include <algorithm>
 #include <cmath>
@@ -63,10 +63,13 @@ enum Salt : std::uint64_t {
 
 namespace saloam {
 
-// Access to World's private members for the builder.
+// Builds a World along a trajectory (build_world): the driven path and the
+// ground raster as its own data, handed to World's constructor
+// (take_world), then the objects into that world through its interface
+// (place_objects).
 class WorldBuilder {
  public:
-  WorldBuilder(World& w, std::uint64_t seed) : w_(w), seed_(seed) {}
+  WorldBuilder(const WorldOptions& options, std::uint64_t seed) : options_(options), seed_(seed) {}
 
   /// A step between consecutive trajectory poses longer than this [m] is
   /// the jump between two passes through the world (SimulationOptions::passes), not a drive.
@@ -76,6 +79,13 @@ class WorldBuilder {
   void build_path(const std::vector<Pose>& trajectory);
   void build_ground();
 
+  /// The world of the path and the ground built so far; the builder keeps
+  /// the ground's raster geometry for placing the objects.
+  World take_world();
+  /// Every kind of object into `world` (take_world's), in placement order.
+  void place_objects(World& world, double total_time);
+
+ private:
   // ------------------------------------------------------------ objects, in placement order
   void place_buildings(double total_time);          // world_buildings.cpp
   void place_parked_vehicles(double total_time);    // world_objects.cpp
@@ -85,10 +95,7 @@ class WorldBuilder {
   void place_structures();                          // world_objects.cpp
   void plant_verges();                              // world_vegetation.cpp
   void place_agents(double total_time);             // world_objects.cpp
-  /// The ray-casting grid over every static object (world_builder.cpp).
-  void build_grid();
 
- private:
   // ------------------------------------------------------------ ground raster steps (world_ground.cpp)
   /// Raster extent (the path's bounding box plus the margin) and size.
   void lay_out_raster();
@@ -108,11 +115,11 @@ class WorldBuilder {
   void box_blur(std::vector<float>& f, int radius) const;
   /// Centre of raster cell (ix, iy) and its index.
   [[nodiscard]] Eigen::Vector2d cell_centre(int ix, int iy) const {
-    const double size = w_.options_.ground_cell;
-    return {w_.origin_.x() + (ix + 0.5) * size, w_.origin_.y() + (iy + 0.5) * size};
+    const double size = options_.ground_cell;
+    return {ground_.origin.x() + (ix + 0.5) * size, ground_.origin.y() + (iy + 0.5) * size};
   }
   [[nodiscard]] std::size_t cell(int ix, int iy) const {
-    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(w_.nx_) + static_cast<std::size_t>(ix);
+    return static_cast<std::size_t>(iy) * static_cast<std::size_t>(ground_.nx) + static_cast<std::size_t>(ix);
   }
 
   // ------------------------------------------------------------ placement helpers (world_builder.cpp)
@@ -166,17 +173,17 @@ class WorldBuilder {
                 double z0, double z1, double remission) const;
   static Primitive cylinder(std::uint16_t label, const Eigen::Vector2d& c, double radius, double z0, double z1,
                             double remission);
-  [[nodiscard]] double ground(const Eigen::Vector2d& p) const { return w_.ground_height(p.x(), p.y()); }
+  [[nodiscard]] double ground(const Eigen::Vector2d& p) const { return w_->ground_height(p.x(), p.y()); }
 
   // Walks the path in steps, calling f(position, direction, s).
   template <class F>
   void walk(double start, F&& f) const {
     double s = start;
-    const double len = w_.path_length();
+    const double len = w_->path_length();
     while (s < len) {
       Eigen::Vector3d pos;
       Eigen::Vector2d dir;
-      w_.path_point(s, pos, dir);
+      w_->path_point(s, pos, dir);
       const double advance = f(pos.head<2>(), dir, s);
       s += std::max(0.5, advance);
     }
@@ -258,7 +265,7 @@ class WorldBuilder {
       for (int k = 0; k < pieces; ++k) {
         Eigen::Vector3d pos;
         Eigen::Vector2d dir;
-        w_.path_point(s + (2 * k + 1) * half, pos, dir);
+        w_->path_point(s + (2 * k + 1) * half, pos, dir);
         const Eigen::Vector2d away = side * Eigen::Vector2d(-dir.y(), dir.x());
         const double edge = street_edge(pos.head<2>() + away * 7.0, side);
         const RunPiece piece{pos.head<2>() + away * (edge + offset), dir, away, half};
@@ -299,8 +306,15 @@ class WorldBuilder {
   };
   static bool far_from(const PointSet& set, const Eigen::Vector2d& c, double min_dist);
 
-  World& w_;
+  WorldOptions options_;
   std::uint64_t seed_;
+  WorldPath path_;        ///< built by build_path, then the world's
+  World::Ground ground_;  ///< built by build_ground, then the world's
+  /// The ground raster's geometry (ground_'s origin, nx, ny), kept for the
+  /// raster of occupied cells once the ground is the world's.
+  Eigen::Vector2d origin_{0, 0};
+  int nx_ = 0, ny_ = 0;
+  World* w_ = nullptr;  ///< the world the objects go into (place_objects)
   std::vector<std::uint8_t> occupied_;
   struct MarkedRect {
     Eigen::Vector2d c, axis;

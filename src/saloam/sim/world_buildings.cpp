@@ -26,7 +26,7 @@ double WorldBuilder::building_plot(const Eigen::Vector2d& p, const Eigen::Vector
                                    double total_time) {
   const Eigen::Vector2d left(-dir.y(), dir.x());
   const Eigen::Vector2d probe = p + side * left * 8.0;
-  const World::Zone z = w_.zone_at(probe.x(), probe.y());
+  const World::Zone z = w_->zone_at(probe.x(), probe.y());
   if (z.sidewalk == 0 && !rng.chance(0.12)) return rng.uniform(15, 40);  // rural: mostly open land
   double length = rng.chance(0.25) ? rng.uniform(25, 45) : rng.uniform(9, 25);
   const double depth = rng.uniform(8, 18);
@@ -117,10 +117,10 @@ void WorldBuilder::add_building(const Eigen::Vector2d& c, const Eigen::Vector2d&
   b.facade.recess = static_cast<float>(rng.uniform(0.12, 0.35));
   b.facade.glass_dropout = static_cast<float>(rng.uniform(0.25, 0.7));
   if (rng.chance(0.15)) b.facade.floor_height = 0;  // plain wall (warehouse, garage)
-  w_.primitives_.push_back(b);
+  w_->add_object(b);
   // A plinth that sticks out a little: facades are not perfect planes.
   if (rng.chance(0.5)) {
-    w_.primitives_.push_back(box(cls::kBuilding, c, axis, hx + 0.12, hy + 0.12, g - 0.5, g + rng.uniform(0.4, 1.0),
+    w_->add_object(box(cls::kBuilding, c, axis, hx + 0.12, hy + 0.12, g - 0.5, g + rng.uniform(0.4, 1.0),
                                  b.remission * 0.8));
   }
   // Pilasters or balconies every few metres on some buildings.
@@ -130,7 +130,7 @@ void WorldBuilder::add_building(const Eigen::Vector2d& c, const Eigen::Vector2d&
     for (double u = -hx + 1; u < hx - 1; u += spacing) {
       for (int s = -1; s <= 1; s += 2) {
         const Eigen::Vector2d pc = c + u * axis + s * (hy + 0.2) * side;
-        w_.primitives_.push_back(box(cls::kBuilding, pc, axis, 0.25, 0.2, g, g + height, b.remission));
+        w_->add_object(box(cls::kBuilding, pc, axis, 0.25, 0.2, g, g + height, b.remission));
       }
     }
   }
@@ -141,7 +141,7 @@ void WorldBuilder::add_building(const Eigen::Vector2d& c, const Eigen::Vector2d&
     top.half_y = static_cast<float>(hy - rng.uniform(1, 3));
     top.z_min = static_cast<float>(g + height);
     top.z_max = static_cast<float>(g + height + rng.uniform(3, 6));
-    w_.primitives_.push_back(top);
+    w_->add_object(top);
   }
 }
 

@@ -15,22 +15,22 @@ namespace saloam {
 using namespace world_building;
 
 void WorldBuilder::build_path(const std::vector<Pose>& trajectory) {
-  const double h = w_.options_.sensor_height;
-  w_.ego_s_.reserve(trajectory.size());
+  const double h = options_.sensor_height;
+  path_.ego_s.reserve(trajectory.size());
   double s = 0;
   Eigen::Vector3d prev = trajectory.front().translation() - Eigen::Vector3d(0, 0, h);
-  w_.path_.push_back(prev);
-  w_.path_s_.push_back(0);
-  w_.ego_s_.push_back(0);
+  path_.points.push_back(prev);
+  path_.s.push_back(0);
+  path_.ego_s.push_back(0);
   for (std::size_t i = 1; i < trajectory.size(); ++i) {
     const Eigen::Vector3d p = trajectory[i].translation() - Eigen::Vector3d(0, 0, h);
     const double len = (p - prev).norm();
     if (len > kPassJump) {
       // The jump from one pass to the next (SimulationOptions::passes):
       // no road along it, no arc length (moving objects do not travel it).
-      w_.path_.push_back(p);
-      w_.path_s_.push_back(s);
-      w_.ego_s_.push_back(s);
+      path_.points.push_back(p);
+      path_.s.push_back(s);
+      path_.ego_s.push_back(s);
       prev = p;
       continue;
     }
@@ -38,12 +38,12 @@ void WorldBuilder::build_path(const std::vector<Pose>& trajectory) {
     if (len > 1e-6) {
       for (int k = 1; k <= pieces; ++k) {
         const double a = static_cast<double>(k) / pieces;
-        w_.path_.push_back(prev + a * (p - prev));
-        w_.path_s_.push_back(s + a * len);
+        path_.points.push_back(prev + a * (p - prev));
+        path_.s.push_back(s + a * len);
       }
     }
     s += len;
-    w_.ego_s_.push_back(s);
+    path_.ego_s.push_back(s);
     prev = p;
   }
 }
@@ -57,35 +57,32 @@ void WorldBuilder::build_ground() {
   side_of_path(source, centres, centre_dirs);
   ground_heights(source, centres);
   street_zones_and_bumps();
-  const std::size_t n = w_.distance_.size();
-  w_.packed_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) w_.packed_[i] = {w_.distance_[i], w_.height_[i], w_.bump_[i], 0.0f};
   bound_ground_rise();
-  occupied_.assign(n, 0);
+  occupied_.assign(ground_.distance.size(), 0);
 }
 
 void WorldBuilder::lay_out_raster() {
-  const auto& opt = w_.options_;
-  Eigen::Vector2d lo = w_.path_.front().head<2>(), hi = lo;
-  for (const auto& p : w_.path_) {
+  const auto& opt = options_;
+  Eigen::Vector2d lo = path_.points.front().head<2>(), hi = lo;
+  for (const auto& p : path_.points) {
     lo = lo.cwiseMin(p.head<2>());
     hi = hi.cwiseMax(p.head<2>());
   }
   lo.array() -= opt.margin;
   hi.array() += opt.margin;
-  w_.origin_ = lo;
+  ground_.origin = lo;
   const double cell = opt.ground_cell;
-  w_.nx_ = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell)) + 1;
-  w_.ny_ = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell)) + 1;
-  const std::size_t n = static_cast<std::size_t>(w_.nx_) * static_cast<std::size_t>(w_.ny_);
+  ground_.nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell)) + 1;
+  ground_.ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell)) + 1;
+  const std::size_t n = static_cast<std::size_t>(ground_.nx) * static_cast<std::size_t>(ground_.ny);
   if (n > 200'000'000ull) throw ConfigError("trajectory spans too large an area for the simulator's ground raster");
 }
 
 void WorldBuilder::road_centre_lines(std::vector<Eigen::Vector3d>& centres, std::vector<Eigen::Vector2d>& dirs) {
-  for (std::size_t k = 0; k < w_.path_.size(); ++k) {
-    const std::size_t k0 = k > 0 ? k - 1 : k, k1 = std::min(w_.path_.size() - 1, k + 1);
-    Eigen::Vector2d dir = (w_.path_[k1] - w_.path_[k0]).head<2>();
-    centres.push_back(w_.path_[k]);
+  for (std::size_t k = 0; k < path_.points.size(); ++k) {
+    const std::size_t k0 = k > 0 ? k - 1 : k, k1 = std::min(path_.points.size() - 1, k + 1);
+    Eigen::Vector2d dir = (path_.points[k1] - path_.points[k0]).head<2>();
+    centres.push_back(path_.points[k]);
     dirs.push_back(dir.norm() > 1e-9 ? Eigen::Vector2d(dir.normalized()) : Eigen::Vector2d(1, 0));
   }
   add_side_streets(centres, dirs);
@@ -94,51 +91,51 @@ void WorldBuilder::road_centre_lines(std::vector<Eigen::Vector3d>& centres, std:
 // Seeds the cells on the lines, then a two-pass propagation (a feature
 // transform, close to the exact Euclidean one).
 std::vector<std::int32_t> WorldBuilder::nearest_centres(const std::vector<Eigen::Vector3d>& centres) {
-  const double cell_size = w_.options_.ground_cell;
-  const Eigen::Vector2d lo = w_.origin_;
-  const std::size_t n = static_cast<std::size_t>(w_.nx_) * static_cast<std::size_t>(w_.ny_);
+  const double cell_size = options_.ground_cell;
+  const Eigen::Vector2d lo = ground_.origin;
+  const std::size_t n = static_cast<std::size_t>(ground_.nx) * static_cast<std::size_t>(ground_.ny);
   std::vector<std::int32_t> source(n, -1);
-  w_.distance_.assign(n, std::numeric_limits<float>::infinity());
+  ground_.distance.assign(n, std::numeric_limits<float>::infinity());
   for (std::size_t k = 0; k < centres.size(); ++k) {
     const int ix = static_cast<int>((centres[k].x() - lo.x()) / cell_size);
     const int iy = static_cast<int>((centres[k].y() - lo.y()) / cell_size);
-    if (ix < 0 || iy < 0 || ix >= w_.nx_ || iy >= w_.ny_) continue;
+    if (ix < 0 || iy < 0 || ix >= ground_.nx || iy >= ground_.ny) continue;
     const double dist = (cell_centre(ix, iy) - centres[k].head<2>()).norm();
     const std::size_t i = cell(ix, iy);
-    if (dist < w_.distance_[i]) {
-      w_.distance_[i] = static_cast<float>(dist);
+    if (dist < ground_.distance[i]) {
+      ground_.distance[i] = static_cast<float>(dist);
       source[i] = static_cast<std::int32_t>(k);
     }
   }
   auto relax = [&](int ix, int iy, int jx, int jy) {
-    if (jx < 0 || jy < 0 || jx >= w_.nx_ || jy >= w_.ny_) return;
+    if (jx < 0 || jy < 0 || jx >= ground_.nx || jy >= ground_.ny) return;
     const std::int32_t src = source[cell(jx, jy)];
     if (src < 0) return;
     const double dist = (cell_centre(ix, iy) - centres[static_cast<std::size_t>(src)].head<2>()).norm();
     const std::size_t i = cell(ix, iy);
-    if (dist < w_.distance_[i]) {
-      w_.distance_[i] = static_cast<float>(dist);
+    if (dist < ground_.distance[i]) {
+      ground_.distance[i] = static_cast<float>(dist);
       source[i] = src;
     }
   };
   for (int pass = 0; pass < 2; ++pass) {
-    for (int iy = 0; iy < w_.ny_; ++iy) {
-      for (int ix = 0; ix < w_.nx_; ++ix) {
+    for (int iy = 0; iy < ground_.ny; ++iy) {
+      for (int ix = 0; ix < ground_.nx; ++ix) {
         relax(ix, iy, ix - 1, iy);
         relax(ix, iy, ix - 1, iy - 1);
         relax(ix, iy, ix, iy - 1);
         relax(ix, iy, ix + 1, iy - 1);
       }
-      for (int ix = w_.nx_ - 1; ix >= 0; --ix) relax(ix, iy, ix + 1, iy);
+      for (int ix = ground_.nx - 1; ix >= 0; --ix) relax(ix, iy, ix + 1, iy);
     }
-    for (int iy = w_.ny_ - 1; iy >= 0; --iy) {
-      for (int ix = w_.nx_ - 1; ix >= 0; --ix) {
+    for (int iy = ground_.ny - 1; iy >= 0; --iy) {
+      for (int ix = ground_.nx - 1; ix >= 0; --ix) {
         relax(ix, iy, ix + 1, iy);
         relax(ix, iy, ix + 1, iy + 1);
         relax(ix, iy, ix, iy + 1);
         relax(ix, iy, ix - 1, iy + 1);
       }
-      for (int ix = 0; ix < w_.nx_; ++ix) relax(ix, iy, ix - 1, iy);
+      for (int ix = 0; ix < ground_.nx; ++ix) relax(ix, iy, ix - 1, iy);
     }
   }
   return source;
@@ -147,15 +144,15 @@ std::vector<std::int32_t> WorldBuilder::nearest_centres(const std::vector<Eigen:
 // Signed lateral offset: which side of the nearest path point's direction.
 void WorldBuilder::side_of_path(const std::vector<std::int32_t>& source, const std::vector<Eigen::Vector3d>& centres,
                                 const std::vector<Eigen::Vector2d>& dirs) {
-  w_.lateral_.resize(source.size());
-  for (int iy = 0; iy < w_.ny_; ++iy) {
-    for (int ix = 0; ix < w_.nx_; ++ix) {
+  ground_.lateral.resize(source.size());
+  for (int iy = 0; iy < ground_.ny; ++iy) {
+    for (int ix = 0; ix < ground_.nx; ++ix) {
       const std::size_t i = cell(ix, iy);
       const auto k = static_cast<std::size_t>(source[i]);
       const Eigen::Vector2d& dir = dirs[k];
       const Eigen::Vector2d rel = cell_centre(ix, iy) - centres[k].head<2>();
       const double cross = dir.x() * rel.y() - dir.y() * rel.x();
-      w_.lateral_[i] = cross >= 0 ? w_.distance_[i] : -w_.distance_[i];
+      ground_.lateral[i] = cross >= 0 ? ground_.distance[i] : -ground_.distance[i];
     }
   }
 }
@@ -168,10 +165,10 @@ void WorldBuilder::side_of_path(const std::vector<std::int32_t>& source, const s
 // above this ground (World::sensor_origin).
 void WorldBuilder::ground_heights(const std::vector<std::int32_t>& source, const std::vector<Eigen::Vector3d>& centres) {
   const std::size_t n = source.size();
-  w_.height_.resize(n);
-  for (std::size_t i = 0; i < n; ++i) w_.height_[i] = static_cast<float>(centres[static_cast<std::size_t>(source[i])].z());
-  box_blur(w_.height_, 4);
-  box_blur(w_.height_, 4);
+  ground_.height.resize(n);
+  for (std::size_t i = 0; i < n; ++i) ground_.height[i] = static_cast<float>(centres[static_cast<std::size_t>(source[i])].z());
+  box_blur(ground_.height, 4);
+  box_blur(ground_.height, 4);
 }
 
 World::Zone WorldBuilder::street_layout(const Eigen::Vector2d& c) const {
@@ -211,15 +208,15 @@ float WorldBuilder::bump_at(const Eigen::Vector2d& c) const {
 }
 
 void WorldBuilder::street_zones_and_bumps() {
-  const std::size_t n = w_.distance_.size();
-  w_.zones_.resize(n);
-  w_.bump_.resize(n);
-  for (int iy = 0; iy < w_.ny_; ++iy) {
-    for (int ix = 0; ix < w_.nx_; ++ix) {
+  const std::size_t n = ground_.distance.size();
+  ground_.zones.resize(n);
+  ground_.bump.resize(n);
+  for (int iy = 0; iy < ground_.ny; ++iy) {
+    for (int ix = 0; ix < ground_.nx; ++ix) {
       const Eigen::Vector2d c = cell_centre(ix, iy);
       const std::size_t i = cell(ix, iy);
-      w_.zones_[i] = street_layout(c);
-      w_.bump_[i] = bump_at(c);
+      ground_.zones[i] = street_layout(c);
+      ground_.bump[i] = bump_at(c);
     }
   }
 }
@@ -234,56 +231,56 @@ void WorldBuilder::street_zones_and_bumps() {
 // into it.
 void WorldBuilder::bound_ground_rise() {
   const int tile = World::kRiseTile;
-  w_.rise_nx_ = (w_.nx_ + tile - 1) / tile;
-  w_.rise_ny_ = (w_.ny_ + tile - 1) / tile;
-  const std::size_t tiles = static_cast<std::size_t>(w_.rise_nx_) * static_cast<std::size_t>(w_.rise_ny_);
-  w_.ground_rise_.assign(tiles, 0.0f);
+  ground_.rise_nx = (ground_.nx + tile - 1) / tile;
+  ground_.rise_ny = (ground_.ny + tile - 1) / tile;
+  const std::size_t tiles = static_cast<std::size_t>(ground_.rise_nx) * static_cast<std::size_t>(ground_.rise_ny);
+  ground_.rise.assign(tiles, 0.0f);
   // Highest raster height and bump reaching into each tile: the ground
   // (World::ground_from) is at most their sum plus the curb.
   std::vector<float> top_height(tiles, -std::numeric_limits<float>::infinity()), top_bump(tiles, 0.0f);
-  for (int iy = 0; iy < w_.ny_; ++iy) {
-    for (int ix = 0; ix < w_.nx_; ++ix) {
+  for (int iy = 0; iy < ground_.ny; ++iy) {
+    for (int ix = 0; ix < ground_.nx; ++ix) {
       const std::size_t i = cell(ix, iy);
       float step_height = 0.0f, step_bump = 0.0f;
-      for (const std::size_t j : {ix + 1 < w_.nx_ ? cell(ix + 1, iy) : i, iy + 1 < w_.ny_ ? cell(ix, iy + 1) : i}) {
-        step_height = std::max(step_height, std::abs(w_.height_[j] - w_.height_[i]));
-        step_bump = std::max(step_bump, std::abs(w_.bump_[j] - w_.bump_[i]));
+      for (const std::size_t j : {ix + 1 < ground_.nx ? cell(ix + 1, iy) : i, iy + 1 < ground_.ny ? cell(ix, iy + 1) : i}) {
+        step_height = std::max(step_height, std::abs(ground_.height[j] - ground_.height[i]));
+        step_bump = std::max(step_bump, std::abs(ground_.bump[j] - ground_.bump[i]));
       }
-      const float rise = static_cast<float>(2.0 * (step_height + step_bump) / w_.options_.ground_cell +
-                                            std::abs(w_.bump_[i]) / 12.0 + 1e-3);
+      const float rise = static_cast<float>(2.0 * (step_height + step_bump) / options_.ground_cell +
+                                            std::abs(ground_.bump[i]) / 12.0 + 1e-3);
       // The node's patches span [ix - 1, ix + 1]: every tile they reach.
-      for (int ty = std::max(0, iy - 1) / tile; ty <= std::min(w_.ny_ - 1, iy + 1) / tile; ++ty) {
-        for (int tx = std::max(0, ix - 1) / tile; tx <= std::min(w_.nx_ - 1, ix + 1) / tile; ++tx) {
-          const std::size_t t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(w_.rise_nx_) + static_cast<std::size_t>(tx);
-          w_.ground_rise_[t] = std::max(w_.ground_rise_[t], rise);
-          top_height[t] = std::max(top_height[t], w_.height_[i]);
-          top_bump[t] = std::max(top_bump[t], w_.bump_[i]);
+      for (int ty = std::max(0, iy - 1) / tile; ty <= std::min(ground_.ny - 1, iy + 1) / tile; ++ty) {
+        for (int tx = std::max(0, ix - 1) / tile; tx <= std::min(ground_.nx - 1, ix + 1) / tile; ++tx) {
+          const std::size_t t = static_cast<std::size_t>(ty) * static_cast<std::size_t>(ground_.rise_nx) + static_cast<std::size_t>(tx);
+          ground_.rise[t] = std::max(ground_.rise[t], rise);
+          top_height[t] = std::max(top_height[t], ground_.height[i]);
+          top_bump[t] = std::max(top_bump[t], ground_.bump[i]);
         }
       }
     }
   }
-  w_.ground_top_.resize(tiles);
+  ground_.top.resize(tiles);
   for (std::size_t t = 0; t < tiles; ++t) {
-    w_.ground_top_[t] = static_cast<float>(top_height[t] + std::max(World::kCurbHeight, World::kParkingRise) + top_bump[t] + 1e-3);
+    ground_.top[t] = static_cast<float>(top_height[t] + std::max(World::kCurbHeight, World::kParkingRise) + top_bump[t] + 1e-3);
   }
 }
 
 void WorldBuilder::add_side_streets(std::vector<Eigen::Vector3d>& centres, std::vector<Eigen::Vector2d>& dirs) {
   Rng rng(hash_combine(seed_, kSaltRoad + 7));
   PointSet junctions;
-  const double len = w_.path_length();
+  const double len = path_.length();
   for (double s = rng.uniform(20, 80); s < len - 10; s += rng.uniform(100, 250)) {
     Eigen::Vector3d pos;
     Eigen::Vector2d dir;
-    w_.path_point(s, pos, dir);
+    path_.point(s, pos, dir);
     // Not on open land, and one junction per place even where the path passes twice.
     if (noise_at(hash_combine(seed_, kSaltRural), pos.x(), pos.y(), 260.0) > kRuralNoise) continue;
     if (!far_from(junctions, pos.head<2>(), 50.0)) continue;
     // Only on straight stretches: a side street off a bend would run askew.
     Eigen::Vector3d before, after;
     Eigen::Vector2d dir_before, dir_after;
-    w_.path_point(s - 15.0, before, dir_before);
-    w_.path_point(s + 15.0, after, dir_after);
+    path_.point(s - 15.0, before, dir_before);
+    path_.point(s + 15.0, after, dir_after);
     if (dir_before.dot(dir_after) < std::cos(0.25)) continue;
     junctions.push_back(pos.head<2>());
     const Eigen::Vector2d left(-dir.y(), dir.x());
@@ -306,7 +303,7 @@ void WorldBuilder::add_side_streets(std::vector<Eigen::Vector3d>& centres, std::
 // Separable box filter with running sums (O(n) whatever the radius); the
 // window is clipped at the raster border.
 void WorldBuilder::box_blur(std::vector<float>& f, int radius) const {
-  const int nx = w_.nx_, ny = w_.ny_;
+  const int nx = ground_.nx, ny = ground_.ny;
   std::vector<float> tmp(f.size());
   std::vector<double> line;
   auto blur_line = [&](int count, auto&& get, auto&& set) {

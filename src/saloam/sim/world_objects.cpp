@@ -18,7 +18,7 @@ void WorldBuilder::place_parked_vehicles(double total_time) {
     Rng rng(hash3(seed_, kSaltCars, static_cast<std::uint64_t>(side + 5)));
     walk(rng.uniform(0, 5), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
-      const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
+      const World::Zone z = w_->zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
       if (z.parking <= 0 && z.curb_parking <= 0) return 3.0;
       const double pick = rng.uniform();
       std::uint16_t label = cls::kCar;
@@ -92,8 +92,8 @@ void WorldBuilder::add_vehicle(const Eigen::Vector2d& c, const Eigen::Vector2d& 
       body.time_on = cabin.time_on = t_switch;
     }
   }
-  w_.primitives_.push_back(body);
-  w_.primitives_.push_back(cabin);
+  w_->add_object(body);
+  w_->add_object(cabin);
 }
 
 void WorldBuilder::place_street_furniture() {
@@ -102,7 +102,7 @@ void WorldBuilder::place_street_furniture() {
     Rng rng(hash3(seed_, kSaltPoles, static_cast<std::uint64_t>(side + 5)));
     walk(rng.uniform(0, 20), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
-      const World::Zone z = w_.zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
+      const World::Zone z = w_->zone_at(p.x() + side * left.x() * 6, p.y() + side * left.y() * 6);
       const double off = z.road(side) + z.parking + (z.sidewalk > 0 ? 0.45 : 1.2);
       const Eigen::Vector2d c = p + side * left * off;
       if (!far_from(poles_, c, 9.0) || !disc_free(c, 0.3, 0.25)) return 3.0;
@@ -112,16 +112,16 @@ void WorldBuilder::place_street_furniture() {
         const double radius = rng.uniform(0.09, 0.14);
         const double h = rng.uniform(6, 9);
         const Primitive pole = cylinder(cls::kPole, c, radius, g, g + h, rng.uniform(0.25, 0.45));
-        w_.primitives_.push_back(pole);
+        w_->add_object(pole);
         const Eigen::Vector2d arm_c = c - side * left * 0.9;
-        w_.primitives_.push_back(box(cls::kPole, arm_c, left, 0.9, 0.07, g + h - 0.15, g + h, pole.remission));
+        w_->add_object(box(cls::kPole, arm_c, left, 0.9, 0.07, g + h - 0.15, g + h, pole.remission));
       } else {  // traffic sign on a thin post, the plate facing traffic
         const double radius = rng.uniform(0.04, 0.06);
         const double h = rng.uniform(2.0, 2.8);
-        w_.primitives_.push_back(cylinder(cls::kPole, c, radius, g, g + h, 0.35));
+        w_->add_object(cylinder(cls::kPole, c, radius, g, g + h, 0.35));
         const double plate = rng.uniform(0.3, 0.45);
         Primitive sign = box(cls::kTrafficSign, c, dir, 0.025, plate, g + h, g + h + 2 * plate, rng.uniform(0.75, 0.95));
-        w_.primitives_.push_back(sign);
+        w_->add_object(sign);
       }
       poles_.push_back(c);
       mark_rect(c, dir, 0.3, 0.3);
@@ -141,13 +141,13 @@ void WorldBuilder::place_structures() {
     if (rng.chance(0.5)) {  // bus shelter / kiosk
       if (!rect_free(c, dir, 2.0, 1.0, 0.1, false)) return 10.0;
       Primitive shelter = box(cls::kOtherStructure, c, dir, 1.8, 0.8, g + 2.1, g + 2.4, 0.3);
-      w_.primitives_.push_back(shelter);
-      w_.primitives_.push_back(box(cls::kOtherStructure, c + side * left * 0.75, dir, 1.8, 0.05, g, g + 2.1, 0.5));
+      w_->add_object(shelter);
+      w_->add_object(box(cls::kOtherStructure, c + side * left * 0.75, dir, 1.8, 0.05, g, g + 2.1, 0.5));
       mark_rect(c, dir, 2.0, 1.0);
     } else {  // low wall
       const double half = rng.uniform(3, 10);
       if (!rect_free(c, dir, half, 0.3, 0.1, false)) return 10.0;
-      w_.primitives_.push_back(box(cls::kOtherStructure, c, dir, half, 0.15, g - 0.1, g + rng.uniform(0.5, 1.2), 0.35));
+      w_->add_object(box(cls::kOtherStructure, c, dir, half, 0.15, g - 0.1, g + rng.uniform(0.5, 1.2), 0.35));
       mark_rect(c, dir, half, 0.3);
     }
     return rng.uniform(120, 300);
@@ -155,7 +155,7 @@ void WorldBuilder::place_structures() {
 }
 
 void WorldBuilder::place_agents(double total_time) {
-  if (!w_.options_.dynamic_objects) return;
+  if (!options_.dynamic_objects) return;
   Rng rng(hash_combine(seed_, kSaltAgents));
   std::uint16_t inst = 1000;
   // Oncoming cars in the left lane, each meeting the ego at some time.
@@ -164,13 +164,13 @@ void WorldBuilder::place_agents(double total_time) {
     a.label = cls::kMovingCar;
     a.instance = inst++;
     a.t_ref = t;
-    a.s_ref = w_.ego_arc_length(t);
+    a.s_ref = w_->ego_arc_length(t);
     a.speed = -rng.uniform(7, 13);
     a.lateral = rng.uniform(2.9, 3.2);  // the oncoming lane, clear of cars parked at its curb
     a.t_begin = t - 15;
     a.t_end = t + 15;
     vehicle_dims(a, rng);
-    w_.agents_.push_back(a);
+    w_->add_agent(a);
   }
   // A car ahead in the ego lane, now and then, plus one that overtakes on the left rarely.
   for (double t = rng.uniform(0, 10); t < total_time; t += rng.uniform(30, 70)) {
@@ -186,7 +186,7 @@ void WorldBuilder::place_agents(double total_time) {
     a.t_begin = t;
     a.t_end = t + rng.uniform(15, 35);
     vehicle_dims(a, rng);
-    w_.agents_.push_back(a);
+    w_->add_agent(a);
   }
   // Pedestrians on the sidewalks, walking either way.
   for (double t = rng.uniform(0, 4); t < total_time; t += rng.uniform(2, 7)) {
@@ -194,7 +194,7 @@ void WorldBuilder::place_agents(double total_time) {
     a.label = cls::kMovingPerson;
     a.instance = inst++;
     a.t_ref = t;
-    a.s_ref = w_.ego_arc_length(t) + rng.uniform(-10, 30);
+    a.s_ref = w_->ego_arc_length(t) + rng.uniform(-10, 30);
     a.speed = (rng.chance(0.5) ? 1 : -1) * rng.uniform(1.0, 1.6);
     a.sidewalk_side = rng.chance(0.5) ? 1 : -1;
     a.t_begin = t - 25;
@@ -203,7 +203,7 @@ void WorldBuilder::place_agents(double total_time) {
     a.height = static_cast<float>(rng.uniform(1.6, 1.9));
     a.remission = static_cast<float>(rng.uniform(0.15, 0.4));
     a.gap_phase = rng.uniform(0, 2 * kPi);
-    w_.agents_.push_back(a);
+    w_->add_agent(a);
   }
 }
 

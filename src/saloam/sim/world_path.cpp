@@ -16,33 +16,37 @@ constexpr double kPi = 3.14159265358979323846;
 }  // namespace
 
 double World::ego_arc_length(double t) const {
-  if (ego_s_.empty()) return 0.0;
+  if (path_.ego_s.empty()) return 0.0;
   const double f = t / options_.frame_period;
-  if (f <= 0) return ego_s_.front();
+  if (f <= 0) return path_.ego_s.front();
   const auto i = static_cast<std::size_t>(f);
-  if (i + 1 >= ego_s_.size()) return ego_s_.back();
+  if (i + 1 >= path_.ego_s.size()) return path_.ego_s.back();
   const double a = f - static_cast<double>(i);
-  return ego_s_[i] + a * (ego_s_[i + 1] - ego_s_[i]);
+  return path_.ego_s[i] + a * (path_.ego_s[i + 1] - path_.ego_s[i]);
 }
 
-void World::path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const {
-  if (path_.size() < 2) {
-    position = path_.empty() ? Eigen::Vector3d::Zero() : path_.front();
+void WorldPath::point(double at, Eigen::Vector3d& position, Eigen::Vector2d& direction) const {
+  if (points.size() < 2) {
+    position = points.empty() ? Eigen::Vector3d::Zero() : points.front();
     direction = {1, 0};
     return;
   }
-  s = std::clamp(s, 0.0, path_s_.back());
-  auto it = std::upper_bound(path_s_.begin(), path_s_.end(), s);
-  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, it - path_s_.begin())) - 1;
-  i = std::min(i, path_.size() - 2);
-  const double len = path_s_[i + 1] - path_s_[i];
-  const double a = len > 1e-9 ? (s - path_s_[i]) / len : 0.0;
-  position = path_[i] + a * (path_[i + 1] - path_[i]);
+  at = std::clamp(at, 0.0, s.back());
+  auto it = std::upper_bound(s.begin(), s.end(), at);
+  std::size_t i = static_cast<std::size_t>(std::max<std::ptrdiff_t>(1, it - s.begin())) - 1;
+  i = std::min(i, points.size() - 2);
+  const double len = s[i + 1] - s[i];
+  const double a = len > 1e-9 ? (at - s[i]) / len : 0.0;
+  position = points[i] + a * (points[i + 1] - points[i]);
   // Direction smoothed over a few metres so cars do not jitter at kinks.
-  const std::size_t i0 = i >= 3 ? i - 3 : 0, i1 = std::min(path_.size() - 1, i + 4);
-  direction = (path_[i1] - path_[i0]).head<2>();
+  const std::size_t i0 = i >= 3 ? i - 3 : 0, i1 = std::min(points.size() - 1, i + 4);
+  direction = (points[i1] - points[i0]).head<2>();
   if (direction.norm() < 1e-9) direction = {1, 0};
   direction.normalize();
+}
+
+void World::path_point(double s, Eigen::Vector3d& position, Eigen::Vector2d& direction) const {
+  path_.point(s, position, direction);
 }
 
 void World::agents_at(double t, const Eigen::Vector2d& near, double radius, std::vector<Primitive>& out) const {

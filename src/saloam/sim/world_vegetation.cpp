@@ -26,7 +26,7 @@ void WorldBuilder::place_street_trees() {
     walk(rng.uniform(0, 10), [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
       const Eigen::Vector2d left(-dir.y(), dir.x());
       const Eigen::Vector2d probe = p + side * left * 7.0;
-      const World::Zone z = w_.zone_at(probe.x(), probe.y());
+      const World::Zone z = w_->zone_at(probe.x(), probe.y());
       const double edge = z.road(side) + z.parking + z.sidewalk;
       const bool rural = z.sidewalk == 0;
       // Tree rows along the verge; rural land gets more and bigger trees, further out too.
@@ -53,13 +53,13 @@ void WorldBuilder::scatter_trees() {
   Rng rng(hash_combine(seed_, kSaltTrees + 50));
   walk(0.0, [&](const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) -> double {
     const Eigen::Vector2d left(-dir.y(), dir.x());
-    const bool rural_here = w_.zone_at(p.x(), p.y()).sidewalk == 0;
+    const bool rural_here = w_->zone_at(p.x(), p.y()).sidewalk == 0;
     for (int k = 0; k < (rural_here ? 90 : 70); ++k) {
       const int side = rng.chance(0.5) ? -1 : 1;
       const Eigen::Vector2d c = p + side * left * rng.uniform(5, 60) + dir * rng.uniform(-5, 5);
       if (!inside_grid(c)) continue;
-      const World::Zone zc = w_.zone_at(c.x(), c.y());
-      if (w_.road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 2) continue;
+      const World::Zone zc = w_->zone_at(c.x(), c.y());
+      if (w_->road_margin(c.x(), c.y()) < zc.parking + zc.sidewalk + 2) continue;
       const double pick = rng.uniform();
       if (pick < 0.55) {  // shrubs and tall weeds covering part of the grass
         const double rx = rng.uniform(2.0, 6.0), ry = rx * rng.uniform(0.5, 1.0);
@@ -95,7 +95,7 @@ void WorldBuilder::plant_verges() {
       const double half_w = rng.uniform(0.4, 1.2);
       const Eigen::Vector2d probe = p + side * left * 7.0;
       const double edge = street_edge(probe, side);
-      const bool rural = w_.zone_at(probe.x(), probe.y()).sidewalk == 0;
+      const bool rural = w_->zone_at(probe.x(), probe.y()).sidewalk == 0;
       const double gap = line_gap(rural);
       const Eigen::Vector2d c = p + half_length * dir + side * left * (edge + gap + half_w);
       if (!rect_free(c, dir, half_length, half_w, kLineClearance, false)) return 0.5;
@@ -103,7 +103,7 @@ void WorldBuilder::plant_verges() {
       const double height = 0.5 + 1.3 * noise_at(hash_combine(seed_, kSaltVerges), c.x(), c.y(), 12.0) + rng.uniform(0.0, 0.3);
       Primitive bed = box(cls::kVegetation, c, dir, half_length, half_w, g - 0.1, g + height, rng.uniform(0.35, 0.5));
       bed.mean_free_path = static_cast<float>(rng.uniform(0.25, 0.5));
-      w_.primitives_.push_back(bed);
+      w_->add_object(bed);
       mark_rect(c, dir, half_length, half_w);
       return 2 * half_length;
     });
@@ -116,7 +116,7 @@ void WorldBuilder::add_tree(const Eigen::Vector2d& c, double crown, Rng& rng) {
   // limes, fruit trees): the near-horizontal beams meet the foliage.
   const double trunk_h = rng.uniform(1.2, 2.4);
   const double radius = rng.uniform(0.1, 0.25);
-  w_.primitives_.push_back(cylinder(cls::kTrunk, c, radius, g, g + trunk_h + crown * 0.8, rng.uniform(0.25, 0.4)));
+  w_->add_object(cylinder(cls::kTrunk, c, radius, g, g + trunk_h + crown * 0.8, rng.uniform(0.25, 0.4)));
   const double rz = crown * rng.uniform(0.8, 1.4);
   Primitive leaves;
   leaves.shape = Shape::kEllipsoid;
@@ -131,7 +131,7 @@ void WorldBuilder::add_tree(const Eigen::Vector2d& c, double crown, Rng& rng) {
   leaves.z_max = static_cast<float>(g + trunk_h + 2 * rz);
   leaves.remission = static_cast<float>(rng.uniform(0.35, 0.55));
   leaves.mean_free_path = static_cast<float>(rng.uniform(0.4, 0.9));
-  w_.primitives_.push_back(leaves);
+  w_->add_object(leaves);
 }
 
 void WorldBuilder::add_shrub_patch(const Eigen::Vector2d& c, const Eigen::Vector2d& axis, double rx, double ry, double height, Rng& rng) {
@@ -148,7 +148,7 @@ void WorldBuilder::add_shrub_patch(const Eigen::Vector2d& c, const Eigen::Vector
   b.z_max = static_cast<float>(g + height);
   b.remission = static_cast<float>(rng.uniform(0.35, 0.55));
   b.mean_free_path = 0.35f;
-  w_.primitives_.push_back(b);
+  w_->add_object(b);
 }
 
 void WorldBuilder::add_bush(const Eigen::Vector2d& c, double r, Rng& rng) {
@@ -163,7 +163,7 @@ void WorldBuilder::add_bush(const Eigen::Vector2d& c, double r, Rng& rng) {
   b.z_max = static_cast<float>(g + r * rng.uniform(1.0, 1.6));
   b.remission = static_cast<float>(rng.uniform(0.35, 0.55));
   b.mean_free_path = 0.3f;
-  w_.primitives_.push_back(b);
+  w_->add_object(b);
 }
 
 }  // namespace saloam
