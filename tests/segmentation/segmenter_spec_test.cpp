@@ -88,6 +88,29 @@ TEST(SegmenterSpec, ReadsASegNetDescriptionAndWritesItBack) {
   EXPECT_EQ(again.knn.window, spec.knn.window);
 }
 
+TEST(SegmenterSpec, TheDynamicBiasOffsetsTheDynamicClassesOnly) {
+  const SegmenterSpec plain = parse_segmenter_spec(kRangeNet, "/models/m.yaml");
+  EXPECT_EQ(plain.dynamic_bias, 0.0);
+  EXPECT_TRUE(decision_offsets(plain).empty()) << "no bias: the plain argmax";
+
+  const SegmenterSpec biased = parse_segmenter_spec(std::string(kRangeNet) + "decision: {dynamic_bias: 1.5}\n", "/models/m.yaml");
+  EXPECT_DOUBLE_EQ(biased.dynamic_bias, 1.5);
+  const auto offsets = decision_offsets(biased);
+  ASSERT_EQ(offsets.size(), biased.classes.size());
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    const bool dynamic = biased.classes[k] == cls::kPerson || biased.classes[k] == cls::kBicyclist ||
+                         biased.classes[k] == cls::kMotorcyclist;
+    EXPECT_EQ(offsets[k], dynamic ? 1.5f : 0.0f) << class_name(biased.classes[k]);
+  }
+  const SegmenterSpec again = parse_segmenter_spec(segmenter_spec_yaml(biased, "/models"), "/models/m.yaml");
+  EXPECT_DOUBLE_EQ(again.dynamic_bias, 1.5);
+
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {dynamic_bias: -1}\n").find("decision.dynamic_bias: -1 is outside"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {static_bias: 1}\n").find("decision.static_bias: unknown key"),
+            std::string::npos);
+}
+
 TEST(SegmenterSpec, ErrorsNameTheFileAndTheKey) {
   EXPECT_NE(error_of("format: other 2\n").find("/models/m.yaml: format: expected 'saloam-segmenter 1'"), std::string::npos);
   EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 1024\n  colums: 3")).find("projection.colums: unknown key"),

@@ -6,6 +6,7 @@
 
 #include <torch/script.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -174,6 +175,20 @@ TEST(SegmenterPlugin, RunsATorchScriptNetworkWithItsDescription) {
     agree += labels[i] == (cloud.points[i].norm() < 10.0f ? cls::kCar : cls::kRoad);
   // The vote may move points within a metre of the 10 m boundary.
   EXPECT_GE(static_cast<double>(agree), 0.98 * static_cast<double>(cloud.size()));
+}
+
+TEST(SegmenterPlugin, TheDynamicBiasTipsOnlyCloseCallsToDynamicClasses) {
+  testing::TempDir dir;
+  write_torchscript_rule(dir / "rule.pt", 20);  // logits 1 for car or road, 0 for every other class
+  const LabelledCloud& cloud = scans().front();
+  auto share_of_persons = [&](const std::string& decision) {
+    write_rangenet_description(dir / "rule.yaml", "rule.pt");
+    std::ofstream(dir / "rule.yaml", std::ios::app) << decision;
+    const auto labels = Segmenter(read_segmenter_spec(dir / "rule.yaml"), kPlugin).labels(cloud);
+    return static_cast<double>(std::count(labels.begin(), labels.end(), cls::kPerson)) / static_cast<double>(labels.size());
+  };
+  EXPECT_EQ(share_of_persons("decision: {dynamic_bias: 0.5}\n"), 0.0) << "a margin of 1 is not a close call at 0.5";
+  EXPECT_EQ(share_of_persons("decision: {dynamic_bias: 2}\n"), 1.0) << "person is the first dynamic class";
 }
 
 TEST(SegmenterPlugin, BrokenModelsAreErrorsNamingTheFile) {

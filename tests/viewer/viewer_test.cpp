@@ -271,13 +271,13 @@ TEST(Viewer, ServerAnswersOnlyToLoopbackHostNames) {
   ServingRun serving;
   const int port = serving.port;
   httplib::Client client("127.0.0.1", port);
-  for (const std::string host : {fmt::format("127.0.0.1:{}", port), fmt::format("localhost:{}", port),
+  for (const std::string& host : {fmt::format("127.0.0.1:{}", port), fmt::format("localhost:{}", port),
                                  fmt::format("LocalHost:{}", port), fmt::format("[::1]:{}", port)}) {
     const auto answer = client.Get("/map.bin", {{"Host", host}});
     ASSERT_TRUE(answer) << host;
     EXPECT_EQ(answer->status, 200) << host;
   }
-  for (const std::string host : {fmt::format("evil.example:{}", port), std::string("evil.example"),
+  for (const std::string& host : {fmt::format("evil.example:{}", port), std::string("evil.example"),
                                  std::string("127.0.0.1"), fmt::format("127.0.0.1:{}", port + 1),
                                  fmt::format("127.0.0.1.evil.example:{}", port), fmt::format("x127.0.0.1:{}", port),
                                  std::string("")}) {

@@ -49,6 +49,7 @@ Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optio
       tracking_(RegistrationSettings::from_config(config.odometry)) {
   tracking_.parallel = false;
   tracking_.inlier_distance = config.loop.inlier_distance;
+  tracking_.level_line_max_rise = 0;  // as the verification's fits (LoopVerificationSettings)
   switch (places_.detector()) {
     case PlaceDetector::kSgpr: score_threshold_ = config.loop.zeta; break;
     case PlaceDetector::kSsc: score_threshold_ = config.loop.ssc_zeta; break;

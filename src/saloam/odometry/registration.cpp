@@ -22,6 +22,7 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
   s.reassociation_min_translation = config.reassociation_min_translation;
   s.reassociation_min_rotation = config.reassociation_min_rotation_deg * M_PI / 180.0;
   s.plane_normal_tolerance = config.plane_normal_tolerance;
+  s.level_line_max_rise = config.use_semantics ? config.level_line_max_rise : 0.0;
   s.class_weight = class_weights(config);
   for (int c = 0; c < kNumClassIndices; ++c) {
     s.orientation[c] = config.use_semantics
@@ -47,6 +48,10 @@ constexpr int kMaxNeighbours = kMaxFitNeighbours;
 struct EdgeMatch {
   Line line;
   bool valid = false;
+  /// A level line (RegistrationSettings::level_line_max_rise): matched as
+  /// `across`, the vertical plane through it, instead of as a line.
+  bool level = false;
+  Plane across;
 };
 struct PlaneMatch {
   Plane plane;
@@ -128,6 +133,12 @@ void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const 
     visit_matched(
         i, edge_matches, plane_matches,
         [&](std::size_t e) {
+          if (edge_matches[e].level) {
+            Eigen::Matrix<double, 1, 6> J;
+            const double r = point_to_plane_residual(T, edges.points[e], edge_matches[e].across, &J);
+            add(std::abs(r), edges.classes[e], 1.0, J);
+            return;
+          }
           Eigen::Matrix<double, 3, 6> J;
           const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
           add(r.norm(), edges.classes[e], 2.0, J);
@@ -163,6 +174,11 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
       if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
         m.line = *line;
         m.valid = true;
+        // d x z is horizontal and across d; it vanishes only for an upright line.
+        if (std::abs(m.line.direction.z()) < settings.level_line_max_rise) {
+          m.level = true;
+          m.across = Plane{m.line.point, m.line.direction.cross(Eigen::Vector3d::UnitZ()).normalized()};
+        }
       }
     }
     edge_matches[i] = m;
@@ -218,6 +234,14 @@ NormalEquations normal_equations(const FeatureCloud& edges, const FeatureCloud& 
     visit_matched(
         i, edge_matches, plane_matches,
         [&](std::size_t e) {
+          if (edge_matches[e].level) {
+            Eigen::Matrix<double, 1, 6> J;
+            const double r = point_to_plane_residual(T, edges.points[e], edge_matches[e].across, &J);
+            const double w = settings.class_weight[edges.classes[e]] * huber_weight(r, k);
+            sum.H.noalias() += w * J.transpose() * J;
+            sum.g.noalias() += (w * r) * J.transpose();
+            return;
+          }
           Eigen::Matrix<double, 3, 6> J;
           const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
           const double w = settings.class_weight[edges.classes[e]] * huber_weight(r.norm(), k);

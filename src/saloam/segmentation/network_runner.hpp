@@ -42,6 +42,10 @@ struct NetworkSpec {
   NetworkFormat format = NetworkFormat::kSegNet;
   std::string weights;  ///< the file with the network
   SegNetShape shape;    ///< kSegNet: the architecture; kTorchScript: in_channels and classes are checked
+  /// Added to each output class's logit before the argmax (empty: nothing;
+  /// else one per class): a decision that weighs one kind of error more than
+  /// another (SegmenterSpec::dynamic_bias).
+  std::vector<float> logit_offsets;
 };
 
 /// One loaded network. classify() is called from one thread at a time per
@@ -50,8 +54,8 @@ struct NetworkSpec {
 class NetworkRunner {
  public:
   virtual ~NetworkRunner() = default;
-  /// Class of each pixel (argmax of the logits over classes 1..K-1: class 0,
-  /// unlabeled, is never predicted) of a C x rows x cols image (channel-major
+  /// Class of each pixel (argmax of the logits plus the spec's offsets over
+  /// classes 1..K-1: class 0, unlabeled, is never predicted) of a C x rows x cols image (channel-major
   /// floats). Throws std::runtime_error with a short reason (shapes that do
   /// not fit, a network that fails).
   virtual std::vector<std::int16_t> classify(const std::vector<float>& image, int channels, int rows,

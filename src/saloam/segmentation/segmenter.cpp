@@ -138,6 +138,7 @@ Segmenter::Segmenter(SegmenterSpec spec, const fs::path& plugin, FeatureConfig r
     : spec_(std::move(spec)), ring_config_(std::move(rings)) {
   const OpenNetwork open = plugin_entry(plugin);
   require_file(spec_.network.weights, fmt::format("network (named by {})", spec_.file.string()));
+  spec_.network.logit_offsets = decision_offsets(spec_);
   std::string error;
   runner_.reset(open(spec_.network, error));
   if (!runner_) throw InputError(spec_.network.weights, error + fmt::format(" (described by {})", spec_.file.string()));

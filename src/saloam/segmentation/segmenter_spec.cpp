@@ -206,7 +206,7 @@ SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& o
                                          documents.size()));
   }
   const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
-  const MapReader r(root, "", origin, {"format", "network", "projection", "classes", "knn"});
+  const MapReader r(root, "", origin, {"format", "network", "projection", "classes", "knn", "decision"});
   if (r.text("format") != kSegmenterFormat)
     r.fail("format", fmt::format("expected '{}'", kSegmenterFormat));
   SegmenterSpec spec;
@@ -215,9 +215,20 @@ SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& o
   read_projection(r.node("projection"), origin, spec);
   spec.classes = read_classes(r.node("classes"), origin);
   spec.knn = read_knn(r.node("knn"), origin);
+  if (r.has("decision")) {
+    const MapReader d(r.node("decision"), "decision", origin, {"dynamic_bias"});
+    spec.dynamic_bias = d.number("dynamic_bias", 0.0, 20.0);
+  }
   spec.network.shape.in_channels = static_cast<int>(spec.projection.channels.size());
   spec.network.shape.classes = static_cast<int>(spec.classes.size());
   return spec;
+}
+
+std::vector<float> decision_offsets(const SegmenterSpec& spec) {
+  if (spec.dynamic_bias == 0.0) return {};
+  std::vector<float> offsets;
+  for (const auto id : spec.classes) offsets.push_back(is_dynamic(id) ? static_cast<float>(spec.dynamic_bias) : 0.0f);
+  return offsets;
 }
 
 SegmenterSpec read_segmenter_spec(const fs::path& file) { return parse_segmenter_spec(read_limited(file), file); }
@@ -261,7 +272,12 @@ std::string segmenter_spec_yaml(const SegmenterSpec& spec, const fs::path& folde
   out << YAML::Key << "knn" << YAML::Value << YAML::Flow << YAML::BeginMap;
   out << YAML::Key << "k" << YAML::Value << spec.knn.k << YAML::Key << "window" << YAML::Value << spec.knn.window;
   out << YAML::Key << "cutoff" << YAML::Value << spec.knn.cutoff << YAML::Key << "sigma" << YAML::Value << spec.knn.sigma;
-  out << YAML::EndMap << YAML::EndMap;
+  out << YAML::EndMap;
+  if (spec.dynamic_bias != 0.0) {
+    out << YAML::Key << "decision" << YAML::Value << YAML::Flow << YAML::BeginMap;
+    out << YAML::Key << "dynamic_bias" << YAML::Value << spec.dynamic_bias << YAML::EndMap;
+  }
+  out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";
 }
 

@@ -19,6 +19,7 @@
 //     stds: [...]               # one per channel, > 0
 //   classes: semantickitti | [unlabeled, car, ...]   # output index -> class name
 //   knn: {k: 5, window: 5, cutoff: 1.0, sigma: 1.0}
+//   decision: {dynamic_bias: 0.0}   # optional
 //
 // Every value is range-checked; an error names the file and the key.
 
@@ -43,7 +44,18 @@ struct SegmenterSpec {
   std::vector<int> beams;           ///< RowMode::kRing: the beam counts (image rows) the model accepts
   std::vector<std::uint16_t> classes;  ///< network output index -> raw SemanticKITTI id
   KnnOptions knn;
+  /// Added to the logits of the dynamic classes (person, bicyclist,
+  /// motorcyclist and the moving-* ones, which the odometry drops) before
+  /// the argmax. The odometry's costs are not symmetric: a walking person
+  /// called a pole becomes a pole axis that moves and pulls the scans with
+  /// it, while a pole called a person only loses one constraint; a bias > 0
+  /// is the decision that weighs the first error more (docs/segmentation.md).
+  double dynamic_bias = 0.0;
 };
+
+/// One offset per output class of `spec` (the dynamic ones get
+/// spec.dynamic_bias), or none when the bias is 0: NetworkSpec::logit_offsets.
+std::vector<float> decision_offsets(const SegmenterSpec& spec);
 
 /// The 20 SemanticKITTI training classes in their learning order (0 =
 /// unlabeled, 1 = car, ..., 19 = traffic-sign), as RangeNet++ and SalsaNext output them.

@@ -46,6 +46,9 @@ LoopVerificationSettings LoopVerificationSettings::from_config(const SaloamConfi
   s.fine.inlier_distance = config.loop.inlier_distance;
   // A loop's fit is judged for degeneracy (min_translation_eigenvalue), not held at its guess.
   s.fine.degeneracy_eigenvalue = 0;
+  // Level lines are the odometry's rule: a loop's fit is judged by inlier
+  // and residual thresholds measured with every edge matched to its line.
+  s.fine.level_line_max_rise = 0;
   s.coarse = s.fine;
   s.coarse.max_correspondence_distance = kCoarseDistance;
   s.coarse.robust_kernel_scale = kCoarseKernel;

@@ -144,8 +144,15 @@ torch::Tensor image_tensor(const std::vector<float>& image, int channels, int ro
       .contiguous(torch::MemoryFormat::ChannelsLast);
 }
 
-std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits) {
-  const auto best = (pixel_logits.squeeze(0).slice(2, 1).argmax(2) + 1).to(torch::kInt16).contiguous();
+std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits, const std::vector<float>& offsets) {
+  torch::Tensor logits = pixel_logits.squeeze(0);
+  if (!offsets.empty()) {
+    if (static_cast<int64_t>(offsets.size()) != logits.size(2))
+      throw std::runtime_error("logit offsets for " + std::to_string(offsets.size()) + " classes, the network has " +
+                               std::to_string(logits.size(2)));
+    logits = logits + torch::tensor(offsets, torch::kFloat32);
+  }
+  const auto best = (logits.slice(2, 1).argmax(2) + 1).to(torch::kInt16).contiguous();
   const auto* p = best.data_ptr<std::int16_t>();
   return {p, p + best.numel()};
 }

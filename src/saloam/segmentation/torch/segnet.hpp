@@ -79,9 +79,10 @@ void load_segnet(SegNet& net, const std::string& file);
 /// A C x rows x cols image (channel-major floats) as a [1, C, rows, cols]
 /// tensor in channels-last layout (the fast one for CPU convolutions).
 torch::Tensor image_tensor(const std::vector<float>& image, int channels, int rows, int cols);
-/// Class of every pixel, row-major, of logits [1, H, W, K]: the argmax over
-/// classes 1..K-1 (class 0, unlabeled, is never predicted).
-std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits);
+/// Class of every pixel, row-major, of logits [1, H, W, K]: the argmax of
+/// the logits plus `offsets` (none, or one per class) over classes 1..K-1
+/// (class 0, unlabeled, is never predicted).
+std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits, const std::vector<float>& offsets = {});
 
 /// "rows must be a multiple of 4 ..." when an image of rows x cols does not
 /// fit `shape`; empty when it does.

@@ -44,7 +44,7 @@ void check_output(const torch::Tensor& logits, int classes, int rows, int cols) 
 
 class SegNetRunner final : public NetworkRunner {
  public:
-  explicit SegNetRunner(const NetworkSpec& spec) : net_(spec.shape) {
+  explicit SegNetRunner(const NetworkSpec& spec) : net_(spec.shape), offsets_(spec.logit_offsets) {
     load_segnet(net_, spec.weights);
     net_->eval();
     net_->fold_batch_norm();
@@ -58,16 +58,18 @@ class SegNetRunner final : public NetworkRunner {
                                std::to_string(channels));
     if (const auto problem = segnet_size_problem(shape, rows, cols); !problem.empty()) throw std::runtime_error(problem);
     torch::NoGradGuard no_grad;
-    return best_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)));
+    return best_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)), offsets_);
   }
 
  private:
   SegNet net_;
+  std::vector<float> offsets_;
 };
 
 class TorchScriptRunner final : public NetworkRunner {
  public:
-  explicit TorchScriptRunner(const NetworkSpec& spec) : module_(torch::jit::load(spec.weights)), classes_(spec.shape.classes) {
+  explicit TorchScriptRunner(const NetworkSpec& spec)
+      : module_(torch::jit::load(spec.weights)), classes_(spec.shape.classes), offsets_(spec.logit_offsets) {
     module_.eval();
   }
 
@@ -79,12 +81,13 @@ class TorchScriptRunner final : public NetworkRunner {
     if (!out.isTensor()) throw std::runtime_error("the network's forward() returns no tensor");
     const torch::Tensor logits = out.toTensor().to(torch::kFloat32);
     check_output(logits, classes_, rows, cols);
-    return best_classes(logits.permute({0, 2, 3, 1}));
+    return best_classes(logits.permute({0, 2, 3, 1}), offsets_);
   }
 
  private:
   torch::jit::Module module_;
   int classes_;
+  std::vector<float> offsets_;
 };
 
 std::unique_ptr<NetworkRunner> open(const NetworkSpec& spec) {
