@@ -55,26 +55,42 @@ struct Errors {
   double drift = 0;       ///< end-point error over the path length
 };
 
-/// The drive's frames 0:frames with `profile`, registered by the odometry
-/// set up with the same profile.
-Errors follow(const SensorProfile& profile, Delivery delivery, std::size_t frames) {
+/// The urban loop's frames 0:frames in world `seed`, rendered with `profile`.
+SimulationOptions drive_options(const SensorProfile& profile, std::size_t frames, std::uint64_t seed) {
   SimulationOptions options;
   options.preset = "urban-loop";
   options.end_frame = frames;
-  options.seed = 7;
+  options.seed = seed;
   options.sensor = profile;
   options.azimuth_steps = profile.simulation.azimuth_steps;
   options.show_progress = false;
+  return options;
+}
+
+struct Followed {
+  std::vector<Pose> truth;     ///< LiDAR poses of the drive
+  std::vector<Pose> estimate;  ///< the odometry's
+};
+
+/// The drive of `options` registered by the odometry set up with the same
+/// profile (and `level_line_max_rise`), its scans delivered as `delivery` says.
+Followed follow_drive(const SimulationOptions& options, double level_line_max_rise, Delivery delivery) {
   const SimulatedSequence sequence(options);
   OdometryConfig config;
-  apply_sensor_profile(profile, config.features);
+  apply_sensor_profile(*options.sensor, config.features);
+  config.level_line_max_rise = level_line_max_rise;
   SemanticOdometry odometry(config);
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     odometry.register_frame(delivered(sequence.render(i).cloud, delivery, static_cast<std::uint32_t>(i)),
                             sequence.times()[i]);
   }
-  const auto truth = camera_to_lidar_poses(sequence.camera_poses(), sequence.velo_to_cam());
-  const auto& estimate = odometry.poses();
+  return {camera_to_lidar_poses(sequence.camera_poses(), sequence.velo_to_cam()), odometry.poses()};
+}
+
+/// The drive's frames 0:frames with `profile`, registered by the odometry
+/// set up with the same profile.
+Errors follow(const SensorProfile& profile, Delivery delivery, std::size_t frames) {
+  const auto [truth, estimate] = follow_drive(drive_options(profile, frames, 7), 0.0, delivery);
   Errors e;
   double path = 0;
   for (std::size_t i = 1; i < truth.size(); ++i) {
@@ -111,25 +127,9 @@ TEST(SensorProfilesOdometry, Vlp16WithoutRingsOrTimes) {
 /// odometry set up with the VLP-16 (1 m mount) on 120 frames of the urban
 /// loop with emulated network labels.
 double vlp16_end_rotation_error_deg(double level_line_max_rise) {
-  const SensorProfile& profile = named("vlp16");
-  SimulationOptions options;
-  options.preset = "urban-loop";
-  options.end_frame = 120;
-  options.seed = 3;
+  SimulationOptions options = drive_options(named("vlp16"), 120, 3);
   options.labels = LabelMode::kNoisy;
-  options.sensor = profile;
-  options.azimuth_steps = profile.simulation.azimuth_steps;
-  options.show_progress = false;
-  const SimulatedSequence sequence(options);
-  OdometryConfig config;
-  apply_sensor_profile(profile, config.features);
-  config.level_line_max_rise = level_line_max_rise;
-  SemanticOdometry odometry(config);
-  for (std::size_t i = 0; i < sequence.size(); ++i) {
-    odometry.register_frame(sequence.render(i).cloud, sequence.times()[i]);
-  }
-  const auto truth = camera_to_lidar_poses(sequence.camera_poses(), sequence.velo_to_cam());
-  const auto& estimate = odometry.poses();
+  const auto [truth, estimate] = follow_drive(options, level_line_max_rise, Delivery::kDriver);
   const Pose moved = truth.front().inverse() * truth.back();
   const Pose estimated = estimate.front().inverse() * estimate.back();
   const double error = rotation_angle(moved.inverse() * estimated) * 180.0 / M_PI;
