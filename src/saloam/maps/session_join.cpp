@@ -15,6 +15,10 @@ namespace saloam {
 
 namespace {
 
+// The first scans of a run are not de-skewed (the odometry has no motion
+// yet): as localisation, no place is searched for from them.
+constexpr std::uint64_t kFirstDeskewedFrame = 2;
+
 bool session_linked(const SavedMap& map, std::size_t k) {
   const std::uint32_t s = map.keyframes[k].session;
   return s >= map.manifest.sessions.size() || map.manifest.sessions[s].linked;
@@ -90,7 +94,7 @@ JoinedMaps SessionJoiner::run() {
       search_loop(q);
     } else if (hypothesis_) {
       confirm(q);
-    } else if (path_[q] - last_attempt_ >= config_.localize.relocalize_interval) {
+    } else if (j.keyframes[q].frame >= kFirstDeskewedFrame && path_[q] - last_attempt_ >= config_.localize.relocalize_interval) {
       relocalize(q);
     }
   }

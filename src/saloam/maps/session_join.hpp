@@ -6,8 +6,8 @@
 // The base map keeps its frame (its first keyframe, held fixed). The joining
 // map's keyframes are gone through in order, as a run would meet them:
 //
-//  * Not linked: every localize.relocalize_interval metres of its path the
-//    keyframe's place descriptor is scored against every base keyframe; the
+//  * Not linked: every localize.relocalize_interval metres of its path (not
+//    from its first two frames, which are not de-skewed) the keyframe's place descriptor is scored against every base keyframe; the
 //    best loop.num_loop above the detector's threshold are verified as loop
 //    closure verifies a candidate (semantic ICP against the keyframes
 //    loop.submap_half_width either side, from the descriptor's yaw; the loop
