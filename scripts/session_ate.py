@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Per-session error of a saved map (docs/map_format.md) whose sessions are
 simulated passes of one world (`saloam simulate --passes ... --pass K`).
 
@@ -6,6 +6,8 @@ simulated passes of one world (`saloam simulate --passes ... --pass K`).
       SEQ_s: the sequence folder session s was made from. Prints, per
       session, the keyframe position RMSE / max [m] after one SE(3)
       alignment of every linked keyframe to the truth (the common frame),
+      and with no alignment (the map frame is the truth's: both are the
+      first keyframe's LiDAR frame),
       and the cross-session loop edges whose relative pose is not the
       truth's (0.5 m, 2 degrees, as loops are judged).
   session_ate.py MAP SEQ --pieces A:B,C:D
@@ -121,13 +123,15 @@ def main():
         else:
             group.append([session])
     R, t = umeyama(np.array([T[:3, 3] for T in est]), np.array([T[:3, 3] for T in truth]))
-    err = np.array([np.linalg.norm(R @ e[:3, 3] + t - g[:3, 3]) for e, g in zip(est, truth)])
     names = args.pieces.split(',') if args.pieces else [f'session {s}' for s in range(len(linked))]
-    for i, name in enumerate(names):
-        sel = np.array([i in g for g in group])
-        if sel.any():
-            print(f'{name}: {sel.sum()} keyframes, RMSE {np.sqrt((err[sel] ** 2).mean()):.3f} m, max {err[sel].max():.3f} m')
-    print(f'all: {len(err)} keyframes, RMSE {np.sqrt((err ** 2).mean()):.3f} m')
+    for label, R, t in (('aligned once', R, t), ('no alignment', np.eye(3), np.zeros(3))):
+        err = np.array([np.linalg.norm(R @ e[:3, 3] + t - g[:3, 3]) for e, g in zip(est, truth)])
+        for i, name in enumerate(names):
+            sel = np.array([i in g for g in group])
+            if sel.any():
+                print(f'{label}: {name}: {sel.sum()} keyframes, RMSE {np.sqrt((err[sel] ** 2).mean()):.3f} m, '
+                      f'max {err[sel].max():.3f} m')
+        print(f'{label}: all: {len(err)} keyframes, RMSE {np.sqrt((err ** 2).mean()):.3f} m')
     if not args.pieces:
         sessions = [s for _, _, s in keyframes]
         true_loops = false_loops = 0

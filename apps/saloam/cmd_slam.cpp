@@ -111,7 +111,7 @@ int run_slam_command(const SlamOptions& options) {
   print_summary(result);
   if (!result.join.empty()) std::cout << result.join << '\n';
   if (result.map_bytes) {
-    std::cout << fmt::format("saved map: {} ({} keyframes, {:.1f} MB, {:.2f} s)\n", options.save_map, result.keyframes,
+    std::cout << fmt::format("saved map: {} ({} keyframes, {:.1f} MB, {:.2f} s)\n", options.save_map, result.map_keyframes,
                              static_cast<double>(*result.map_bytes) / 1e6, result.map_save_seconds);
   }
   if (run_options.write_map && !result.interrupted) write_view_page(folder);

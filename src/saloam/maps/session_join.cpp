@@ -18,6 +18,8 @@ namespace {
 // The first scans of a run are not de-skewed (the odometry has no motion
 // yet): as localisation, no place is searched for from them.
 constexpr std::uint64_t kFirstDeskewedFrame = 2;
+// Levenberg-Marquardt iterations per phase of the joint optimisation (at least).
+constexpr int kJoinIterations = 100;
 
 bool session_linked(const SavedMap& map, std::size_t k) {
   const std::uint32_t s = map.keyframes[k].session;
@@ -75,6 +77,7 @@ class SessionJoiner {
   std::vector<double> path_;  ///< [m] along the joining map's keyframes (sessions one after the other)
   std::optional<Hypothesis> hypothesis_;
   std::optional<Pose> base_from_joining_;  ///< the link (updated by each cross-session loop)
+  Pose initial_link_ = Pose::Identity();    ///< the link as confirmed: places the joining poses before the optimisation
   std::optional<std::size_t> linked_at_;
   double last_attempt_ = -1e300, last_loop_ = -1e300;
   std::vector<CrossEdge> edges_;
@@ -204,6 +207,7 @@ void SessionJoiner::confirm(std::size_t q) {
 
 void SessionJoiner::link(std::size_t q, const Hypothesis& h) {
   base_from_joining_ = h.base_from_joining;
+  initial_link_ = h.base_from_joining;
   linked_at_ = q;
   last_loop_ = path_[q];
   edges_.insert(edges_.end(), h.edges.begin(), h.edges.end());
@@ -288,12 +292,17 @@ std::vector<Pose> SessionJoiner::optimize(JoinedMaps& out) const {
   for (std::size_t k = 0; k < out.map.keyframes.size(); ++k) {
     if (!session_linked(out.map, k)) continue;
     const Pose& pose = out.map.keyframes[k].pose;
-    node[k] = graph.add_node(k < out.base_keyframes ? pose : orthonormalized(*base_from_joining_ * pose));
+    node[k] = graph.add_node(k < out.base_keyframes ? pose : orthonormalized(initial_link_ * pose));
   }
   for (const PoseGraphEdge& e : out.map.edges) {
     if (node[e.from] != kNone && node[e.to] != kNone) graph.add_edge({node[e.from], node[e.to], e.measured, e.information, e.kind});
   }
-  out.optimization = graph.optimize(PoseGraphOptions::from_config(config_.slam));
+  // The joining poses start where the link puts them, as far from the
+  // solution as the joining map drifted: more iterations than an
+  // incremental optimisation of the SLAM needs.
+  PoseGraphOptions options = PoseGraphOptions::from_config(config_.slam);
+  options.max_iterations = std::max(options.max_iterations, kJoinIterations);
+  out.optimization = graph.optimize(options);
   std::vector<Pose> poses(out.map.keyframes.size());
   for (std::size_t k = 0; k < poses.size(); ++k) {
     poses[k] = node[k] != kNone ? graph.pose(node[k]) : out.map.keyframes[k].pose;

@@ -402,9 +402,10 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
     }
     result.map_save_seconds = save_timer.elapsed_s();
     result.map_bytes = map_disk_bytes(*options.save_map);
+    result.map_keyframes = joined ? joined->joined.map.keyframes.size() : slam.keyframes().size();
     summary["saved_map"] = {{"folder", std::filesystem::absolute(*options.save_map).lexically_normal().string()},
                             {"bytes", *result.map_bytes},
-                            {"keyframes", slam.keyframes().size()},
+                            {"keyframes", result.map_keyframes},
                             {"seconds", result.map_save_seconds}};
   }
   if (options.write_map && !stop_requested()) {

@@ -71,6 +71,7 @@ struct SlamRunResult {
   std::optional<LoopSummary> loop_summary_poses_txt;  ///< against poses.txt, when poses_sensor.txt was used
   std::optional<std::uintmax_t> map_bytes;  ///< size of the saved map on disk (when one was saved)
   double map_save_seconds = 0;
+  std::size_t map_keyframes = 0;  ///< keyframes of the saved map (both sessions' when joined)
   std::string join;  ///< what joining join_map did (describe_join; empty when none)
 };
 
