@@ -221,10 +221,7 @@ void Localizer::confirm(LocalizedFrame& out) {
   out.timing.relocalization_ms += timer.elapsed_ms();
 }
 
-void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
-  last_relocalization_ = travelled_;
-  const StageTimer timer;
-  const PlaceDescriptor query = places_.describe(scan);
+std::vector<std::size_t> Localizer::relocalization_candidates(const LocalizedFrame& out) const {
   // On the odometry (left the map not long ago) a place must lie within
   // Eq. 3's radius of where the odometry says the run is, as a loop
   // candidate must: the drift since the last fix is bounded. Only a run
@@ -240,6 +237,14 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
     candidates.resize(map_.size());
     for (std::size_t k = 0; k < map_.size(); ++k) candidates[k] = k;
   }
+  return candidates;
+}
+
+void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
+  last_relocalization_ = travelled_;
+  const StageTimer timer;
+  const PlaceDescriptor query = places_.describe(scan);
+  std::vector<std::size_t> candidates = relocalization_candidates(out);
   const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
   const std::vector<PlaceCandidate> chosen = best_places(map_, places_, query, std::move(candidates), score_threshold_, n);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));

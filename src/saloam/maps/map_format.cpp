@@ -141,6 +141,24 @@ std::vector<double> pose_numbers(const Pose& pose) {
   return v;
 }
 
+// "velo_to_cam": 12 finite numbers (at most 1000), an orthonormal rotation.
+Pose parse_velo_to_cam(const nlohmann::json& tr, const fs::path& origin) {
+  if (!tr.is_array() || tr.size() != 12) throw InputError(origin, "\"velo_to_cam\" is not 12 numbers");
+  double v[12];
+  for (std::size_t i = 0; i < 12; ++i) {
+    if (!tr[i].is_number() || !std::isfinite(tr[i].get<double>()) || std::abs(tr[i].get<double>()) > 1e3) {
+      throw InputError(origin, "\"velo_to_cam\" holds a value that is not a finite number of at most 1000");
+    }
+    v[i] = tr[i].get<double>();
+  }
+  Pose tr_pose = pose_from_3x4(v);
+  const double error = orthonormality_error(tr_pose.linear());
+  if (!(error <= kRotationTolerance) || tr_pose.linear().determinant() <= 0) {
+    throw InputError(origin, "\"velo_to_cam\": the rotation is not orthonormal");
+  }
+  return orthonormalized(tr_pose);
+}
+
 // Version 2's "sessions" (each with source, first_frame, keyframes, linked;
 // the first linked; keyframes summing to the map's) and "cross_session_loops".
 void parse_sessions(const nlohmann::json& j, MapManifest& m, const fs::path& origin) {
@@ -351,21 +369,7 @@ MapManifest parse_map_manifest(std::string_view text, const fs::path& origin) {
   const auto& camera = field("camera_frame_outputs");
   if (!camera.is_boolean()) throw InputError(origin, "\"camera_frame_outputs\" is not true or false");
   m.camera_frame_outputs = camera.get<bool>();
-  const auto& tr = field("velo_to_cam");
-  if (!tr.is_array() || tr.size() != 12) throw InputError(origin, "\"velo_to_cam\" is not 12 numbers");
-  double v[12];
-  for (std::size_t i = 0; i < 12; ++i) {
-    if (!tr[i].is_number() || !std::isfinite(tr[i].get<double>()) || std::abs(tr[i].get<double>()) > 1e3) {
-      throw InputError(origin, "\"velo_to_cam\" holds a value that is not a finite number of at most 1000");
-    }
-    v[i] = tr[i].get<double>();
-  }
-  m.velo_to_cam = pose_from_3x4(v);
-  const double error = orthonormality_error(m.velo_to_cam.linear());
-  if (!(error <= kRotationTolerance) || m.velo_to_cam.linear().determinant() <= 0) {
-    throw InputError(origin, "\"velo_to_cam\": the rotation is not orthonormal");
-  }
-  m.velo_to_cam = orthonormalized(m.velo_to_cam);
+  m.velo_to_cam = parse_velo_to_cam(field("velo_to_cam"), origin);
   if (m.version >= 2) {
     parse_sessions(j, m, origin);
   } else {
