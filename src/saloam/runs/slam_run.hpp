@@ -7,6 +7,8 @@
 //   map.ply, map.png the global semantic map rebuilt from the optimised poses, with the loop edges
 //   trajectories.png odometry, loop-closed and (when known) ground-truth trajectories
 //   timing.json      per-stage timings, Hz, memory
+//   cross_session.csv  with a map to join (SlamRunOptions::join_map): every
+//                    verified cross-session candidate and confirming fit
 //   eval_odometry.{json,png}, eval_slam.{json,png}  with SEQ/poses.txt
 //     (loops are judged against SEQ/poses_sensor.txt when a simulated sequence has it)
 //   summary.json     written last: where the frames came from (sequence,
