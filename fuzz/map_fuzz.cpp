@@ -1,4 +1,4 @@
-// The saved map's readers (maps/map_format.hpp): the first byte picks the
+// The saved map's readers (maps/map_format.hpp; versions 1 and 2): the first byte picks the
 // file (0 map.json, 1 keyframes.bin, 2 edges.bin, 3 places.bin, 4 a
 // feature file), the rest is its content. Accepted input must keep the
 // format's promises: finite values, orthonormal rotations, edges between
@@ -36,7 +36,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     switch (which) {
       case 0: {
         const MapManifest m = parse_map_manifest(fuzz::as_text(data + 1, size - 1), origin);
-        SALOAM_FUZZ_CHECK(m.version == kMapFormatVersion && m.keyframes > 0 && m.loop_edges <= m.edges);
+        SALOAM_FUZZ_CHECK(m.version >= kMapFormatOldestVersion && m.version <= kMapFormatVersion && m.keyframes > 0 &&
+                          m.loop_edges <= m.edges && m.cross_session_loops <= m.loop_edges);
+        SALOAM_FUZZ_CHECK(!m.sessions.empty() && m.sessions.front().linked);
+        std::uint64_t session_keyframes = 0;
+        for (const MapSession& s : m.sessions) session_keyframes += s.keyframes;
+        SALOAM_FUZZ_CHECK(session_keyframes == m.keyframes);
         check_pose(m.velo_to_cam);
         (void)parse_place_detector(m.detector);
         break;
@@ -47,7 +52,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           check_pose(keyframes[k].pose);
           check_pose(keyframes[k].odometry_pose);
           SALOAM_FUZZ_CHECK(std::isfinite(keyframes[k].timestamp) && keyframes[k].travelled >= 0);
-          if (k > 0) SALOAM_FUZZ_CHECK(keyframes[k].frame > keyframes[k - 1].frame);
+          if (k == 0) SALOAM_FUZZ_CHECK(keyframes[k].session == 0);
+          if (k > 0 && keyframes[k].session == keyframes[k - 1].session) {
+            SALOAM_FUZZ_CHECK(keyframes[k].frame > keyframes[k - 1].frame);
+          }
+          if (k > 0) SALOAM_FUZZ_CHECK(keyframes[k].session - keyframes[k - 1].session <= 1);
         }
         break;
       }

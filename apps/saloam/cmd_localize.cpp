@@ -100,13 +100,7 @@ int run_localize_command(const LocalizeOptions& options) {
   // The map's own configuration (its detector made the descriptors), a
   // --config instead, then --set on top.
   SavedMap saved = read_map(options.map);
-  SaloamConfig config = options.config.config_file.empty() ? saved.config
-                                                           : load_config(config_file_path(options.config.config_file));
-  apply_config_overrides(config, options.config.overrides);
-  if (config.loop.detector != saved.config.loop.detector) {
-    throw ConfigError(fmt::format("loop.detector is {}, but the map's descriptors were made for {}", config.loop.detector,
-                                  saved.config.loop.detector));
-  }
+  SaloamConfig config = options.config.resolve_for_map(saved.config);
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }

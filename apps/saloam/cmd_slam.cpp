@@ -12,6 +12,7 @@
 #include "command.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/eval/evaluation_report.hpp"
+#include "saloam/maps/prior_map.hpp"
 #include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/viewer/viewer_page.hpp"
@@ -26,8 +27,27 @@ struct SlamOptions {
   std::string model;
   bool no_map = false;
   std::string save_map;
+  std::string map;
   ConfigOptions config;
 };
+
+/// `--map`: the map to join, its configuration as the run's (a --config
+/// instead, --set on top; the detector must stay the map's). InputError when
+/// --save-map is missing or names the map itself (inputs are never replaced).
+std::unique_ptr<PriorMap> open_join_map(const SlamOptions& options, SaloamConfig& config) {
+  if (options.save_map.empty()) throw InputError(options.map, "--map needs --save-map: the joined map is a new map");
+  std::error_code ec;
+  if (std::filesystem::weakly_canonical(options.map, ec) == std::filesystem::weakly_canonical(options.save_map, ec)) {
+    throw InputError(options.save_map, "is the map given with --map: inputs are never overwritten (choose another --save-map)");
+  }
+  SavedMap saved = read_map(options.map);
+  if (!options.detector.empty()) throw InputError(options.map, "--detector with --map: the map's detector is used");
+  config = options.config.resolve_for_map(saved.config);
+  const std::filesystem::path folder = options.map;
+  const auto cached = static_cast<std::size_t>(std::max(1, config.localize.cached_keyframes));
+  return std::make_unique<PriorMap>(std::move(saved), [folder](std::size_t k) { return read_map_features(folder, k); },
+                                    cached);
+}
 
 void print_summary(const SlamRunResult& r) {
   std::cout << fmt::format("{} frames, {} keyframes; {} loops accepted of {} verified; median {:.1f} ms/frame ({:.1f} Hz), "
@@ -72,6 +92,8 @@ void write_view_page(OutputFolder& folder) {
 int run_slam_command(const SlamOptions& options) {
   SaloamConfig config = options.config.resolve();
   if (!options.detector.empty()) apply_config_option(config, "--detector", "loop.detector", options.detector);
+  std::unique_ptr<PriorMap> join_map;
+  if (!options.map.empty()) join_map = open_join_map(options, config);
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
@@ -82,12 +104,14 @@ int run_slam_command(const SlamOptions& options) {
   run_options.write_map = !options.no_map;
   if (!options.save_map.empty()) run_options.save_map = options.save_map;
   if (sensor.profile) run_options.sensor = sensor.profile->name;
+  run_options.join_map = join_map.get();
 
   OutputFolder folder = open_slam_folder(options.out, source->info());
   const SlamRunResult result = run_slam(*source, config, load_loop_network(config), folder, run_options);
   print_summary(result);
+  if (!result.join.empty()) std::cout << result.join << '\n';
   if (result.map_bytes) {
-    std::cout << fmt::format("saved map: {} ({} keyframes, {:.1f} MB, {:.2f} s)\n", options.save_map, result.keyframes,
+    std::cout << fmt::format("saved map: {} ({} keyframes, {:.1f} MB, {:.2f} s)\n", options.save_map, result.map_keyframes,
                              static_cast<double>(*result.map_bytes) / 1e6, result.map_save_seconds);
   }
   if (run_options.write_map && !result.interrupted) write_view_page(folder);
@@ -113,6 +137,11 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--save-map", options->save_map,
                      "Save the map for later runs (a folder: keyframes, descriptors, pose graph, configuration; "
                      "docs/map_format.md); `saloam localize --map` reads it");
+      app.add_option("--map", options->map,
+                     "Join this saved map (multi-session SLAM): cross-session loop closure against its keyframes and "
+                     "one pose graph over both; needs --save-map (the joined map; the map given is not changed) and "
+                     "runs with the map's configuration")
+          ->check(CLI::ExistingDirectory);
       add_no_calib_flag(app, options->source.no_calib);
       options->config.add_to(app);
       return [options] { return run_slam_command(*options); };

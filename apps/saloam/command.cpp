@@ -40,6 +40,16 @@ SaloamConfig ConfigOptions::resolve() const {
   return config;
 }
 
+SaloamConfig ConfigOptions::resolve_for_map(const SaloamConfig& map_config) const {
+  SaloamConfig config = config_file.empty() ? map_config : load_config(config_file_path(config_file));
+  apply_config_overrides(config, overrides);
+  if (config.loop.detector != map_config.loop.detector) {
+    throw ConfigError(fmt::format("loop.detector is {}, but the map's descriptors were made for {}", config.loop.detector,
+                                  map_config.loop.detector));
+  }
+  return config;
+}
+
 std::optional<std::filesystem::path> program_dir() {
   std::error_code error;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);

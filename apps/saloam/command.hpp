@@ -44,6 +44,10 @@ struct ConfigOptions {
   std::vector<std::string> overrides;
   void add_to(CLI::App& app);
   [[nodiscard]] SaloamConfig resolve() const;
+  /// The configuration of a run in a saved map: the map's (`map_config`,
+  /// whose detector made its descriptors), a --config instead, --set on
+  /// top; ConfigError when the detector is no longer the map's.
+  [[nodiscard]] SaloamConfig resolve_for_map(const SaloamConfig& map_config) const;
 };
 
 /// --segment, --segmenter FILE and --projection FILE of the commands that can

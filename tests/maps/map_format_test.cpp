@@ -7,6 +7,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
@@ -186,6 +187,35 @@ TEST(MapFormat, ReplacesAnEarlierMapButNothingElse) {
   EXPECT_TRUE(std::filesystem::exists(dir / "other" / "notes.txt"));
 }
 
+TEST(MapFormat, SessionsRoundTrip) {
+  testing::TempDir dir("saloam_map_sessions");
+  TestMap t = make_map(7);
+  for (std::size_t k = 4; k < 7; ++k) {
+    t.map.keyframes[k].session = 1;
+    t.map.keyframes[k].frame = k - 4;      // frames and path start again in a new session
+    t.map.keyframes[k].travelled = 0.5 * static_cast<double>(k - 4);
+  }
+  t.map.manifest.sessions = {MapSession{"/data/a", 12, 0, true}, MapSession{"/data/b", 3, 0, false}};
+  PoseGraphEdge cross;
+  cross.from = 1;
+  cross.to = 5;
+  cross.kind = EdgeKind::kLoop;
+  cross.information = 2 * Matrix6d::Identity();
+  t.map.edges.push_back(cross);
+  write_test_map(dir / "map", t);
+  const SavedMap read = read_map(dir / "map");
+  ASSERT_EQ(read.manifest.sessions.size(), 2u);
+  EXPECT_EQ(read.manifest.sessions[0].source, "/data/a");
+  EXPECT_EQ(read.manifest.sessions[0].keyframes, 4u);
+  EXPECT_TRUE(read.manifest.sessions[0].linked);
+  EXPECT_EQ(read.manifest.sessions[1].source, "/data/b");
+  EXPECT_EQ(read.manifest.sessions[1].first_frame, 3u);
+  EXPECT_EQ(read.manifest.sessions[1].keyframes, 3u);
+  EXPECT_FALSE(read.manifest.sessions[1].linked);
+  EXPECT_EQ(read.manifest.cross_session_loops, 2u);  // 1 -> 5, and make_map's loop 0 -> 6
+  for (std::size_t k = 0; k < 7; ++k) EXPECT_EQ(read.keyframes[k].session, k < 4 ? 0u : 1u);
+}
+
 // Rewrites `file` with one change made by `edit` on its bytes.
 void edit_file(const std::filesystem::path& file, const std::function<void(std::string&)>& edit) {
   std::ifstream in(file, std::ios::binary);
@@ -193,6 +223,51 @@ void edit_file(const std::filesystem::path& file, const std::function<void(std::
   in.close();
   edit(bytes);
   std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+}
+
+// The map in `folder` as version 1 wrote it: every table's version 1, no
+// session per keyframe, a manifest without sessions.
+void downgrade_to_version_1(const std::filesystem::path& folder) {
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder)) {
+    if (entry.path().extension() == ".bin") edit_file(entry.path(), [](std::string& b) { b[8] = 1; });
+  }
+  edit_file(folder / "keyframes.bin", [](std::string& b) {
+    std::string v1 = b.substr(0, 24);
+    for (std::size_t at = 24; at + 220 <= b.size(); at += 220) v1 += b.substr(at, 216);
+    b = v1;
+  });
+  edit_file(folder / "map.json", [](std::string& b) {
+    nlohmann::json j = nlohmann::json::parse(b);
+    j["version"] = 1;
+    j.erase("sessions");
+    j.erase("cross_session_loops");
+    b = j.dump(2);
+  });
+}
+
+TEST(MapFormat, ReadsVersion1Maps) {
+  testing::TempDir dir("saloam_map_v1");
+  const TestMap t = make_map(5);
+  write_test_map(dir / "map", t);
+  downgrade_to_version_1(dir / "map");
+  const SavedMap read = read_map(dir / "map");
+  EXPECT_EQ(read.manifest.version, 1u);
+  ASSERT_EQ(read.manifest.sessions.size(), 1u);
+  EXPECT_EQ(read.manifest.sessions[0].source, "/data/run");
+  EXPECT_EQ(read.manifest.sessions[0].first_frame, 12u);
+  EXPECT_EQ(read.manifest.sessions[0].keyframes, 5u);
+  EXPECT_TRUE(read.manifest.sessions[0].linked);
+  ASSERT_EQ(read.keyframes.size(), 5u);
+  for (std::size_t k = 0; k < 5; ++k) {
+    EXPECT_EQ(read.keyframes[k].session, 0u);
+    EXPECT_EQ(read.keyframes[k].frame, t.map.keyframes[k].frame);
+    EXPECT_TRUE(read.keyframes[k].odometry_pose.isApprox(t.map.keyframes[k].odometry_pose, 1e-12));
+  }
+  EXPECT_EQ(read.edges.size(), t.map.edges.size());
+  EXPECT_EQ(read_map_features(dir / "map", 4).planar_points, t.features[4].planar_points);
+  // Written again, it is a version 2 map.
+  write_map(dir / "again", read, [&](std::size_t k) -> const StoredFeatures& { return t.features[k]; });
+  EXPECT_EQ(read_map(dir / "again").manifest.version, kMapFormatVersion);
 }
 
 TEST(MapFormat, ReaderNamesTheFileAndTheProblem) {
@@ -211,14 +286,14 @@ TEST(MapFormat, ReaderNamesTheFileAndTheProblem) {
     return error;
   };
   const auto put_double = [](std::string& bytes, std::size_t at, double v) { std::memcpy(bytes.data() + at, &v, 8); };
-  EXPECT_NE(broken("version", "keyframes.bin", [](std::string& b) { b[8] = 2; }).find("format version 2"),
+  EXPECT_NE(broken("version", "keyframes.bin", [](std::string& b) { b[8] = 3; }).find("format version 3"),
             std::string::npos);
   EXPECT_NE(broken("magic", "edges.bin", [](std::string& b) { b[0] = 'X'; }).find("magic"), std::string::npos);
   EXPECT_NE(broken("truncated", "places.bin", [](std::string& b) { b.resize(b.size() - 3); }).find("truncated"),
             std::string::npos);
   EXPECT_NE(broken("trailing", "keyframes.bin", [](std::string& b) { b += "x"; }).find("trailing"), std::string::npos);
-  // Keyframe 1's first pose value (after the header, keyframe 0's 216 bytes and 24 bytes of frame, time, length).
-  EXPECT_NE(broken("nan", "keyframes.bin", [&](std::string& b) { put_double(b, 24 + 216 + 24, std::nan("")); })
+  // Keyframe 1's first pose value (after the header, keyframe 0's 220 bytes and 24 bytes of frame, time, length).
+  EXPECT_NE(broken("nan", "keyframes.bin", [&](std::string& b) { put_double(b, 24 + 220 + 24, std::nan("")); })
                 .find("not finite"),
             std::string::npos);
   EXPECT_NE(broken("rotation", "keyframes.bin", [&](std::string& b) { put_double(b, 24 + 24, 3.0); }).find("orthonormal"),
@@ -228,8 +303,16 @@ TEST(MapFormat, ReaderNamesTheFileAndTheProblem) {
                 .find("positive definite"),
             std::string::npos);
   EXPECT_NE(broken("count", "map.json",
-                   [](std::string& b) { b.replace(b.find("\"keyframes\": 4"), 14, "\"keyframes\": 5"); }, "keyframes.bin")
-                .find("map.json says 5"),
+                   [](std::string& b) { b.replace(b.find("\"keyframes\": 4"), 14, "\"keyframes\": 5"); })
+                .find("the sessions hold 4 keyframes, \"keyframes\" says 5"),
+            std::string::npos);
+  // Keyframe 1's session (the last 4 bytes of its record) set to 2: sessions follow one another from 0.
+  EXPECT_NE(broken("session", "keyframes.bin", [](std::string& b) { b[24 + 2 * 220 - 4] = 2; })
+                .find("session 2 after session 0"),
+            std::string::npos);
+  // Keyframe 3 in a second session the manifest does not list.
+  EXPECT_NE(broken("sessions", "keyframes.bin", [](std::string& b) { b[24 + 4 * 220 - 4] = 1; })
+                .find("session 1; map.json lists 1"),
             std::string::npos);
   EXPECT_NE(broken("format", "map.json", [](std::string& b) { b.replace(b.find("saloam-map"), 10, "other-map!"); })
                 .find("not a saloam map"),

@@ -10,17 +10,10 @@
 
 #include "saloam/core/lie.hpp"
 #include "saloam/core/profiling.hpp"
+#include "saloam/maps/map_search.hpp"
 
 namespace saloam {
 
-namespace {
-// Guesses closer than this to the first one converge to the same fit.
-constexpr double kSameGuessTranslation = 1.0;            // [m]
-constexpr double kSameGuessRotation = 5.0 * M_PI / 180;  // [rad]
-// Map keyframes whose Scan Context is scored exactly per relocalisation
-// attempt, picked by their ring keys (as Scan Context's own retrieval).
-constexpr std::size_t kRingKeyCandidates = 100;
-}  // namespace
 
 std::string_view localization_status_name(LocalizationStatus status) {
   switch (status) {
@@ -50,11 +43,7 @@ Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optio
   tracking_.parallel = false;
   tracking_.inlier_distance = config.loop.inlier_distance;
   tracking_.level_line_max_rise = 0;  // as the verification's fits (LoopVerificationSettings)
-  switch (places_.detector()) {
-    case PlaceDetector::kSgpr: score_threshold_ = config.loop.zeta; break;
-    case PlaceDetector::kSsc: score_threshold_ = config.loop.ssc_zeta; break;
-    default: score_threshold_ = config.loop.scancontext_zeta; break;
-  }
+  score_threshold_ = place_score_threshold(config, places_.detector());
 }
 
 Localizer::~Localizer() = default;
@@ -111,13 +100,7 @@ const Localizer::Submap& Localizer::submap_near(const Eigen::Vector3d& position)
   auto submap = std::make_unique<Submap>(verification_);
   submap->built_at = position;
   // Keyframes near the place, thinned to submap_spacing (the map's overlap a lot).
-  for (const std::size_t k : map_.near(position, lc.track_radius)) {
-    const Eigen::Vector3d& p = map_.pose(k).translation();
-    const bool crowded = std::any_of(submap->keyframes.begin(), submap->keyframes.end(), [&](std::size_t j) {
-      return (map_.pose(j).translation() - p).norm() < lc.submap_spacing;
-    });
-    if (!crowded) submap->keyframes.push_back(k);
-  }
+  submap->keyframes = thinned_near(map_, position, lc.track_radius, lc.submap_spacing);
   for (const std::size_t k : submap->keyframes) submap->features.add(map_.features(k)->expand(), map_.pose(k));
   submap_ = std::move(submap);
   return *submap_;
@@ -238,10 +221,7 @@ void Localizer::confirm(LocalizedFrame& out) {
   out.timing.relocalization_ms += timer.elapsed_ms();
 }
 
-void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
-  last_relocalization_ = travelled_;
-  const StageTimer timer;
-  const PlaceDescriptor query = places_.describe(scan);
+std::vector<std::size_t> Localizer::relocalization_candidates(const LocalizedFrame& out) const {
   // On the odometry (left the map not long ago) a place must lie within
   // Eq. 3's radius of where the odometry says the run is, as a loop
   // candidate must: the drift since the last fix is bounded. Only a run
@@ -257,68 +237,30 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
     candidates.resize(map_.size());
     for (std::size_t k = 0; k < map_.size(); ++k) candidates[k] = k;
   }
-  // Scan Context's retrieval step on a large map: the nearest ring keys
-  // (rotation invariant) first, the exact column-shift distance for those only.
-  if (uses_scan_context(places_.detector()) && candidates.size() > kRingKeyCandidates) {
-    std::vector<std::pair<float, std::size_t>> by_key;
-    by_key.reserve(candidates.size());
-    for (const std::size_t k : candidates)
-      by_key.emplace_back((map_.place(k).context.ring_key - query.context.ring_key).squaredNorm(), k);
-    std::partial_sort(by_key.begin(), by_key.begin() + static_cast<std::ptrdiff_t>(kRingKeyCandidates), by_key.end());
-    candidates.clear();
-    for (std::size_t i = 0; i < kRingKeyCandidates; ++i) candidates.push_back(by_key[i].second);
-    std::sort(candidates.begin(), candidates.end());
-  }
-  std::vector<const PlaceDescriptor*> descriptors;
-  descriptors.reserve(candidates.size());
-  for (const std::size_t k : candidates) descriptors.push_back(&map_.place(k));
-  const std::vector<PlaceMatch> scored = places_.match(query, descriptors);
-  std::unordered_map<std::size_t, PlaceMatch> matches;
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
-    if (scored[i].score > score_threshold_) {
-      order.push_back(candidates[i]);
-      matches[candidates[i]] = scored[i];
-    }
-  }
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return matches[a].score != matches[b].score ? matches[a].score > matches[b].score : a < b;
-  });
+  return candidates;
+}
+
+void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
+  last_relocalization_ = travelled_;
+  const StageTimer timer;
+  const PlaceDescriptor query = places_.describe(scan);
+  std::vector<std::size_t> candidates = relocalization_candidates(out);
   const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
-  // Neighbouring keyframes are the same place: verify at most one of each stretch.
-  std::vector<std::size_t> chosen;
-  for (const std::size_t k : order) {
-    if (chosen.size() >= n) break;
-    const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](std::size_t c) {
-      return (map_.pose(c).translation() - map_.pose(k).translation()).norm() < 5.0;
-    });
-    if (!same_place) chosen.push_back(k);
-  }
+  const std::vector<PlaceCandidate> chosen = best_places(map_, places_, query, std::move(candidates), score_threshold_, n);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
-  for (const std::size_t match : chosen) {
-    const Pose match_inverse = map_.pose(match).inverse();
-    LoopSubmap submap(verification_);
-    const std::size_t first = match >= w ? match - w : 0, last = std::min(match + w, map_.size() - 1);
-    for (std::size_t k = first; k <= last; ++k) submap.add(map_.features(k)->expand(), match_inverse * map_.pose(k));
+  for (const PlaceCandidate& candidate : chosen) {
+    const std::size_t match = candidate.keyframe;
+    const LoopSubmap submap = submap_around(map_, match, w, verification_);
     // Guesses: the descriptor's yaw (and SSC's offset); on the odometry also where it says we are.
-    std::vector<Pose> guesses;
-    Pose yaw_guess = Pose::Identity();
-    if (matches[match].yaw) {
-      yaw_guess.linear() = Eigen::AngleAxisd(*matches[match].yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-      if (matches[match].translation) yaw_guess.translation().head<2>() = *matches[match].translation;
-    }
-    guesses.push_back(yaw_guess);
+    std::vector<Pose> guesses{place_match_guess(candidate.match)};
     if (state_ == State::kOdometry) {
-      const Pose estimate = orthonormalized(match_inverse * map_from_odometry_ * out.odometry_pose);
-      const Pose difference = yaw_guess.inverse() * estimate;
-      if (difference.translation().norm() > kSameGuessTranslation || rotation_angle(difference) > kSameGuessRotation)
-        guesses.push_back(estimate);
+      add_distinct_guess(guesses, orthonormalized(map_.pose(match).inverse() * map_from_odometry_ * out.odometry_pose));
     }
     RelocalizationRecord record;
     record.frame = out.frame;
     record.travelled = travelled_;
     record.keyframe = match;
-    record.score = matches[match];
+    record.score = candidate.match;
     record.verification = verify_loop(odometry_.last_features(), submap, guesses, verification_);
     record.pose = orthonormalized(map_.pose(match) * record.verification.relative);
     const bool accepted = record.verification.accepted;

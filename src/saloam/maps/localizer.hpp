@@ -114,6 +114,9 @@ class Localizer {
   struct Submap;
 
   void relocalize(const LabelledCloud& scan, LocalizedFrame& out);
+  /// The map keyframes a relocalisation attempt scores: all of them, or on
+  /// the odometry those within Eq. 3's radius of the prediction.
+  [[nodiscard]] std::vector<std::size_t> relocalization_candidates(const LocalizedFrame& out) const;
   void confirm(LocalizedFrame& out);
   void track(LocalizedFrame& out);
   void reenter(LocalizedFrame& out);

@@ -63,6 +63,41 @@ void remove_stale_partials(const fs::path& target) {
   }
 }
 
+// The manifest's sessions with their keyframe counts from the keyframes (a
+// map of one session without a list gets one from the manifest's source).
+std::vector<MapSession> sessions_of(const SavedMap& map) {
+  std::vector<MapSession> sessions = map.manifest.sessions;
+  if (sessions.empty()) sessions.push_back({map.manifest.source, map.manifest.first_frame, 0, true});
+  for (MapSession& s : sessions) s.keyframes = 0;
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    const std::uint32_t s = map.keyframes[k].session;
+    const bool in_order = s < sessions.size() && (k == 0 ? s == 0 : s == map.keyframes[k - 1].session ||
+                                                                      s == map.keyframes[k - 1].session + 1);
+    if (!in_order) throw InputError(map.folder, fmt::format("keyframe {}: session {} out of order", k, s));
+    ++sessions[s].keyframes;
+  }
+  if (sessions.back().keyframes == 0) throw InputError(map.folder, "a session without keyframes");
+  sessions.front().linked = true;
+  return sessions;
+}
+
+// Each session of the manifest holds the keyframes marked with it.
+void check_sessions(const SavedMap& map, const fs::path& keyframes_file) {
+  std::vector<std::uint64_t> counts(map.manifest.sessions.size(), 0);
+  for (const MapKeyframe& kf : map.keyframes) {
+    if (kf.session >= counts.size()) {
+      throw InputError(keyframes_file, fmt::format("session {}; map.json lists {}", kf.session, counts.size()));
+    }
+    ++counts[kf.session];
+  }
+  for (std::size_t s = 0; s < counts.size(); ++s) {
+    if (counts[s] != map.manifest.sessions[s].keyframes) {
+      throw InputError(keyframes_file, fmt::format("session {} has {} keyframes, map.json says {}", s, counts[s],
+                                                   map.manifest.sessions[s].keyframes));
+    }
+  }
+}
+
 }  // namespace
 
 void check_map_destination(const fs::path& folder) {
@@ -99,6 +134,11 @@ void write_map(const fs::path& folder, const SavedMap& map,
   manifest.loop_edges = static_cast<std::uint64_t>(
       std::count_if(map.edges.begin(), map.edges.end(), [](const PoseGraphEdge& e) { return e.kind == EdgeKind::kLoop; }));
   manifest.detector = map.config.loop.detector;
+  manifest.sessions = sessions_of(map);
+  manifest.cross_session_loops = static_cast<std::uint64_t>(
+      std::count_if(map.edges.begin(), map.edges.end(), [&](const PoseGraphEdge& e) {
+        return e.kind == EdgeKind::kLoop && map.keyframes[e.from].session != map.keyframes[e.to].session;
+      }));
   write_file_atomically(temporary / "config.yaml", config_to_yaml(map.config));
   {
     const auto put = [&](const fs::path& file, const std::vector<std::byte>& bytes) {
@@ -156,6 +196,7 @@ SavedMap read_map(const fs::path& folder) {
   if (map.keyframes.size() != map.manifest.keyframes) {
     throw InputError(keyframes_file, fmt::format("{} keyframes, map.json says {}", map.keyframes.size(), map.manifest.keyframes));
   }
+  check_sessions(map, keyframes_file);
   const fs::path edges_file = folder / "edges.bin";
   map.edges = parse_map_edges(read_table(edges_file), map.keyframes.size(), edges_file);
   if (map.edges.size() != map.manifest.edges) {

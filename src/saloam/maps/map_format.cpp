@@ -105,9 +105,10 @@ class ByteReader {
       fail("not a saloam map file (no SALOAMAP magic)");
     }
     at_ = kMapMagic.size();
-    const auto version = get<std::uint32_t>("version");
-    if (version != kMapFormatVersion) {
-      fail(fmt::format("format version {}; this saloam reads version {}", version, kMapFormatVersion));
+    version_ = get<std::uint32_t>("version");
+    if (version_ < kMapFormatOldestVersion || version_ > kMapFormatVersion) {
+      fail(fmt::format("format version {}; this saloam reads versions {} to {}", version_, kMapFormatOldestVersion,
+                       kMapFormatVersion));
     }
     const auto table = get<std::uint32_t>("table kind");
     if (table != static_cast<std::uint32_t>(expected)) {
@@ -119,6 +120,7 @@ class ByteReader {
     if (at_ != bytes_.size()) fail(fmt::format("{} bytes of trailing data after the last record", bytes_.size() - at_));
   }
   [[nodiscard]] std::size_t remaining() const { return bytes_.size() - at_; }
+  [[nodiscard]] std::uint32_t version() const { return version_; }
   [[noreturn]] void fail(const std::string& problem) const { throw InputError(origin_, problem); }
 
  private:
@@ -128,6 +130,7 @@ class ByteReader {
   std::span<const std::byte> bytes_;
   const fs::path& origin_;
   std::size_t at_ = 0;
+  std::uint32_t version_ = 0;
 };
 
 std::string_view edge_kind_name(EdgeKind kind) { return kind == EdgeKind::kLoop ? "loop" : "odometry"; }
@@ -136,6 +139,62 @@ std::vector<double> pose_numbers(const Pose& pose) {
   std::vector<double> v(12);
   pose_to_3x4(pose, v.data());
   return v;
+}
+
+// "velo_to_cam": 12 finite numbers (at most 1000), an orthonormal rotation.
+Pose parse_velo_to_cam(const nlohmann::json& tr, const fs::path& origin) {
+  if (!tr.is_array() || tr.size() != 12) throw InputError(origin, "\"velo_to_cam\" is not 12 numbers");
+  double v[12];
+  for (std::size_t i = 0; i < 12; ++i) {
+    if (!tr[i].is_number() || !std::isfinite(tr[i].get<double>()) || std::abs(tr[i].get<double>()) > 1e3) {
+      throw InputError(origin, "\"velo_to_cam\" holds a value that is not a finite number of at most 1000");
+    }
+    v[i] = tr[i].get<double>();
+  }
+  Pose tr_pose = pose_from_3x4(v);
+  const double error = orthonormality_error(tr_pose.linear());
+  if (!(error <= kRotationTolerance) || tr_pose.linear().determinant() <= 0) {
+    throw InputError(origin, "\"velo_to_cam\": the rotation is not orthonormal");
+  }
+  return orthonormalized(tr_pose);
+}
+
+// Version 2's "sessions" (each with source, first_frame, keyframes, linked;
+// the first linked; keyframes summing to the map's) and "cross_session_loops".
+void parse_sessions(const nlohmann::json& j, MapManifest& m, const fs::path& origin) {
+  const auto sessions = j.find("sessions");
+  if (sessions == j.end() || !sessions->is_array() || sessions->empty() || sessions->size() > m.keyframes) {
+    throw InputError(origin, "\"sessions\" is not a list of 1 to \"keyframes\" sessions");
+  }
+  std::uint64_t keyframes = 0;
+  for (std::size_t i = 0; i < sessions->size(); ++i) {
+    const nlohmann::json& s = (*sessions)[i];
+    const auto bad = [&](const char* what) {
+      return InputError(origin, fmt::format("session {}: {}", i, what));
+    };
+    if (!s.is_object()) throw bad("not a JSON object");
+    const auto source = s.find("source"), first = s.find("first_frame"), count = s.find("keyframes"),
+               linked = s.find("linked");
+    if (source == s.end() || !source->is_string()) throw bad("\"source\" is not a string");
+    if (first == s.end() || !first->is_number_unsigned()) throw bad("\"first_frame\" is not a non-negative integer");
+    if (count == s.end() || !count->is_number_unsigned() || count->get<std::uint64_t>() == 0 ||
+        count->get<std::uint64_t>() > m.keyframes) {
+      throw bad("\"keyframes\" is not a count of 1 to the map's keyframes");
+    }
+    if (linked == s.end() || !linked->is_boolean()) throw bad("\"linked\" is not true or false");
+    if (i == 0 && !linked->get<bool>()) throw bad("the first session defines the map frame: it is linked");
+    m.sessions.push_back({source->get<std::string>(), first->get<std::uint64_t>(), count->get<std::uint64_t>(),
+                          linked->get<bool>()});
+    keyframes += m.sessions.back().keyframes;
+  }
+  if (keyframes != m.keyframes) {
+    throw InputError(origin, fmt::format("the sessions hold {} keyframes, \"keyframes\" says {}", keyframes, m.keyframes));
+  }
+  const auto loops = j.find("cross_session_loops");
+  if (loops == j.end() || !loops->is_number_unsigned() || loops->get<std::uint64_t>() > m.loop_edges) {
+    throw InputError(origin, "\"cross_session_loops\" is not a count of at most \"loop_edges\"");
+  }
+  m.cross_session_loops = loops->get<std::uint64_t>();
 }
 
 }  // namespace
@@ -156,6 +215,12 @@ std::string encode_map_manifest(const MapManifest& m) {
   j["loop_edges"] = m.loop_edges;
   j["camera_frame_outputs"] = m.camera_frame_outputs;
   j["velo_to_cam"] = pose_numbers(m.velo_to_cam);
+  j["sessions"] = nlohmann::ordered_json::array();
+  for (const MapSession& s : m.sessions) {
+    j["sessions"].push_back(
+        {{"source", s.source}, {"first_frame", s.first_frame}, {"keyframes", s.keyframes}, {"linked", s.linked}});
+  }
+  j["cross_session_loops"] = m.cross_session_loops;
   j["files"] = {{"config", "config.yaml"},
                 {"keyframes", "keyframes.bin"},
                 {"edges", "edges.bin"},
@@ -173,6 +238,7 @@ std::vector<std::byte> encode_map_keyframes(std::span<const MapKeyframe> keyfram
     w.put(k.travelled);
     w.put_pose(k.pose);
     w.put_pose(k.odometry_pose);
+    w.put(k.session);
   }
   return w.take();
 }
@@ -280,10 +346,12 @@ MapManifest parse_map_manifest(std::string_view text, const fs::path& origin) {
   }
   MapManifest m;
   const auto& version = field("version");
-  if (!version.is_number_unsigned() || version.get<std::uint64_t>() != kMapFormatVersion) {
-    throw InputError(origin, fmt::format("format version {}; this saloam reads version {}", version.dump(),
-                                         kMapFormatVersion));
+  if (!version.is_number_unsigned() || version.get<std::uint64_t>() < kMapFormatOldestVersion ||
+      version.get<std::uint64_t>() > kMapFormatVersion) {
+    throw InputError(origin, fmt::format("format version {}; this saloam reads versions {} to {}", version.dump(),
+                                         kMapFormatOldestVersion, kMapFormatVersion));
   }
+  m.version = version.get<std::uint32_t>();
   m.detector = string_of("detector");
   try {
     (void)parse_place_detector(m.detector);
@@ -301,28 +369,20 @@ MapManifest parse_map_manifest(std::string_view text, const fs::path& origin) {
   const auto& camera = field("camera_frame_outputs");
   if (!camera.is_boolean()) throw InputError(origin, "\"camera_frame_outputs\" is not true or false");
   m.camera_frame_outputs = camera.get<bool>();
-  const auto& tr = field("velo_to_cam");
-  if (!tr.is_array() || tr.size() != 12) throw InputError(origin, "\"velo_to_cam\" is not 12 numbers");
-  double v[12];
-  for (std::size_t i = 0; i < 12; ++i) {
-    if (!tr[i].is_number() || !std::isfinite(tr[i].get<double>()) || std::abs(tr[i].get<double>()) > 1e3) {
-      throw InputError(origin, "\"velo_to_cam\" holds a value that is not a finite number of at most 1000");
-    }
-    v[i] = tr[i].get<double>();
+  m.velo_to_cam = parse_velo_to_cam(field("velo_to_cam"), origin);
+  if (m.version >= 2) {
+    parse_sessions(j, m, origin);
+  } else {
+    m.sessions = {MapSession{m.source, m.first_frame, m.keyframes, true}};
   }
-  m.velo_to_cam = pose_from_3x4(v);
-  const double error = orthonormality_error(m.velo_to_cam.linear());
-  if (!(error <= kRotationTolerance) || m.velo_to_cam.linear().determinant() <= 0) {
-    throw InputError(origin, "\"velo_to_cam\": the rotation is not orthonormal");
-  }
-  m.velo_to_cam = orthonormalized(m.velo_to_cam);
   return m;
 }
 
 std::vector<MapKeyframe> parse_map_keyframes(std::span<const std::byte> bytes, const fs::path& origin) {
   ByteReader r(bytes, origin);
-  constexpr std::size_t kRecord = 8 + 8 + 8 + 96 + 96;
-  const std::size_t n = r.count(r.header(MapTable::kKeyframes), kRecord, "keyframes", kMaxMapKeyframes);
+  const std::uint64_t records = r.header(MapTable::kKeyframes);
+  const std::size_t record_bytes = 8 + 8 + 8 + 96 + 96 + (r.version() >= 2 ? 4 : 0);
+  const std::size_t n = r.count(records, record_bytes, "keyframes", kMaxMapKeyframes);
   std::vector<MapKeyframe> keyframes(n);
   for (std::size_t k = 0; k < n; ++k) {
     MapKeyframe& kf = keyframes[k];
@@ -331,10 +391,17 @@ std::vector<MapKeyframe> parse_map_keyframes(std::span<const std::byte> bytes, c
     kf.travelled = r.finite("path length", kMaxMapCoordinate * 100);
     kf.pose = r.pose(fmt::format("keyframe {}: pose", k));
     kf.odometry_pose = r.pose(fmt::format("keyframe {}: odometry pose", k));
-    if (k > 0 && kf.frame <= keyframes[k - 1].frame) {
+    if (r.version() >= 2) kf.session = r.get<std::uint32_t>("session");
+    const std::uint32_t previous_session = k > 0 ? keyframes[k - 1].session : 0;
+    if (k == 0 ? kf.session != 0 : kf.session != previous_session && kf.session != previous_session + 1) {
+      r.fail(fmt::format("keyframe {}: session {} after session {} (sessions follow one another from 0)", k,
+                         kf.session, previous_session));
+    }
+    const bool follows = k > 0 && kf.session == previous_session;  // same session as the one before
+    if (follows && kf.frame <= keyframes[k - 1].frame) {
       r.fail(fmt::format("keyframe {}: frame {} does not follow frame {}", k, kf.frame, keyframes[k - 1].frame));
     }
-    if (kf.travelled < 0 || (k > 0 && kf.travelled < keyframes[k - 1].travelled)) {
+    if (kf.travelled < 0 || (follows && kf.travelled < keyframes[k - 1].travelled)) {
       r.fail(fmt::format("keyframe {}: path length {} decreases or is negative", k, kf.travelled));
     }
   }

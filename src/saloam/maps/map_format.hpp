@@ -4,7 +4,7 @@
 //
 //   MAP/map.json              manifest: format, version, counts, detector, sensor, origin of the data
 //   MAP/config.yaml           the configuration the map was made with (config_to_yaml)
-//   MAP/keyframes.bin         per keyframe: frame, time, path length, optimised pose, odometry pose
+//   MAP/keyframes.bin         per keyframe: frame, time, path length, optimised pose, odometry pose, session
 //   MAP/edges.bin             the pose graph's edges: nodes, kind, measurement, information (6x6)
 //   MAP/places.bin            per keyframe: its place descriptor (Scan Context, SSC, SGPR graph)
 //   MAP/features/NNNNNN.bin   per keyframe: its labelled feature cloud (sensor frame), read on demand
@@ -12,7 +12,8 @@
 // Binary files are little-endian and start with the same 24-byte header:
 // magic "SALOAMAP", the format version (uint32), the table's kind (uint32)
 // and its record count (uint64). Poses are T_map<-sensor, the map frame being
-// the LiDAR frame of the first keyframe. A map is written into a temporary
+// the LiDAR frame of the first keyframe (a session not linked to the first
+// keeps its own frame: MapSession::linked). A map is written into a temporary
 // folder beside MAP and renamed into place when complete (an earlier map of
 // the same name is replaced only then); a folder that is not a saloam map is
 // never replaced.
@@ -40,7 +41,10 @@
 
 namespace saloam {
 
-inline constexpr std::uint32_t kMapFormatVersion = 1;
+/// Version written; the reader also reads every version from kMapFormatOldestVersion
+/// (version 1: one session, no session per keyframe).
+inline constexpr std::uint32_t kMapFormatVersion = 2;
+inline constexpr std::uint32_t kMapFormatOldestVersion = 1;
 inline constexpr std::string_view kMapFormatName = "saloam-map";
 inline constexpr std::string_view kMapMagic = "SALOAMAP";  ///< 8 bytes, no terminator in the files
 
@@ -61,6 +65,18 @@ struct MapKeyframe {
   double travelled = 0;          ///< [m] odometry path length up to it
   Pose pose = Pose::Identity();  ///< optimised T_map<-sensor
   Pose odometry_pose = Pose::Identity();  ///< the mapping run's odometry pose
+  std::uint32_t session = 0;     ///< the drive (MapManifest::sessions) it belongs to
+};
+
+/// One drive of a map (a `slam` run; joined by `slam --map` or `merge`).
+struct MapSession {
+  std::string source;             ///< where its scans came from (informational)
+  std::uint64_t first_frame = 0;  ///< the source's frame of its keyframe frame 0
+  std::uint64_t keyframes = 0;
+  /// Its poses are in the map frame, tied to session 0 by verified loops
+  /// (session 0 always is); false: in its own frame (the LiDAR frame of its
+  /// first keyframe), a component of the pose graph of its own.
+  bool linked = true;
 };
 
 /// The manifest (map.json).
@@ -76,6 +92,10 @@ struct MapManifest {
   std::uint64_t loop_edges = 0;
   bool camera_frame_outputs = false;  ///< the mapping run had a Tr (calib.txt)
   Pose velo_to_cam = Pose::Identity();  ///< that Tr (identity when none)
+  /// The drives, in keyframe order (keyframes of session s follow those of
+  /// s-1). Version 1 maps read as one session (source, first_frame).
+  std::vector<MapSession> sessions;
+  std::uint64_t cross_session_loops = 0;  ///< loop edges between keyframes of different sessions
 };
 
 /// Everything of a map but the feature clouds: what a run holds in memory.

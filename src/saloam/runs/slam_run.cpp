@@ -14,6 +14,8 @@
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/io/ply.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/maps/session_join.hpp"
+#include "saloam/maps/session_report.hpp"
 #include "saloam/maps/slam_map.hpp"
 #include "saloam/mapping/map_render.hpp"
 #include "saloam/place/graph_json.hpp"
@@ -315,6 +317,32 @@ nlohmann::json write_results(const SlamSystem& slam, const std::vector<Pose>& op
   return evaluate_run(slam, config, truth, odometry_out, slam_out, out_dir, result, info);
 }
 
+// The run's keyframes joined to a saved map, and every frame's pose in the
+// map's frame when linked (in the run's own otherwise).
+struct JoinedSession {
+  std::unique_ptr<PriorMap> joining;
+  JoinedMaps joined;
+  std::vector<Pose> frame_poses;
+};
+
+JoinedSession join_session(const SlamSystem& slam, const SaloamConfig& config, const MapManifest& manifest,
+                           const PriorMap& map) {
+  JoinedSession s;
+  const auto cached = static_cast<std::size_t>(std::max(1, config.localize.cached_keyframes));
+  s.joining = std::make_unique<PriorMap>(saved_map_of(slam, config, manifest),
+                                         [&slam](std::size_t k) { return slam.keyframes()[k].features; }, cached);
+  const PlaceRecognizer places(parse_place_detector(config.loop.detector), load_loop_network(config),
+                               GraphBuilderConfig{}, ScanContextConfig{}, config.loop.ssc);
+  s.joined = join_maps(map, *s.joining, config, places);
+  std::vector<Pose> keyframe_poses;
+  for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {
+    keyframe_poses.push_back(s.joined.map.keyframes[s.joined.base_keyframes + k].pose);
+  }
+  s.frame_poses = slam.optimized_poses(keyframe_poses);
+  spdlog::info("{}", describe_join(s.joined, map.saved().folder.string()));
+  return s;
+}
+
 }  // namespace
 
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
@@ -349,23 +377,35 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   result.registration_failures = health.failures();
   result.degenerate_frames = health.degenerate_frames();
   odometry_writer.commit();
-  const std::vector<Pose> optimized = slam.optimized_poses();
+  MapManifest manifest;
+  manifest.sensor = options.sensor;
+  if (info.folder) manifest.source = std::filesystem::absolute(*info.folder).lexically_normal().string();
+  manifest.first_frame = info.first_frame;
+  manifest.camera_frame_outputs = tr.has_value();
+  if (tr) manifest.velo_to_cam = *tr;
+  std::optional<JoinedSession> joined;
+  if (options.join_map && !stop_requested() && !slam.keyframes().empty()) {
+    joined.emplace(join_session(slam, config, manifest, *options.join_map));
+    write_cross_session_csv(out_dir / "cross_session.csv", joined->joined);
+    result.join = describe_join(joined->joined, options.join_map->saved().folder.string());
+  }
+  const std::vector<Pose> optimized = joined ? joined->frame_poses : slam.optimized_poses();
   nlohmann::json summary = write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);
+  if (joined) summary["session_join"] = join_summary_json(joined->joined);
 
   if (options.save_map && !stop_requested() && !slam.keyframes().empty()) {
     const StageTimer save_timer;
-    MapManifest manifest;
-    manifest.sensor = options.sensor;
-    if (info.folder) manifest.source = std::filesystem::absolute(*info.folder).lexically_normal().string();
-    manifest.first_frame = info.first_frame;
-    manifest.camera_frame_outputs = tr.has_value();
-    if (tr) manifest.velo_to_cam = *tr;
-    write_slam_map(*options.save_map, slam, config, manifest);
+    if (joined) {
+      write_joined_map(*options.save_map, joined->joined, *options.join_map, *joined->joining);
+    } else {
+      write_slam_map(*options.save_map, slam, config, manifest);
+    }
     result.map_save_seconds = save_timer.elapsed_s();
     result.map_bytes = map_disk_bytes(*options.save_map);
+    result.map_keyframes = joined ? joined->joined.map.keyframes.size() : slam.keyframes().size();
     summary["saved_map"] = {{"folder", std::filesystem::absolute(*options.save_map).lexically_normal().string()},
                             {"bytes", *result.map_bytes},
-                            {"keyframes", slam.keyframes().size()},
+                            {"keyframes", result.map_keyframes},
                             {"seconds", result.map_save_seconds}};
   }
   if (options.write_map && !stop_requested()) {

@@ -7,6 +7,8 @@
 //   map.ply, map.png the global semantic map rebuilt from the optimised poses, with the loop edges
 //   trajectories.png odometry, loop-closed and (when known) ground-truth trajectories
 //   timing.json      per-stage timings, Hz, memory
+//   cross_session.csv  with a map to join (SlamRunOptions::join_map): every
+//                    verified cross-session candidate and confirming fit
 //   eval_odometry.{json,png}, eval_slam.{json,png}  with SEQ/poses.txt
 //     (loops are judged against SEQ/poses_sensor.txt when a simulated sequence has it)
 //   summary.json     written last: where the frames came from (sequence,
@@ -29,6 +31,7 @@
 #include "saloam/core/types.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/frame_source.hpp"
+#include "saloam/maps/prior_map.hpp"
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/slam/slam_system.hpp"
 
@@ -44,6 +47,11 @@ struct SlamRunOptions {
   /// none: no map is saved. Not saved when the run is interrupted.
   std::optional<std::filesystem::path> save_map;
   std::string sensor;  ///< the sensor profile's name, recorded in the saved map
+  /// A map this run joins (`slam --map`, maps/session_join.hpp): after the
+  /// frames, the run's keyframes are joined to it; when linked, poses.txt
+  /// and the map outputs are in its frame, and save_map (required) holds
+  /// both sessions. cross_session.csv lists the verified cross-session fits.
+  const PriorMap* join_map = nullptr;
 };
 
 struct SlamRunResult {
@@ -65,6 +73,8 @@ struct SlamRunResult {
   std::optional<LoopSummary> loop_summary_poses_txt;  ///< against poses.txt, when poses_sensor.txt was used
   std::optional<std::uintmax_t> map_bytes;  ///< size of the saved map on disk (when one was saved)
   double map_save_seconds = 0;
+  std::size_t map_keyframes = 0;  ///< keyframes of the saved map (both sessions' when joined)
+  std::string join;  ///< what joining join_map did (describe_join; empty when none)
 };
 
 /// Loads the SGPR network when the configured detector needs one, from the
@@ -75,7 +85,7 @@ std::optional<SgprNetwork> load_loop_network(const SaloamConfig& config);
 inline const std::vector<std::string> kSlamOutputs{
     "poses.txt",     "poses_tum.txt",   "poses_odometry.txt", "poses_odometry_tum.txt", "loops.csv",
     "graph_map.json", "map.ply",        "map.png",            "trajectories.png",       "timing.json",
-    "eval_odometry.json", "eval_odometry.png", "eval_slam.json", "eval_slam.png", "summary.json", "view.html"};
+    "eval_odometry.json", "eval_odometry.png", "eval_slam.json", "eval_slam.png", "cross_session.csv", "summary.json", "view.html"};
 
 /// The output folder of a SLAM run over `source` (open_run_folder()).
 OutputFolder open_slam_folder(const std::filesystem::path& out_dir, const SourceInfo& source);

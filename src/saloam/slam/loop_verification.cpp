@@ -177,4 +177,45 @@ LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap
   return best;
 }
 
+namespace {
+// Guesses closer than this to each other converge to the same fit: one is enough.
+constexpr double kSameGuessTranslation = 1.0;            // [m]
+constexpr double kSameGuessRotation = 5.0 * M_PI / 180;  // [rad]
+// Added to H / N so that a direction no correspondence constrains still has
+// a little information (the edge stays positive definite).
+constexpr double kInformationFloor = 1e-3;
+}  // namespace
+
+Pose place_match_guess(const PlaceMatch& match) {
+  Pose guess = Pose::Identity();
+  if (match.yaw) {
+    guess.linear() = Eigen::AngleAxisd(*match.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    if (match.translation) guess.translation().head<2>() = *match.translation;
+  }
+  return guess;
+}
+
+void add_distinct_guess(std::vector<Pose>& guesses, const Pose& guess) {
+  const bool same = std::any_of(guesses.begin(), guesses.end(), [&](const Pose& g) {
+    const Pose difference = g.inverse() * guess;
+    return difference.translation().norm() <= kSameGuessTranslation && rotation_angle(difference) <= kSameGuessRotation;
+  });
+  if (!same) guesses.push_back(guess);
+}
+
+Matrix6d registration_information(const RegistrationResult& registration, double frames, double scale) {
+  Matrix6d per_correspondence;
+  if (registration.ok && registration.correspondences() > 0) {
+    per_correspondence = registration.hessian / registration.correspondences();
+  } else {
+    // No registration (first frames, or a failure that kept the prediction):
+    // what a typical scan gives, per correspondence.
+    per_correspondence = Matrix6d::Zero();
+    per_correspondence.diagonal() << 0.3, 0.3, 0.3, 30.0, 30.0, 30.0;
+  }
+  const double floor = kInformationFloor * std::max(1e-9, per_correspondence.trace() / 6.0);
+  per_correspondence.diagonal().array() += floor;
+  return scale / std::max(1.0, frames) * per_correspondence;
+}
+
 }  // namespace saloam

@@ -34,6 +34,8 @@
 #include "saloam/core/types.hpp"
 #include "saloam/odometry/local_map.hpp"
 #include "saloam/odometry/registration.hpp"
+#include "saloam/place/place_recognizer.hpp"
+#include "saloam/slam/pose_graph.hpp"
 
 namespace saloam {
 
@@ -88,5 +90,20 @@ struct LoopVerification {
 /// (T_candidate<-query) and applies the acceptance tests.
 LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap, std::span<const Pose> guesses,
                              const LoopVerificationSettings& settings);
+
+/// The initial guess a place match gives for T_candidate<-query: its yaw
+/// about z and, when the descriptor gives one (SSC), its x-y offset;
+/// identity without either.
+Pose place_match_guess(const PlaceMatch& match);
+
+/// Appends `guess` unless a guess already in `guesses` lies within 1 m and
+/// 5 degrees of it (the registration would converge to the same fit).
+void add_distinct_guess(std::vector<Pose>& guesses, const Pose& guess);
+
+/// Information of a loop or odometry edge from its registration:
+/// scale / max(1, frames) * (H / N + 1e-3 * trace(H / N) / 6 * I), H the
+/// Gauss-Newton Hessian and N the correspondence count (a typical scan's
+/// per-correspondence information when the registration failed).
+Matrix6d registration_information(const RegistrationResult& registration, double frames, double scale);
 
 }  // namespace saloam

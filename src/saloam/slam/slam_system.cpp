@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "saloam/core/lie.hpp"
 #include "saloam/core/profiling.hpp"
@@ -9,13 +10,6 @@
 namespace saloam {
 
 namespace {
-// Guesses closer than this to each other converge to the same fit: one is enough.
-constexpr double kSameGuessTranslation = 1.0;         // [m]
-constexpr double kSameGuessRotation = 5.0 * M_PI / 180;  // [rad]
-// Added to H / N so that a direction no correspondence constrains still has
-// a little information (the edge stays positive definite).
-constexpr double kInformationFloor = 1e-3;
-
 void append(const FeatureCloud& cloud, std::vector<Eigen::Vector3f>& points, std::vector<ClassIndex>& classes) {
   points.reserve(cloud.size());
   for (const auto& p : cloud.points) points.push_back(p.cast<float>());
@@ -209,15 +203,7 @@ LoopRecord SlamSystem::verify(std::size_t query, const Proposal& proposal) const
   // Initial guesses: the current estimates, and the descriptor's yaw (with
   // its x-y offset when it gives one, SSC's) in place.
   std::vector<Pose> guesses{orthonormalized(match_inverse * graph_.pose(query))};
-  if (proposal.match.yaw) {
-    Pose yaw_guess = Pose::Identity();
-    yaw_guess.linear() = Eigen::AngleAxisd(*proposal.match.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    if (proposal.match.translation) yaw_guess.translation().head<2>() = *proposal.match.translation;
-    const Pose difference = guesses.front().inverse() * yaw_guess;
-    if (difference.translation().norm() > kSameGuessTranslation || rotation_angle(difference) > kSameGuessRotation) {
-      guesses.push_back(yaw_guess);
-    }
-  }
+  if (proposal.match.yaw) add_distinct_guess(guesses, place_match_guess(proposal.match));
   LoopRecord record;
   record.query_keyframe = query;
   record.match_keyframe = match;
@@ -244,26 +230,20 @@ void SlamSystem::optimize() {
 }
 
 Matrix6d SlamSystem::information_of(const RegistrationResult& registration, double frames) const {
-  Matrix6d per_correspondence;
-  if (registration.ok && registration.correspondences() > 0) {
-    per_correspondence = registration.hessian / registration.correspondences();
-  } else {
-    // No registration (first frames, or a failure that kept the prediction):
-    // what a typical scan gives, per correspondence.
-    per_correspondence = Matrix6d::Zero();
-    per_correspondence.diagonal() << 0.3, 0.3, 0.3, 30.0, 30.0, 30.0;
-  }
-  const double floor = kInformationFloor * std::max(1e-9, per_correspondence.trace() / 6.0);
-  per_correspondence.diagonal().array() += floor;
-  return config_.slam.information_scale / std::max(1.0, frames) * per_correspondence;
+  return registration_information(registration, frames, config_.slam.information_scale);
 }
 
 std::vector<Pose> SlamSystem::optimized_poses() const {
+  std::vector<Pose> keyframe_poses(keyframes_.size());
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) keyframe_poses[k] = graph_.pose(k);
+  return optimized_poses(keyframe_poses);
+}
+
+std::vector<Pose> SlamSystem::optimized_poses(const std::vector<Pose>& keyframe_poses) const {
+  if (keyframe_poses.size() != keyframes_.size()) throw std::invalid_argument("one pose per keyframe is needed");
   std::vector<Pose> poses;
   const auto& odometry = odometry_.poses();
   poses.reserve(odometry.size());
-  std::vector<Pose> keyframe_poses(keyframes_.size());
-  for (std::size_t k = 0; k < keyframes_.size(); ++k) keyframe_poses[k] = graph_.pose(k);
   for (std::size_t f = 0; f < frame_keyframe_.size(); ++f) {
     const Keyframe& kf = keyframes_[frame_keyframe_[f]];
     poses.push_back(orthonormalized(keyframe_poses[frame_keyframe_[f]] * (kf.odometry_pose.inverse() * odometry[f])));

@@ -85,6 +85,10 @@ class SlamSystem {
 
   /// Every frame's pose after loop closure (world = first frame).
   [[nodiscard]] std::vector<Pose> optimized_poses() const;
+  /// Every frame's pose with the keyframes at `keyframe_poses` (one per
+  /// keyframe, e.g. after a joint optimisation with another map): each frame
+  /// rides on its keyframe with its odometry offset.
+  [[nodiscard]] std::vector<Pose> optimized_poses(const std::vector<Pose>& keyframe_poses) const;
   [[nodiscard]] const std::vector<Pose>& odometry_poses() const { return odometry_.poses(); }
   [[nodiscard]] const std::vector<double>& timestamps() const { return odometry_.timestamps(); }
   [[nodiscard]] const SemanticOdometry& odometry() const { return odometry_; }

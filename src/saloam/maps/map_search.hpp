@@ -1,0 +1,49 @@
+#pragma once
+// Searching a saved map for a place, shared by localisation (localizer.hpp)
+// and the joining of sessions (session_join.hpp): the map keyframes whose
+// place descriptors score best against a query, the verification submap
+// around one of them, and the map keyframes near a position.
+
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "saloam/core/config.hpp"
+#include "saloam/maps/prior_map.hpp"
+#include "saloam/place/place_recognizer.hpp"
+#include "saloam/slam/loop_verification.hpp"
+
+namespace saloam {
+
+/// A map keyframe proposed for verification and its descriptor's score.
+struct PlaceCandidate {
+  std::size_t keyframe = 0;
+  PlaceMatch match;
+};
+
+/// The detector's score threshold (loop.zeta, loop.ssc_zeta or
+/// loop.scancontext_zeta).
+double place_score_threshold(const SaloamConfig& config, PlaceDetector detector);
+
+/// Among `candidates` (map keyframes), those whose descriptor scores above
+/// `threshold` against `query`, best first (ties: the lower index), at most
+/// `count`, and at most one within 5 m of another (neighbouring keyframes are
+/// the same place). With a Scan Context detector only the 100 candidates
+/// with the nearest ring keys (rotation invariant) are scored exactly, as
+/// Scan Context's own retrieval does.
+std::vector<PlaceCandidate> best_places(const PriorMap& map, const PlaceRecognizer& places,
+                                        const PlaceDescriptor& query, std::vector<std::size_t> candidates,
+                                        double threshold, std::size_t count);
+
+/// The verification submap of map keyframe `match`: the keyframes up to
+/// `half_width` either side of it in the same session, in match's sensor frame.
+LoopSubmap submap_around(const PriorMap& map, std::size_t match, std::size_t half_width,
+                         const LoopVerificationSettings& settings);
+
+/// Map keyframes within `radius` of `position`, ascending, thinned so that
+/// none lies within `spacing` of one kept before it.
+std::vector<std::size_t> thinned_near(const PriorMap& map, const Eigen::Vector3d& position, double radius,
+                                      double spacing);
+
+}  // namespace saloam
