@@ -141,9 +141,9 @@ struct OdometryConfig {
   /// labels (ground gives none) cross the rings upright; a level line is
   /// mostly one ring's footprint seen by several frames, whose height moves
   /// with the sensor (z = range * tan(elevation)): fitted as a line, it pulls
-  /// the pitch, most with 16 beams (docs/odometry.md, "Level edge lines";
-  /// 0.5 there). 0 (off): pending a false relocalisation it causes (ibid.).
-  double level_line_max_rise = 0;
+  /// the pitch, most with 16 beams (docs/odometry.md, "Level edge lines":
+  /// 0.5, lines rising less than 30 degrees). 0: off, every line a line.
+  double level_line_max_rise = 0.5;
   bool use_semantics = true;     ///< false: label-agnostic FLOAM-style baseline
   /// Match within groups of classes that networks confuse and that share a
   /// geometry (ground, building+fence, pole-like, vehicles; see class_group())

@@ -26,7 +26,13 @@ constexpr std::size_t kCoarseStride = 3;
 constexpr double kAmbiguityShifts[] = {-3.0, -1.5, 1.5, 3.0};
 constexpr double kDistinctTranslation = 0.5;
 constexpr double kDistinctRotation = 2.0 * M_PI / 180;
-constexpr int kFineRounds = 3;
+// The fine stage re-associates until a round moves the pose less than the
+// odometry's reassociation_min_translation / _rotation_deg, at most this
+// often: a fit from a descriptor's yaw (no translation known) slides along
+// a street for several rounds before its neighbour sets settle, and a fit
+// judged before that is judged where it happened to stop (docs/loop_closure.md,
+// "Fine-stage rounds").
+constexpr int kFineRounds = 10;
 constexpr int kIterations = 15;
 
 FeatureCloud every_nth(const FeatureCloud& cloud, std::size_t n) {
