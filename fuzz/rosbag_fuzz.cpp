@@ -7,16 +7,32 @@
 
 #include <cstdio>
 #include <fstream>
+#include <system_error>
 
 #include <fmt/format.h>
 
 #include "point_cloud_checks.hpp"
 #include "saloam/sources/rosbag_source.hpp"
 
+namespace {
+/// The file each input is written to: one per process, removed when it ends.
+struct ScratchBag {
+  std::filesystem::path path = std::filesystem::temp_directory_path() / fmt::format("saloam_fuzz_{}.bag", ::getpid());
+  ScratchBag() = default;
+  ScratchBag(const ScratchBag&) = delete;
+  ScratchBag& operator=(const ScratchBag&) = delete;
+  ~ScratchBag() {
+    std::error_code ignored;
+    std::filesystem::remove(path, ignored);
+  }
+};
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace saloam;
   fuzz::quiet_logs();
-  static const std::filesystem::path file = std::filesystem::temp_directory_path() / fmt::format("saloam_fuzz_{}.bag", ::getpid());
+  static const ScratchBag scratch;
+  const std::filesystem::path& file = scratch.path;
   {
     std::ofstream out(file, std::ios::binary | std::ios::trunc);
     out << kRosbagMagic;

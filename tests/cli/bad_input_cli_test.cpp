@@ -15,6 +15,7 @@
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "cli/cli_fixture.hpp"
 #include "testing/test_support.hpp"
 
 namespace saloam {
@@ -25,50 +26,13 @@ using testing::quoted;
 using testing::run_command;
 using testing::TempDir;
 
-std::string saloam_cmd(const std::string& args) { return quoted(testing::cli_path()) + " " + args; }
-
-/// A labelled scan: a few poles and a building wall around the sensor.
-LabelledCloud street_scan() {
-  LabelledCloud cloud;
-  cloud.has_labels = true;
-  for (int k = 0; k < 6; ++k) {
-    const float x = -15.0F + 6.0F * static_cast<float>(k);
-    for (int i = 0; i < 60; ++i) cloud.push_back({x, 5.0F, -1.5F + 0.05F * static_cast<float>(i)}, 0.3F, cls::kPole, 0);
-    for (int i = 0; i < 200; ++i)
-      cloud.push_back({x + 0.02F * static_cast<float>(i), -8.0F, -1.5F + 0.02F * static_cast<float>(i % 50)}, 0.3F,
-                      cls::kBuilding, 0);
-  }
-  return cloud;
-}
+using testing::expect_has;
+using testing::failure_of;
+using testing::saloam_cmd;
 
 /// SEQ with `frames` scans, poses.txt, times.txt and calib.txt.
 fs::path write_sequence(const TempDir& tmp, std::size_t frames = 4) {
-  const fs::path seq = tmp / "seq";
-  SequenceWriter writer(seq);
-  std::vector<Pose> poses;
-  std::vector<double> times;
-  for (std::size_t i = 0; i < frames; ++i) {
-    writer.write_scan(i, street_scan());
-    Pose pose = Pose::Identity();
-    pose.translation() = Eigen::Vector3d(0, 0, 0.1 * static_cast<double>(i));
-    poses.push_back(pose);
-    times.push_back(0.1 * static_cast<double>(i));
-  }
-  writer.write_camera_poses(poses);
-  writer.write_times(times);
-  writer.write_calib(Pose::Identity());
-  return seq;
-}
-
-/// Runs `saloam ARGS`; expects exit status 2 (an input error) and returns the output.
-std::string failure_of(const std::string& args) {
-  std::string output;
-  EXPECT_EQ(run_command(saloam_cmd(args), &output), 2) << args << "\n" << output;
-  return output;
-}
-
-void expect_has(const std::string& output, const std::string& fragment) {
-  EXPECT_NE(output.find(fragment), std::string::npos) << "missing '" << fragment << "' in:\n" << output;
+  return testing::write_street_sequence(tmp / "seq", frames);
 }
 
 TEST(BadInputCli, GapInScanNumbersStopsEveryCommandThatReadsASequence) {

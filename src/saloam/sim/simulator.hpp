@@ -22,6 +22,7 @@
 
 #include "saloam/core/sensor_profile.hpp"
 #include "saloam/core/types.hpp"
+#include "saloam/eval/segmentation_score.hpp"
 #include "saloam/sim/class_shares.hpp"
 #include "saloam/sim/lidar.hpp"
 #include "saloam/sim/label_noise.hpp"

@@ -144,13 +144,17 @@ torch::Tensor image_tensor(const std::vector<float>& image, int channels, int ro
       .contiguous(torch::MemoryFormat::ChannelsLast);
 }
 
-std::vector<std::int16_t> best_classes(const torch::Tensor& pixel_logits, const std::vector<float>& offsets) {
+torch::Tensor offsets_tensor(const std::vector<float>& offsets) {
+  return offsets.empty() ? torch::Tensor() : torch::tensor(offsets, torch::kFloat32);
+}
+
+std::vector<std::int16_t> best_classes(torch::Tensor pixel_logits, const torch::Tensor& offsets) {
   torch::Tensor logits = pixel_logits.squeeze(0);
-  if (!offsets.empty()) {
-    if (static_cast<int64_t>(offsets.size()) != logits.size(2))
-      throw std::runtime_error("logit offsets for " + std::to_string(offsets.size()) + " classes, the network has " +
+  if (offsets.defined()) {
+    if (offsets.numel() != logits.size(2))
+      throw std::runtime_error("logit offsets for " + std::to_string(offsets.numel()) + " classes, the network has " +
                                std::to_string(logits.size(2)));
-    logits = logits + torch::tensor(offsets, torch::kFloat32);
+    logits.add_(offsets);
   }
   const auto best = (logits.slice(2, 1).argmax(2) + 1).to(torch::kInt16).contiguous();
   const auto* p = best.data_ptr<std::int16_t>();

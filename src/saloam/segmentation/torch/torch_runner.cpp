@@ -44,7 +44,7 @@ void check_output(const torch::Tensor& logits, int classes, int rows, int cols) 
 
 class SegNetRunner final : public NetworkRunner {
  public:
-  explicit SegNetRunner(const NetworkSpec& spec) : net_(spec.shape), offsets_(spec.logit_offsets) {
+  explicit SegNetRunner(const NetworkSpec& spec) : net_(spec.shape), offsets_(offsets_tensor(spec.logit_offsets)) {
     load_segnet(net_, spec.weights);
     net_->eval();
     net_->fold_batch_norm();
@@ -63,13 +63,13 @@ class SegNetRunner final : public NetworkRunner {
 
  private:
   SegNet net_;
-  std::vector<float> offsets_;
+  torch::Tensor offsets_;  ///< undefined: no decision bias
 };
 
 class TorchScriptRunner final : public NetworkRunner {
  public:
   explicit TorchScriptRunner(const NetworkSpec& spec)
-      : module_(torch::jit::load(spec.weights)), classes_(spec.shape.classes), offsets_(spec.logit_offsets) {
+      : module_(torch::jit::load(spec.weights)), classes_(spec.shape.classes), offsets_(offsets_tensor(spec.logit_offsets)) {
     module_.eval();
   }
 
@@ -87,7 +87,7 @@ class TorchScriptRunner final : public NetworkRunner {
  private:
   torch::jit::Module module_;
   int classes_;
-  std::vector<float> offsets_;
+  torch::Tensor offsets_;  ///< undefined: no decision bias
 };
 
 std::unique_ptr<NetworkRunner> open(const NetworkSpec& spec) {
