@@ -104,9 +104,8 @@ int run_localize_command(const LocalizeOptions& options) {
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
-  const std::size_t cached = static_cast<std::size_t>(config.localize.cached_keyframes);
-  const std::filesystem::path folder = options.map;
-  const PriorMap map(std::move(saved), [folder](std::size_t k) { return read_map_features(folder, k); }, cached);
+  const PriorMap map =
+      PriorMap::open(options.map, std::move(saved), static_cast<std::size_t>(config.localize.cached_keyframes));
   const double load_s = load_timer.elapsed_s();
   std::cout << fmt::format("map {}: {} keyframes, {} edges ({} loops), detector {}, loaded in {:.2f} s (features on demand)\n",
                            options.map, map.size(), map.saved().edges.size(), map.saved().manifest.loop_edges,

@@ -38,13 +38,11 @@ int run_merge_command(const MergeOptions& options) {
   if (uses_sgpr(parse_place_detector(config.loop.detector))) {
     config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
   }
-  const auto cached = static_cast<std::size_t>(std::max(1, config.localize.cached_keyframes));
-  const fs::path folder_a = options.map_a, folder_b = options.map_b;
-  const PriorMap base(std::move(a), [folder_a](std::size_t k) { return read_map_features(folder_a, k); }, cached);
-  const PriorMap joining(read_map(folder_b), [folder_b](std::size_t k) { return read_map_features(folder_b, k); }, cached);
+  const auto cached = static_cast<std::size_t>(config.localize.cached_keyframes);
+  const PriorMap base = PriorMap::open(options.map_a, std::move(a), cached);
+  const PriorMap joining = PriorMap::open(options.map_b, cached);
   check_map_destination(options.out);
-  const PlaceRecognizer places(parse_place_detector(config.loop.detector), load_loop_network(config),
-                               GraphBuilderConfig{}, ScanContextConfig{}, config.loop.ssc);
+  const PlaceRecognizer places = PlaceRecognizer::from_config(config.loop, load_loop_network(config));
   const JoinedMaps joined = join_maps(base, joining, config, places);
   write_joined_map(options.out, joined, base, joining);
   std::cout << fmt::format("{} ({} keyframes) + {} ({} keyframes) -> {}: {} sessions, {} cross-session loop edges, "

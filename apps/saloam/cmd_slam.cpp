@@ -43,10 +43,8 @@ std::unique_ptr<PriorMap> open_join_map(const SlamOptions& options, SaloamConfig
   SavedMap saved = read_map(options.map);
   if (!options.detector.empty()) throw InputError(options.map, "--detector with --map: the map's detector is used");
   config = options.config.resolve_for_map(saved.config);
-  const std::filesystem::path folder = options.map;
-  const auto cached = static_cast<std::size_t>(std::max(1, config.localize.cached_keyframes));
-  return std::make_unique<PriorMap>(std::move(saved), [folder](std::size_t k) { return read_map_features(folder, k); },
-                                    cached);
+  return std::make_unique<PriorMap>(
+      PriorMap::open(options.map, std::move(saved), static_cast<std::size_t>(config.localize.cached_keyframes)));
 }
 
 void print_summary(const SlamRunResult& r) {

@@ -36,8 +36,7 @@ Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optio
     : config_(config),
       map_(map),
       odometry_(config.odometry),
-      places_(parse_place_detector(config.loop.detector), std::move(network), GraphBuilderConfig{}, ScanContextConfig{},
-              config.loop.ssc),
+      places_(PlaceRecognizer::from_config(config.loop, std::move(network))),
       verification_(LoopVerificationSettings::from_config(config)),
       tracking_(RegistrationSettings::from_config(config.odometry)) {
   tracking_.parallel = false;

@@ -19,7 +19,11 @@ PriorMap::PriorMap(SavedMap map, std::function<StoredFeatures(std::size_t)> load
 }
 
 PriorMap PriorMap::open(const std::filesystem::path& folder, std::size_t cached) {
-  return PriorMap(read_map(folder), [folder](std::size_t k) { return read_map_features(folder, k); }, cached);
+  return open(folder, read_map(folder), cached);
+}
+
+PriorMap PriorMap::open(const std::filesystem::path& folder, SavedMap saved, std::size_t cached) {
+  return PriorMap(std::move(saved), [folder](std::size_t k) { return read_map_features(folder, k); }, cached);
 }
 
 std::shared_ptr<const StoredFeatures> PriorMap::features(std::size_t k) const {

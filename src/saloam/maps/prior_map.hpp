@@ -26,6 +26,9 @@ class PriorMap {
   PriorMap(SavedMap map, std::function<StoredFeatures(std::size_t)> load_features, std::size_t cached);
   /// A map on disk: read_map(folder), features read from it when needed.
   static PriorMap open(const std::filesystem::path& folder, std::size_t cached);
+  /// A map on disk already read (`saved` = read_map(folder)), features read
+  /// from `folder` when needed.
+  static PriorMap open(const std::filesystem::path& folder, SavedMap saved, std::size_t cached);
 
   [[nodiscard]] const SavedMap& saved() const { return map_; }
   [[nodiscard]] std::size_t size() const { return map_.keyframes.size(); }

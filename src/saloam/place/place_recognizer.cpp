@@ -28,6 +28,11 @@ std::string_view place_detector_name(PlaceDetector detector) {
   return "?";
 }
 
+PlaceRecognizer PlaceRecognizer::from_config(const LoopClosureConfig& loop, std::optional<SgprNetwork> network) {
+  return PlaceRecognizer(parse_place_detector(loop.detector), std::move(network), GraphBuilderConfig{},
+                         ScanContextConfig{}, loop.ssc);
+}
+
 PlaceRecognizer::PlaceRecognizer(PlaceDetector detector, std::optional<SgprNetwork> network,
                                  GraphBuilderConfig graph_config, ScanContextConfig context_config,
                                  SscConfig ssc_config)

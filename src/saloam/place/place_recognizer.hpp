@@ -13,6 +13,7 @@
 #include <string_view>
 #include <vector>
 
+#include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/place/scan_context.hpp"
 #include "saloam/place/semantic_scan_context.hpp"
@@ -62,6 +63,10 @@ class PlaceRecognizer {
   /// `network` is required when the detector uses SGPR (std::invalid_argument otherwise).
   PlaceRecognizer(PlaceDetector detector, std::optional<SgprNetwork> network, GraphBuilderConfig graph_config = {},
                   ScanContextConfig context_config = {}, SscConfig ssc_config = {});
+  /// The loop closure's recogniser: `loop.detector` with `loop.ssc`
+  /// (SGPR's `network` when the detector uses it), as SLAM, localisation
+  /// and the joining of sessions describe and match keyframes.
+  static PlaceRecognizer from_config(const LoopClosureConfig& loop, std::optional<SgprNetwork> network);
 
   /// The descriptor of a scan in its sensor frame (SGPR needs labels).
   [[nodiscard]] PlaceDescriptor describe(const LabelledCloud& scan) const;

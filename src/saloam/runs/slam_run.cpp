@@ -331,8 +331,7 @@ JoinedSession join_session(const SlamSystem& slam, const SaloamConfig& config, c
   const auto cached = static_cast<std::size_t>(std::max(1, config.localize.cached_keyframes));
   s.joining = std::make_unique<PriorMap>(saved_map_of(slam, config, manifest),
                                          [&slam](std::size_t k) { return slam.keyframes()[k].features; }, cached);
-  const PlaceRecognizer places(parse_place_detector(config.loop.detector), load_loop_network(config),
-                               GraphBuilderConfig{}, ScanContextConfig{}, config.loop.ssc);
+  const PlaceRecognizer places = PlaceRecognizer::from_config(config.loop, load_loop_network(config));
   s.joined = join_maps(map, *s.joining, config, places);
   std::vector<Pose> keyframe_poses;
   for (std::size_t k = 0; k < slam.keyframes().size(); ++k) {

@@ -43,8 +43,7 @@ std::size_t StoredFeatures::bytes() const {
 SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> network)
     : config_(config),
       odometry_(config.odometry),
-      places_(parse_place_detector(config.loop.detector), std::move(network), GraphBuilderConfig{}, ScanContextConfig{},
-              config.loop.ssc),
+      places_(PlaceRecognizer::from_config(config.loop, std::move(network))),
       gate_(CandidateGate::from_config(config.loop)),
       verification_(LoopVerificationSettings::from_config(config)),
       graph_options_(PoseGraphOptions::from_config(config.slam)),
