@@ -20,6 +20,7 @@
 #include "saloam/io/trajectory_io.hpp"
 #include "saloam/maps/prior_map.hpp"
 #include "saloam/runs/localize_run.hpp"
+#include "saloam/runs/session_eval.hpp"
 #include "saloam/runs/slam_run.hpp"
 
 namespace saloam::cli {
@@ -33,38 +34,13 @@ struct LocalizeOptions {
   ConfigOptions config;
 };
 
-/// "origin" and "passes" of a simulated pass (simulation.yaml), when the folder has them.
-struct SimulatedPass {
-  Pose origin;
-  std::string passes;
-};
-std::optional<SimulatedPass> simulated_pass(const std::filesystem::path& folder) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(folder / "simulation.yaml", ec)) return std::nullopt;
-  std::istringstream lines(read_file(folder / "simulation.yaml", 1 << 16, "simulation record"));
-  SimulatedPass pass;
-  bool origin = false;
-  for (std::string line; std::getline(lines, line);) {
-    if (line.starts_with("passes: ")) pass.passes = line.substr(8);
-    if (line.starts_with("origin: ")) {
-      std::istringstream numbers(line.substr(8));
-      double v[12];
-      origin = true;
-      for (double& x : v) origin = origin && static_cast<bool>(numbers >> x);
-      if (origin) pass.origin = orthonormalized(pose_from_3x4(v));
-    }
-  }
-  if (!origin || pass.passes.empty()) return std::nullopt;
-  return pass;
-}
-
 /// T_map<-L0 when the map and the scans are passes of one simulated world
 /// (`simulate --passes`), both from their first frame: the truth to judge
 /// relocalisations by.
 std::optional<Pose> simulated_truth(const PriorMap& map, const SourceInfo& info) {
   const MapManifest& m = map.saved().manifest;
   if (m.source.empty() || !info.folder || m.first_frame != 0 || info.first_frame != 0) return std::nullopt;
-  const auto map_pass = simulated_pass(m.source), run_pass = simulated_pass(*info.folder);
+  const auto map_pass = read_simulated_pass(m.source), run_pass = read_simulated_pass(*info.folder);
   if (!map_pass || !run_pass || map_pass->passes != run_pass->passes) return std::nullopt;
   return orthonormalized(map_pass->origin.inverse() * run_pass->origin);
 }

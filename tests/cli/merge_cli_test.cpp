@@ -1,5 +1,6 @@
 // End-to-end: `saloam slam --map` (a second pass joins a saved map) and
-// `saloam merge` on two short passes of one simulated world.
+// `saloam merge` on two short passes of one simulated world, and `saloam
+// eval --map` of the merged map.
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,34 @@ TEST(MergeCli, JoinsASecondPassAndMergesTwoMaps) {
   EXPECT_TRUE(merged["sessions"][1]["linked"].get<bool>());
   EXPECT_EQ(merged["cross_session_loops"], joined["cross_session_loops"]);
   EXPECT_EQ(merged["keyframes"], joined["keyframes"]);
+
+  // Per-session error of the merged map against both passes' truth.
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("eval --map {} --gt {} --gt {} --json {}", quoted(dir / "merged"),
+                                               quoted(dir / "pass0"), quoted(dir / "pass1"), quoted(dir / "eval.json"))),
+                        &output),
+            0)
+      << output;
+  const auto eval = nlohmann::json::parse(file_text(dir / "eval.json"));
+  ASSERT_EQ(eval["sessions"].size(), 2u) << eval.dump(1);
+  for (const auto& session : eval["sessions"]) {
+    EXPECT_TRUE(session["linked"].get<bool>());
+    EXPECT_GT(session["aligned_m"]["count"].get<int>(), 10);
+    EXPECT_LT(session["aligned_m"]["rmse"].get<double>(), 0.5) << eval.dump(1);
+  }
+  EXPECT_EQ(eval["cross_session_loops"]["false"].get<int>(), 0);
+  EXPECT_EQ(eval["cross_session_loops"]["true"], merged["cross_session_loops"]);
+  // One truth for two sessions, or --est with --map: refused.
+  EXPECT_EQ(run_command(saloam_cmd(fmt::format("eval --map {} --gt {}", quoted(dir / "merged"), quoted(dir / "pass0"))),
+                        &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("2 sessions, 1 ground truths"), std::string::npos) << output;
+  EXPECT_EQ(run_command(saloam_cmd(fmt::format("eval --map {} --gt {} --gt {} --est {}", quoted(dir / "merged"),
+                                               quoted(dir / "pass0"), quoted(dir / "pass1"),
+                                               quoted(dir / "slampass1" / "poses.txt"))),
+                        &output),
+            2)
+      << output;
 }
 
 }  // namespace

@@ -193,10 +193,15 @@ void Localizer::confirm(LocalizedFrame& out) {
   record.pose = record.verification.relative;
   out.inlier_fraction = record.verification.inlier_fraction;
   out.mean_residual = record.verification.mean_residual;
+  if (record.verification.accepted && small_correction(predicted, record.verification.relative)) {
+    require_measured_motion(record.verification, odometry_.last_features(), submap_->features, h.last_pose,
+                            verification_);
+  }
   const bool agrees = record.verification.accepted && small_correction(predicted, record.verification.relative);
   if (agrees) {
     h.map_from_odometry = orthonormalized(record.verification.relative * out.odometry_pose.inverse());
     h.last_fix = travelled_;
+    h.last_pose = record.verification.relative;
     if (--h.confirmations_left <= 0) {
       record.outcome = "confirmed";
       map_from_odometry_ = h.map_from_odometry;
@@ -268,6 +273,7 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
       h.map_from_odometry = orthonormalized(record.pose * out.odometry_pose.inverse());
       h.confirmations_left = config_.localize.confirmations;
       h.last_fix = travelled_;
+      h.last_pose = record.pose;
       if (h.confirmations_left <= 0) {
         record.outcome = "confirmed";
         map_from_odometry_ = h.map_from_odometry;

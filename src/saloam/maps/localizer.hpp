@@ -12,7 +12,9 @@
 //  * Hypothesis: localize.confirmations later fixes, confirm_interval metres
 //    apart, must agree: each registers the scan against the map around the
 //    pose the odometry predicts from the hypothesis and must pass the same
-//    acceptance test with a small correction. Then the run is placed
+//    acceptance test with a small correction; registered again from the
+//    last fix's pose (without the odometry's motion since), it must land
+//    on the same pose: the map, not the prediction, fixes it. Then the run is placed
 //    ("relocalised"); a fix that fails refutes the hypothesis. Frames before
 //    the confirmation are not placed (no pose is guessed).
 //  * Tracking: every localize.track_every-th frame registers against the
@@ -110,6 +112,7 @@ class Localizer {
     Pose map_from_odometry;
     int confirmations_left = 0;
     double last_fix = 0;  ///< travelled at the last fix
+    Pose last_pose = Pose::Identity();  ///< T_map<-sensor at the last fix
   };
   struct Submap;
 

@@ -41,6 +41,18 @@ std::vector<PlaceCandidate> best_places(const PriorMap& map, const PlaceRecogniz
 LoopSubmap submap_around(const PriorMap& map, std::size_t match, std::size_t half_width,
                          const LoopVerificationSettings& settings);
 
+/// Whether the map itself measures the motion the odometry claims since the
+/// last fix of a hypothesis: `query` registered against `submap` from
+/// `last_fix` (the pose of the last fix, without the odometry's motion since;
+/// in the submap's frame) must land within 0.5 m and 2 degrees of where
+/// `fit` (its verification from the prediction) landed. A fit that follows
+/// the prediction because the map constrains nothing along the street (a
+/// hypothesis turned the wrong way along it slides with the wrongly
+/// predicted motion) stays near `last_fix` instead: then `fit` is marked not
+/// accepted, with the reason. Nothing is done when `fit` was not accepted.
+void require_measured_motion(LoopVerification& fit, const ScanFeatures& query, const LoopSubmap& submap,
+                             const Pose& last_fix, const LoopVerificationSettings& settings);
+
 /// Map keyframes within `radius` of `position`, ascending, thinned so that
 /// none lies within `spacing` of one kept before it.
 std::vector<std::size_t> thinned_near(const PriorMap& map, const Eigen::Vector3d& position, double radius,

@@ -48,20 +48,29 @@ class SessionJoiner {
     Pose base_from_joining;
     int confirmations_left = 0;
     double last_fix = 0;
+    Pose last_pose = Pose::Identity();  ///< T_base<-joining keyframe at the last fix
     std::vector<CrossEdge> edges;
   };
 
   void relocalize(std::size_t q);
   void confirm(std::size_t q);
   void search_loop(std::size_t q);
-  /// Registers joining keyframe q against the base keyframes near `predicted` (T_base<-q).
-  CrossSessionRecord fit_near(std::size_t q, const Pose& predicted) const;
+  /// Registers joining keyframe q against the base keyframes near `predicted`
+  /// (T_base<-q); accepted only when the base map measures the motion since
+  /// `last_fix` (T_base<-keyframe of the hypothesis' last fix; require_measured_motion).
+  CrossSessionRecord fit_near(std::size_t q, const Pose& predicted, const Pose& last_fix) const;
   CrossSessionRecord verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses) const;
   [[nodiscard]] CrossEdge edge_of(const CrossSessionRecord& r) const {
     return {r.match, r.query, r.verification.relative,
             registration_information(r.verification.registration, 1.0, config_.slam.information_scale)};
   }
   [[nodiscard]] bool small_correction(const Pose& predicted, const Pose& fitted) const;
+  /// A cross-session loop after the link may correct the link's prediction
+  /// only as much as the joining map drifts: localize.track_max_correction
+  /// (m, deg), times loop.sigma * `since` / track_max_correction where that
+  /// is more (`since`: path since the last cross-session loop). Else `r` is
+  /// marked not accepted: another place that looks alike.
+  void require_link_agrees(CrossSessionRecord& r, const Pose& predicted, double since) const;
   void link(std::size_t q, const Hypothesis& h);
   JoinedMaps assemble() const;
   std::vector<Pose> optimize(JoinedMaps& out) const;
@@ -139,6 +148,7 @@ void SessionJoiner::relocalize(std::size_t q) {
     h.base_from_joining = orthonormalized(r.pose * joining_.pose(q).inverse());
     h.confirmations_left = config_.localize.confirmations;
     h.last_fix = path_[q];
+    h.last_pose = r.pose;
     h.edges.push_back(edge_of(r));
     r.outcome = h.confirmations_left <= 0 ? "confirmed" : "hypothesis";
     records_.push_back(std::move(r));
@@ -151,7 +161,7 @@ void SessionJoiner::relocalize(std::size_t q) {
   }
 }
 
-CrossSessionRecord SessionJoiner::fit_near(std::size_t q, const Pose& predicted) const {
+CrossSessionRecord SessionJoiner::fit_near(std::size_t q, const Pose& predicted, const Pose& last_fix) const {
   const LocalizeConfig& lc = config_.localize;
   CrossSessionRecord r;
   r.query = q;
@@ -170,8 +180,10 @@ CrossSessionRecord SessionJoiner::fit_near(std::size_t q, const Pose& predicted)
   LoopSubmap submap(verification_);
   for (const std::size_t k : near) submap.add(base_.features(k)->expand(), match_inverse * base_.pose(k));
   const std::vector<Pose> guesses{orthonormalized(match_inverse * predicted)};
-  r.verification = verify_loop(joining_.features(q)->expand(), submap, guesses, verification_);
+  const ScanFeatures query = joining_.features(q)->expand();
+  r.verification = verify_loop(query, submap, guesses, verification_);
   r.pose = orthonormalized(base_.pose(r.match) * r.verification.relative);
+  require_measured_motion(r.verification, query, submap, match_inverse * last_fix, verification_);
   return r;
 }
 
@@ -185,7 +197,7 @@ void SessionJoiner::confirm(std::size_t q) {
   Hypothesis& h = *hypothesis_;
   if (path_[q] - h.last_fix < config_.localize.confirm_interval) return;
   const Pose predicted = orthonormalized(h.base_from_joining * joining_.pose(q));
-  CrossSessionRecord r = fit_near(q, predicted);
+  CrossSessionRecord r = fit_near(q, predicted, h.last_pose);
   if (!r.verification.accepted || !small_correction(predicted, r.pose)) {
     r.outcome = "refuted";
     records_.push_back(std::move(r));
@@ -195,6 +207,7 @@ void SessionJoiner::confirm(std::size_t q) {
   }
   h.base_from_joining = orthonormalized(r.pose * joining_.pose(q).inverse());
   h.last_fix = path_[q];
+  h.last_pose = r.pose;
   h.edges.push_back(edge_of(r));
   const bool confirmed = --h.confirmations_left <= 0;
   r.outcome = confirmed ? "confirmed" : "confirms";
@@ -215,6 +228,21 @@ void SessionJoiner::link(std::size_t q, const Hypothesis& h) {
                h.edges.size());
 }
 
+void SessionJoiner::require_link_agrees(CrossSessionRecord& r, const Pose& predicted, double since) const {
+  if (!r.verification.accepted) return;
+  const LocalizeConfig& lc = config_.localize;
+  const double scale = std::max(1.0, config_.loop.sigma * since / lc.track_max_correction);
+  const Pose difference = predicted.inverse() * r.pose;
+  const double degrees = rotation_angle(difference) * 180 / M_PI;
+  if (difference.translation().norm() <= scale * lc.track_max_correction && degrees <= scale * lc.track_max_correction_deg) {
+    return;
+  }
+  r.verification.accepted = false;
+  r.verification.reason = fmt::format("moves the link by {:.1f} m, {:.1f} deg (at most {:.1f} m, {:.1f} deg after {:.0f} m)",
+                                      difference.translation().norm(), degrees, scale * lc.track_max_correction,
+                                      scale * lc.track_max_correction_deg, since);
+}
+
 void SessionJoiner::search_loop(std::size_t q) {
   if (path_[q] - last_loop_ < config_.loop.search_interval_after_loop) return;
   const Pose predicted = orthonormalized(*base_from_joining_ * joining_.pose(q));
@@ -224,6 +252,7 @@ void SessionJoiner::search_loop(std::size_t q) {
       best_places(base_, places_, joining_.place(q), base_.near(predicted.translation(), radius), threshold_, n);
   for (const PlaceCandidate& c : candidates) {
     CrossSessionRecord r = verify(q, c, {orthonormalized(base_.pose(c.keyframe).inverse() * predicted)});
+    require_link_agrees(r, predicted, path_[q] - last_loop_);
     const bool accepted = r.verification.accepted;
     r.outcome = accepted ? "loop" : "rejected loop";
     if (accepted) {

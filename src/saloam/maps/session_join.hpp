@@ -16,14 +16,18 @@
 //    localize.confirmations later keyframes, localize.confirm_interval
 //    metres apart, must register against the base keyframes near the pose
 //    the hypothesis predicts (the acceptance test, a correction below
-//    localize.track_max_correction); a failing one refutes it. Confirmed,
+//    localize.track_max_correction, and registered again from the last
+//    fix's pose the same pose: map_search.hpp's require_measured_motion);
+//    a failing one refutes it. Confirmed,
 //    the hypothesis and its confirmations become cross-session loop edges and
 //    the joining map is linked. Before that it is a component of its own.
 //  * Linked: from then on each keyframe (after an accepted loop, once per
 //    loop.search_interval_after_loop metres) searches the base keyframes
 //    within Eq. 3's radius of where the link puts it (the path since the
 //    last cross-session loop as d), scores and verifies them as loops; an
-//    accepted one is a further edge and updates the link.
+//    accepted one that moves the link no more than the joining map drifts
+//    (localize.track_max_correction, growing with loop.sigma * d) is a
+//    further edge and updates the link.
 //
 // Linked, one pose graph over both maps (both maps' edges and the
 // cross-session ones) is optimised from the base poses and the joining
