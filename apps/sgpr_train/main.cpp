@@ -99,9 +99,9 @@ SgprTrainArgs with_run_options(SgprTrainArgs args, const CLI::App& app, const fs
   return args;
 }
 
-int run_sgpr_train(const SgprTrainArgs& given, const CLI::App& app) {
-  const SgprTrainArgs args = given.resume.empty() ? given : with_run_options(given, app, given.resume);
-  SgprTrainOptions options;
+/// Where the run goes: --out for a new run (not one that holds a run
+/// already), or --resume's folder.
+void choose_output(const SgprTrainArgs& args, SgprTrainOptions& options) {
   if (!args.resume.empty()) {
     if (!args.out.empty() && fs::path(args.out) != fs::path(args.resume))
       throw ConfigError("--resume DIR continues the run in DIR: leave out --out (or give the same folder)");
@@ -115,9 +115,10 @@ int run_sgpr_train(const SgprTrainArgs& given, const CLI::App& app) {
   if (!options.resume && fs::exists(options.out / "checkpoint"))
     throw ConfigError(fmt::format("{} already holds a training run: continue it with --resume {} or choose another --out",
                                   options.out.string(), options.out.string()));
-  const fs::path recipe_file = !args.data.empty() ? fs::path(args.data) : options.out / "recipe.yaml";
-  if (args.data.empty() && !options.resume) throw ConfigError("--data RECIPE.yaml is required for a new run");
-  const DataRecipe recipe = read_data_recipe(recipe_file);
+}
+
+/// The options given on the command line (and --resume's run).
+void take_options(const SgprTrainArgs& args, SgprTrainOptions& options) {
   if (!args.init.empty()) {
     require_file(args.init, "initial SGPR weights");
     if (fs::weakly_canonical(args.init).parent_path() == fs::weakly_canonical(options.out))
@@ -137,40 +138,60 @@ int run_sgpr_train(const SgprTrainArgs& given, const CLI::App& app) {
   options.augment.jitter_sigma = args.jitter;
   options.augment.jitter_clip = 3.0 * args.jitter;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
-  keep_recipe(options.out, recipe);
+}
 
-  const auto train = build_sequences(recipe.train, options.out, !args.no_cache);
-  if (stop_requested()) return 130;
-  const auto validation = build_sequences(recipe.validation, options.out, !args.no_cache);
-  if (stop_requested()) return 130;
-
+/// What training.json records of the data.
+nlohmann::json data_info(const DataRecipe& recipe, const std::vector<GraphSequence>& train) {
   nlohmann::json info;
   info["data"] = recipe_to_json(recipe);
   info["training_graphs"] = 0;
   for (const auto& s : train) info["training_graphs"] = info["training_graphs"].get<std::size_t>() + s.graphs.size();
+  return info;
+}
+
+void print_start(const SgprTrainOptions& options) {
   std::cout << fmt::format("sgpr-train: {} from {}, {} epochs, batch {}, lr {:g}, seed {}, {} thread(s)\n",
                            options.resume ? "resuming" : "training",
                            options.resume ? options.out.string() : options.init.empty() ? "scratch" : options.init.string(),
                            options.epochs, options.batch, options.optimizer.learning_rate, options.seed, options.threads);
-  double best = 0;
-  const auto result = train_sgpr(train, validation, options, info, [&](const EpochRecord& r) {
-    best = std::max(best, r.val_max_f1);
-    std::cout << fmt::format("epoch {:>3}/{}: loss {:.4f}, {:.0f} pairs/s, validation max F1 {:.4f} (recall at 100 % "
-                             "precision {:.3f}), {:.0f} s\n",
-                             r.epoch, options.epochs, r.loss, r.pairs_per_second, r.val_max_f1,
-                             r.val_recall_at_full_precision, r.seconds)
-              << std::flush;
-  });
+}
+
+void print_epoch(const EpochRecord& r, int epochs) {
+  std::cout << fmt::format("epoch {:>3}/{}: loss {:.4f}, {:.0f} pairs/s, validation max F1 {:.4f} (recall at 100 % "
+                           "precision {:.3f}), {:.0f} s\n",
+                           r.epoch, epochs, r.loss, r.pairs_per_second, r.val_max_f1, r.val_recall_at_full_precision,
+                           r.seconds)
+            << std::flush;
+}
+
+void print_result(const SgprTrainResult& result, const SgprTrainOptions& options) {
   std::cout << fmt::format("validation max F1: initial weights {:.4f}, best {:.4f} (epoch {}); wrote {} (best), {} "
                            "(last), training.json, curves.png\n",
                            result.initial_val_max_f1,
                            result.best_epoch == 0 ? result.initial_val_max_f1
                                                   : result.history.at(static_cast<std::size_t>(result.best_epoch - 1)).val_max_f1,
                            result.best_epoch, (options.out / "best.sgw").string(), (options.out / "model.sgw").string());
-  if (result.interrupted) return 130;
-  return 0;
 }
 
+int run_sgpr_train(const SgprTrainArgs& given, const CLI::App& app) {
+  const SgprTrainArgs args = given.resume.empty() ? given : with_run_options(given, app, given.resume);
+  SgprTrainOptions options;
+  choose_output(args, options);
+  if (args.data.empty() && !options.resume) throw ConfigError("--data RECIPE.yaml is required for a new run");
+  const DataRecipe recipe = read_data_recipe(!args.data.empty() ? fs::path(args.data) : options.out / "recipe.yaml");
+  take_options(args, options);
+  keep_recipe(options.out, recipe);
+
+  const auto train = build_sequences(recipe.train, options.out, !args.no_cache);
+  if (stop_requested()) return 130;
+  const auto validation = build_sequences(recipe.validation, options.out, !args.no_cache);
+  if (stop_requested()) return 130;
+  print_start(options);
+  const auto result = train_sgpr(train, validation, options, data_info(recipe, train),
+                                 [&](const EpochRecord& r) { print_epoch(r, options.epochs); });
+  print_result(result, options);
+  return result.interrupted ? 130 : 0;
+}
 
 std::function<int()> add_sgpr_train_options(CLI::App& app) {
   auto args = std::make_shared<SgprTrainArgs>();

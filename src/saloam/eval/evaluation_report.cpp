@@ -20,6 +20,72 @@ nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : 
 
 constexpr std::array<const char*, 3> kAxisNames{"x", "y", "z"};
 
+nlohmann::json kitti_json(const KittiMetrics& kitti) {
+  nlohmann::json j;
+  j["t_err_percent"] = number(kitti.t_err_percent);
+  j["r_err_deg_per_100m"] = number(kitti.r_err_deg_per_100m);
+  j["segments"] = kitti.segments;
+  j["per_length"] = nlohmann::json::array();
+  for (const auto& l : kitti.per_length) {
+    j["per_length"].push_back({{"length_m", l.length_m},
+                               {"t_err_percent", number(l.t_err_percent)},
+                               {"r_err_deg_per_100m", number(l.r_err_deg_per_100m)},
+                               {"segments", l.segments}});
+  }
+  return j;
+}
+
+/// ATE statistics (aligned and unaligned), the alignment transform, and per pose the aligned errors.
+nlohmann::json ate_json(const AteMetrics& ate, bool per_frame) {
+  nlohmann::json j;
+  j["alignment"] = alignment_name(ate.alignment);
+  for (const auto& [suffix, s] : {std::pair{"aligned", ate.aligned}, std::pair{"unaligned", ate.unaligned}}) {
+    j[fmt::format("rmse_{}", suffix)] = number(s.rmse);
+    j[fmt::format("mean_{}", suffix)] = number(s.mean);
+    j[fmt::format("median_{}", suffix)] = number(s.median);
+    j[fmt::format("max_{}", suffix)] = number(s.max);
+  }
+  j["scale"] = ate.transform.scale;
+  nlohmann::json rotation = nlohmann::json::array();
+  for (int r = 0; r < 3; ++r) {
+    rotation.push_back({ate.transform.rotation(r, 0), ate.transform.rotation(r, 1), ate.transform.rotation(r, 2)});
+  }
+  j["rotation"] = rotation;
+  j["translation"] = {ate.transform.translation.x(), ate.transform.translation.y(), ate.transform.translation.z()};
+  if (per_frame) j["per_pose_aligned_m"] = ate.aligned_errors;
+  return j;
+}
+
+nlohmann::json rpe_json(const RpeMetrics& rpe, bool per_frame) {
+  nlohmann::json j;
+  j["delta"] = rpe.delta;
+  j["trans_rmse_m"] = number(rpe.trans.rmse);
+  j["trans_mean_m"] = number(rpe.trans.mean);
+  j["trans_median_m"] = number(rpe.trans.median);
+  j["trans_max_m"] = number(rpe.trans.max);
+  j["rot_rmse_deg"] = number(rpe.rot.rmse);
+  j["rot_mean_deg"] = number(rpe.rot.mean);
+  j["rot_median_deg"] = number(rpe.rot.median);
+  j["rot_max_deg"] = number(rpe.rot.max);
+  if (per_frame) {
+    j["per_frame_trans_m"] = rpe.trans_errors_m;
+    j["per_frame_rot_deg"] = rpe.rot_errors_deg;
+  }
+  return j;
+}
+
+nlohmann::json bias_json(const ScaleBias& bias) {
+  nlohmann::json j;
+  j["delta"] = bias.delta;
+  j["windows"] = bias.windows;
+  j["length_m"] = number(bias.length_m);
+  j["forward_percent"] = number(bias.forward_percent);
+  j["lateral_percent"] = number(bias.lateral_percent);
+  j["vertical_percent"] = number(bias.vertical_percent);
+  j["body_up"] = {bias.body_up.x(), bias.body_up.y(), bias.body_up.z()};
+  return j;
+}
+
 }  // namespace
 
 std::string format_metric(double value, int decimals) {
@@ -27,8 +93,7 @@ std::string format_metric(double value, int decimals) {
 }
 
 nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const EvaluationLabels& labels, bool per_frame) {
-  using nlohmann::json;
-  json j;
+  nlohmann::json j;
   j["gt"] = labels.gt_name;
   j["est"] = labels.est_name;
   j["alignment"] = alignment_name(ev.ate.alignment);
@@ -36,64 +101,10 @@ nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const Evaluati
   j["gt_poses"] = ev.gt_poses;
   j["est_poses"] = ev.est_poses;
   j["gt_length_m"] = number(ev.gt_length_m);
-
-  json kitti;
-  kitti["t_err_percent"] = number(ev.kitti.t_err_percent);
-  kitti["r_err_deg_per_100m"] = number(ev.kitti.r_err_deg_per_100m);
-  kitti["segments"] = ev.kitti.segments;
-  kitti["per_length"] = json::array();
-  for (const auto& l : ev.kitti.per_length) {
-    kitti["per_length"].push_back({{"length_m", l.length_m},
-                                   {"t_err_percent", number(l.t_err_percent)},
-                                   {"r_err_deg_per_100m", number(l.r_err_deg_per_100m)},
-                                   {"segments", l.segments}});
-  }
-  j["kitti"] = kitti;
-
-  json ate;
-  ate["alignment"] = alignment_name(ev.ate.alignment);
-  for (const auto& [suffix, s] : {std::pair{"aligned", ev.ate.aligned}, std::pair{"unaligned", ev.ate.unaligned}}) {
-    ate[fmt::format("rmse_{}", suffix)] = number(s.rmse);
-    ate[fmt::format("mean_{}", suffix)] = number(s.mean);
-    ate[fmt::format("median_{}", suffix)] = number(s.median);
-    ate[fmt::format("max_{}", suffix)] = number(s.max);
-  }
-  ate["scale"] = ev.ate.transform.scale;
-  json rotation = json::array();
-  for (int r = 0; r < 3; ++r) {
-    rotation.push_back({ev.ate.transform.rotation(r, 0), ev.ate.transform.rotation(r, 1), ev.ate.transform.rotation(r, 2)});
-  }
-  ate["rotation"] = rotation;
-  ate["translation"] = {ev.ate.transform.translation.x(), ev.ate.transform.translation.y(),
-                        ev.ate.transform.translation.z()};
-  if (per_frame) ate["per_pose_aligned_m"] = ev.ate.aligned_errors;
-  j["ate"] = ate;
-
-  json rpe;
-  rpe["delta"] = ev.rpe.delta;
-  rpe["trans_rmse_m"] = number(ev.rpe.trans.rmse);
-  rpe["trans_mean_m"] = number(ev.rpe.trans.mean);
-  rpe["trans_median_m"] = number(ev.rpe.trans.median);
-  rpe["trans_max_m"] = number(ev.rpe.trans.max);
-  rpe["rot_rmse_deg"] = number(ev.rpe.rot.rmse);
-  rpe["rot_mean_deg"] = number(ev.rpe.rot.mean);
-  rpe["rot_median_deg"] = number(ev.rpe.rot.median);
-  rpe["rot_max_deg"] = number(ev.rpe.rot.max);
-  if (per_frame) {
-    rpe["per_frame_trans_m"] = ev.rpe.trans_errors_m;
-    rpe["per_frame_rot_deg"] = ev.rpe.rot_errors_deg;
-  }
-  j["rpe"] = rpe;
-
-  json bias;
-  bias["delta"] = ev.bias.delta;
-  bias["windows"] = ev.bias.windows;
-  bias["length_m"] = number(ev.bias.length_m);
-  bias["forward_percent"] = number(ev.bias.forward_percent);
-  bias["lateral_percent"] = number(ev.bias.lateral_percent);
-  bias["vertical_percent"] = number(ev.bias.vertical_percent);
-  bias["body_up"] = {ev.bias.body_up.x(), ev.bias.body_up.y(), ev.bias.body_up.z()};
-  j["scale_bias"] = bias;
+  j["kitti"] = kitti_json(ev.kitti);
+  j["ate"] = ate_json(ev.ate, per_frame);
+  j["rpe"] = rpe_json(ev.rpe, per_frame);
+  j["scale_bias"] = bias_json(ev.bias);
   j["warnings"] = ev.warnings;
   return j;
 }

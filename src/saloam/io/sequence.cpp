@@ -62,6 +62,58 @@ std::vector<fs::path> numbered_scans(const fs::path& velodyne) {
   return scans;
 }
 
+/// The labels folder: `given` (which must exist), else `root`/labels (which may not).
+fs::path labels_folder(const fs::path& root, const std::optional<fs::path>& given) {
+  if (!given) return root / "labels";
+  std::error_code ec;
+  if (!fs::is_directory(*given, ec)) throw InputError(*given, "labels folder not found");
+  return *given;
+}
+
+/// Per scan, its .label file in `labels_dir` (same stem); empty when the
+/// folder holds none of them. Throws InputError when only some scans have
+/// one, or when the folder was `asked_for` and holds none.
+std::vector<std::optional<fs::path>> matching_labels(const std::vector<fs::path>& scans, const fs::path& labels_dir,
+                                                     bool asked_for) {
+  std::vector<std::optional<fs::path>> labels;
+  std::size_t found = 0;
+  std::error_code ec;
+  for (const auto& scan : scans) {
+    fs::path label = labels_dir / scan.filename();
+    label.replace_extension(".label");
+    if (fs::is_regular_file(label, ec)) {
+      labels.emplace_back(label);
+      ++found;
+    } else {
+      labels.emplace_back(std::nullopt);
+    }
+  }
+  if (found > 0 && found != scans.size()) {
+    const auto missing = std::find(labels.begin(), labels.end(), std::nullopt) - labels.begin();
+    throw InputError(labels_dir, fmt::format("labels for {} of {} scans; first missing: {}", found, scans.size(),
+                                             scans[static_cast<std::size_t>(missing)].stem().string() + ".label"));
+  }
+  if (found == 0 && asked_for) throw InputError(labels_dir, "no .label files matching the scans");
+  if (found == 0) labels.clear();
+  return labels;
+}
+
+/// The first `count` entries of what `file` holds (a sequence may hold only
+/// its first scans); throws InputError when it holds fewer.
+template <typename T>
+std::vector<T> first_entries(std::vector<T> entries, std::size_t count, const fs::path& file, const char* what) {
+  if (entries.size() < count) throw InputError(file, fmt::format("{} {} for {} scans", entries.size(), what, count));
+  entries.resize(count);
+  return entries;
+}
+
+/// Scan times without a times.txt: 10 Hz from 0 s.
+std::vector<double> nominal_times(std::size_t count) {
+  std::vector<double> times(count);
+  for (std::size_t i = 0; i < count; ++i) times[i] = 0.1 * static_cast<double>(i);
+  return times;
+}
+
 }  // namespace
 
 SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
@@ -75,57 +127,22 @@ SequenceReader::SequenceReader(fs::path root, SequenceOptions options)
   if (!fs::is_directory(velodyne, ec)) throw InputError(velodyne, "missing velodyne/ folder of .bin scans");
   scan_files_ = numbered_scans(velodyne);
 
-  // Labels: a predictions folder if given, else labels/ when it exists.
-  fs::path labels_dir = root_ / "labels";
-  if (options_.labels_dir) {
-    labels_dir = *options_.labels_dir;
-    if (!fs::is_directory(labels_dir, ec)) throw InputError(labels_dir, "labels folder not found");
-  }
+  const fs::path labels_dir = labels_folder(root_, options_.labels_dir);
   if (!options_.ignore_labels && fs::is_directory(labels_dir, ec)) {
-    std::size_t found = 0;
-    for (const auto& scan : scan_files_) {
-      fs::path label = labels_dir / scan.filename();
-      label.replace_extension(".label");
-      if (fs::is_regular_file(label, ec)) {
-        label_files_.emplace_back(label);
-        ++found;
-      } else {
-        label_files_.emplace_back(std::nullopt);
-      }
-    }
-    if (found > 0 && found != scan_files_.size()) {
-      const auto missing = std::find(label_files_.begin(), label_files_.end(), std::nullopt) - label_files_.begin();
-      throw InputError(labels_dir, fmt::format("labels for {} of {} scans; first missing: {}", found,
-                                               scan_files_.size(),
-                                               scan_files_[static_cast<std::size_t>(missing)].stem().string() + ".label"));
-    }
-    if (found == 0 && options_.labels_dir) throw InputError(labels_dir, "no .label files matching the scans");
-    labels_available_ = found > 0;
+    label_files_ = matching_labels(scan_files_, labels_dir, options_.labels_dir.has_value());
   }
+  labels_available_ = !label_files_.empty();
   if (!labels_available_) label_files_.assign(scan_files_.size(), std::nullopt);
 
   // Absent is allowed; anything in their place (a folder, a link to a
   // device, a FIFO) is read and refused by the reader, never taken for absent.
   const fs::path times_file = root_ / "times.txt";
-  if (path_taken(times_file)) {
-    times_ = read_times(times_file);
-    if (times_.size() < scan_files_.size()) {
-      throw InputError(times_file, fmt::format("{} timestamps for {} scans", times_.size(), scan_files_.size()));
-    }
-    times_.resize(scan_files_.size());  // a sequence may hold only its first scans
-    has_times_file_ = true;
-  } else {
-    times_.resize(scan_files_.size());
-    for (std::size_t i = 0; i < times_.size(); ++i) times_[i] = 0.1 * static_cast<double>(i);
-  }
-
+  has_times_file_ = path_taken(times_file);
+  times_ = has_times_file_ ? first_entries(read_times(times_file), scan_files_.size(), times_file, "timestamps")
+                           : nominal_times(scan_files_.size());
   const fs::path poses_file = root_ / "poses.txt";
   if (path_taken(poses_file)) {
-    camera_poses_ = read_kitti_poses(poses_file);
-    if (camera_poses_.size() < scan_files_.size()) {
-      throw InputError(poses_file, fmt::format("{} poses for {} scans", camera_poses_.size(), scan_files_.size()));
-    }
-    camera_poses_.resize(scan_files_.size());  // as for times.txt
+    camera_poses_ = first_entries(read_kitti_poses(poses_file), scan_files_.size(), poses_file, "poses");
   }
 }
 

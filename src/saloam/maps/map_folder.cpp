@@ -97,35 +97,24 @@ void check_sessions(const SavedMap& map, const fs::path& keyframes_file) {
   }
 }
 
-}  // namespace
-
-void check_map_destination(const fs::path& folder) {
-  if (path_taken(folder) && !is_saloam_map(folder)) {
-    throw InputError(folder, "exists and is not a saloam map: it is left as it is (choose another --save-map)");
-  }
+// A fresh name for a temporary folder beside `target` ("NAME.partial-PID.N").
+fs::path partial_folder_name(const fs::path& target) {
+  static std::atomic<unsigned> counter{0};
+  return target.string() + fmt::format(".partial-{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
 }
 
-void write_map(const fs::path& folder, const SavedMap& map,
-               const std::function<const StoredFeatures&(std::size_t)>& features) {
-  std::error_code ec;
-  check_map_destination(folder);
-  if (map.keyframes.empty()) throw InputError(folder, "no keyframe to save: the map would be empty");
-  if (map.places.size() != map.keyframes.size()) throw InputError(folder, "one place descriptor per keyframe is needed");
-  if (!folder.parent_path().empty()) create_folder(folder.parent_path());
-  remove_stale_partials(folder);
-  static std::atomic<unsigned> counter{0};
-  const fs::path temporary =
-      folder.string() + fmt::format(".partial-{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
-  struct RemoveOnFailure {
-    const fs::path& path;
-    bool armed = true;
-    ~RemoveOnFailure() {
-      std::error_code ignored;
-      if (armed) fs::remove_all(path, ignored);
-    }
-  } cleanup{temporary};
-  create_folder(temporary / "features");
+// Removes a folder when it goes out of scope still armed.
+struct RemoveOnFailure {
+  const fs::path& path;
+  bool armed = true;
+  ~RemoveOnFailure() {
+    std::error_code ignored;
+    if (armed) fs::remove_all(path, ignored);
+  }
+};
 
+// The manifest of `map` as written: its counts, detector and sessions.
+MapManifest manifest_to_write(const SavedMap& map) {
   MapManifest manifest = map.manifest;
   manifest.version = kMapFormatVersion;
   manifest.keyframes = map.keyframes.size();
@@ -138,25 +127,34 @@ void write_map(const fs::path& folder, const SavedMap& map,
       std::count_if(map.edges.begin(), map.edges.end(), [&](const PoseGraphEdge& e) {
         return e.kind == EdgeKind::kLoop && map.keyframes[e.from].session != map.keyframes[e.to].session;
       }));
-  write_file_atomically(temporary / "config.yaml", config_to_yaml(map.config));
-  {
-    const auto put = [&](const fs::path& file, const std::vector<std::byte>& bytes) {
-      write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-    };
-    put(temporary / "keyframes.bin", encode_map_keyframes(map.keyframes));
-    put(temporary / "edges.bin", encode_map_edges(map.edges));
-    put(temporary / "places.bin", encode_map_places(map.places));
-    for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
-      put(map_features_path(temporary, k), encode_map_features(features(k)));
-    }
-  }
-  // The manifest last: a folder without one is no map.
-  write_file_atomically(temporary / "map.json", encode_map_manifest(manifest));
+  return manifest;
+}
 
-  // An earlier map of this name goes aside first, and away once the new one is in place.
+// Every file of the map into `folder`, the manifest last: a folder without one is no map.
+void write_map_tables(const fs::path& folder, const SavedMap& map,
+                      const std::function<const StoredFeatures&(std::size_t)>& features) {
+  create_folder(folder / "features");
+  const MapManifest manifest = manifest_to_write(map);
+  write_file_atomically(folder / "config.yaml", config_to_yaml(map.config));
+  const auto put = [&](const fs::path& file, const std::vector<std::byte>& bytes) {
+    write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  };
+  put(folder / "keyframes.bin", encode_map_keyframes(map.keyframes));
+  put(folder / "edges.bin", encode_map_edges(map.edges));
+  put(folder / "places.bin", encode_map_places(map.places));
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    put(map_features_path(folder, k), encode_map_features(features(k)));
+  }
+  write_file_atomically(folder / "map.json", encode_map_manifest(manifest));
+}
+
+// Renames the finished `temporary` to `folder`. An earlier map of this name
+// goes aside first, and away once the new one is in place (back, when that fails).
+void replace_folder(const fs::path& folder, const fs::path& temporary) {
+  std::error_code ec;
   fs::path previous;
   if (path_taken(folder)) {
-    previous = folder.string() + fmt::format(".partial-{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
+    previous = partial_folder_name(folder);
     fs::rename(folder, previous, ec);
     if (ec) throw InputError(folder, fmt::format("cannot move the earlier map aside: {}", ec.message()));
   }
@@ -166,8 +164,29 @@ void write_map(const fs::path& folder, const SavedMap& map,
     if (!previous.empty()) fs::rename(previous, folder, ignored);
     throw InputError(folder, fmt::format("cannot put the map in place: {}", ec.message()));
   }
-  cleanup.armed = false;
   if (!previous.empty()) fs::remove_all(previous, ec);
+}
+
+}  // namespace
+
+void check_map_destination(const fs::path& folder) {
+  if (path_taken(folder) && !is_saloam_map(folder)) {
+    throw InputError(folder, "exists and is not a saloam map: it is left as it is (choose another --save-map)");
+  }
+}
+
+void write_map(const fs::path& folder, const SavedMap& map,
+               const std::function<const StoredFeatures&(std::size_t)>& features) {
+  check_map_destination(folder);
+  if (map.keyframes.empty()) throw InputError(folder, "no keyframe to save: the map would be empty");
+  if (map.places.size() != map.keyframes.size()) throw InputError(folder, "one place descriptor per keyframe is needed");
+  if (!folder.parent_path().empty()) create_folder(folder.parent_path());
+  remove_stale_partials(folder);
+  const fs::path temporary = partial_folder_name(folder);
+  RemoveOnFailure cleanup{temporary};
+  write_map_tables(temporary, map, features);
+  replace_folder(folder, temporary);
+  cleanup.armed = false;
 }
 
 SavedMap read_map(const fs::path& folder) {

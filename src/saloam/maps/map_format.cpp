@@ -446,71 +446,86 @@ std::vector<PoseGraphEdge> parse_map_edges(std::span<const std::byte> bytes, std
   return edges;
 }
 
+namespace {
+
+// One place's Scan Context: its size (which must be this saloam's), then the cells.
+ScanContext read_scan_context(ByteReader& r, const std::string& at) {
+  const ScanContextConfig sc_config;
+  const auto rows = r.get<std::uint32_t>("Scan Context rows"), cols = r.get<std::uint32_t>("Scan Context sectors");
+  if (rows != static_cast<std::uint32_t>(sc_config.num_rings) || cols != static_cast<std::uint32_t>(sc_config.num_sectors)) {
+    r.fail(fmt::format("{}: Scan Context of {} x {} cells; this saloam makes {} x {}", at, rows, cols,
+                       sc_config.num_rings, sc_config.num_sectors));
+  }
+  Eigen::MatrixXf descriptor(rows, cols);
+  for (Eigen::Index i = 0; i < descriptor.size(); ++i) {
+    descriptor.data()[i] = r.finite_float("a Scan Context cell", 1.0e4F);
+  }
+  return scan_context_from_descriptor(std::move(descriptor));
+}
+
+// One place's Semantic Scan Context: its class-coded points, then its key
+// sectors (as many as the map's loop.ssc.key_sectors); the cells are rebuilt.
+SemanticScanContext read_ssc(ByteReader& r, const std::string& at, const SscConfig& ssc_config) {
+  SemanticScanContext ssc;
+  const std::size_t points = r.count(r.get<std::uint32_t>("SSC point count"), 9, "SSC points", kMaxSscPoints);
+  ssc.points.resize(points);
+  ssc.codes.resize(points);
+  for (std::size_t i = 0; i < points; ++i) {
+    const float x = r.finite_float("an SSC point", kMaxFeatureCoordinate);
+    const float y = r.finite_float("an SSC point", kMaxFeatureCoordinate);
+    ssc.points[i] = {x, y};
+    ssc.codes[i] = r.get<std::uint8_t>("an SSC class code");
+    if (ssc.codes[i] == 0 || ssc.codes[i] >= kSscNumCodes) {
+      r.fail(fmt::format("{}: SSC class code {} (1..{})", at, ssc.codes[i], kSscNumCodes - 1));
+    }
+  }
+  const auto keys = r.get<std::uint32_t>("SSC key sectors");
+  if (keys != static_cast<std::uint32_t>(ssc_config.key_sectors)) {
+    r.fail(fmt::format("{}: {} SSC key sectors; the map's loop.ssc.key_sectors is {}", at, keys, ssc_config.key_sectors));
+  }
+  r.count(keys, 12, "SSC key sectors", keys);
+  ssc.key_range.resize(keys);
+  ssc.key_points.resize(keys);
+  for (std::size_t i = 0; i < keys; ++i) {
+    ssc.key_range[i] = r.finite_float("an SSC key range", kMaxFeatureCoordinate);
+    if (ssc.key_range[i] < 0) r.fail(fmt::format("{}: negative SSC key range", at));
+    const float x = r.finite_float("an SSC key point", kMaxFeatureCoordinate);
+    const float y = r.finite_float("an SSC key point", kMaxFeatureCoordinate);
+    ssc.key_points[i] = {x, y};
+  }
+  ssc.cells = ssc_cells(ssc.points, ssc.codes, SscAlignment{}, ssc_config);
+  return ssc;
+}
+
+// One place's semantic graph (node classes and centres) and SGPR embedding.
+void read_sgpr(ByteReader& r, const std::string& at, PlaceDescriptor& p) {
+  const std::size_t nodes = r.count(r.get<std::uint32_t>("graph node count"), 28, "graph nodes", kMaxGraphNodes);
+  p.graph.nodes.resize(nodes);
+  p.graph.centers.resize(nodes);
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const auto c = r.get<std::int32_t>("a node class");
+    if (c < 0 || c >= kNumNodeClasses) r.fail(fmt::format("{}: node class {} (0..{})", at, c, kNumNodeClasses - 1));
+    p.graph.nodes[i] = c;
+    for (int a = 0; a < 3; ++a) p.graph.centers[i][a] = r.finite("a node centre", kMaxGraphCoordinate);
+  }
+  for (int i = 0; i < kSgprEmbeddingSize; ++i) p.embedding[i] = r.finite_float("an SGPR embedding value", 1.0e6F);
+}
+
+}  // namespace
+
 std::vector<PlaceDescriptor> parse_map_places(std::span<const std::byte> bytes, const SaloamConfig& config,
                                               const fs::path& origin) {
   ByteReader r(bytes, origin);
   const std::size_t n = r.count(r.header(MapTable::kPlaces), 4, "place descriptors", kMaxMapKeyframes);
-  const ScanContextConfig sc_config;
-  const SscConfig& ssc_config = config.loop.ssc;
   std::vector<PlaceDescriptor> places(n);
   for (std::size_t k = 0; k < n; ++k) {
     PlaceDescriptor& p = places[k];
     const std::string at = fmt::format("place {}", k);
     const auto flags = r.get<std::uint32_t>("descriptor flags");
     if ((flags & ~kKnownPlaceFlags) != 0) r.fail(fmt::format("{}: unknown descriptor flags {:#x}", at, flags));
-    if (flags & kHasScanContext) {
-      const auto rows = r.get<std::uint32_t>("Scan Context rows"), cols = r.get<std::uint32_t>("Scan Context sectors");
-      if (rows != static_cast<std::uint32_t>(sc_config.num_rings) || cols != static_cast<std::uint32_t>(sc_config.num_sectors)) {
-        r.fail(fmt::format("{}: Scan Context of {} x {} cells; this saloam makes {} x {}", at, rows, cols,
-                           sc_config.num_rings, sc_config.num_sectors));
-      }
-      Eigen::MatrixXf descriptor(rows, cols);
-      for (Eigen::Index i = 0; i < descriptor.size(); ++i) {
-        descriptor.data()[i] = r.finite_float("a Scan Context cell", 1.0e4F);
-      }
-      p.context = scan_context_from_descriptor(std::move(descriptor));
-    }
-    if (flags & kHasSsc) {
-      const std::size_t points = r.count(r.get<std::uint32_t>("SSC point count"), 9, "SSC points", kMaxSscPoints);
-      p.ssc.points.resize(points);
-      p.ssc.codes.resize(points);
-      for (std::size_t i = 0; i < points; ++i) {
-        const float x = r.finite_float("an SSC point", kMaxFeatureCoordinate);
-        const float y = r.finite_float("an SSC point", kMaxFeatureCoordinate);
-        p.ssc.points[i] = {x, y};
-        p.ssc.codes[i] = r.get<std::uint8_t>("an SSC class code");
-        if (p.ssc.codes[i] == 0 || p.ssc.codes[i] >= kSscNumCodes) {
-          r.fail(fmt::format("{}: SSC class code {} (1..{})", at, p.ssc.codes[i], kSscNumCodes - 1));
-        }
-      }
-      const auto keys = r.get<std::uint32_t>("SSC key sectors");
-      if (keys != static_cast<std::uint32_t>(ssc_config.key_sectors)) {
-        r.fail(fmt::format("{}: {} SSC key sectors; the map's loop.ssc.key_sectors is {}", at, keys, ssc_config.key_sectors));
-      }
-      r.count(keys, 12, "SSC key sectors", keys);
-      p.ssc.key_range.resize(keys);
-      p.ssc.key_points.resize(keys);
-      for (std::size_t i = 0; i < keys; ++i) {
-        p.ssc.key_range[i] = r.finite_float("an SSC key range", kMaxFeatureCoordinate);
-        if (p.ssc.key_range[i] < 0) r.fail(fmt::format("{}: negative SSC key range", at));
-        const float x = r.finite_float("an SSC key point", kMaxFeatureCoordinate);
-        const float y = r.finite_float("an SSC key point", kMaxFeatureCoordinate);
-        p.ssc.key_points[i] = {x, y};
-      }
-      p.ssc.cells = ssc_cells(p.ssc.points, p.ssc.codes, SscAlignment{}, ssc_config);
-    }
-    if (flags & kHasSgpr) {
-      const std::size_t nodes = r.count(r.get<std::uint32_t>("graph node count"), 28, "graph nodes", kMaxGraphNodes);
-      p.graph.nodes.resize(nodes);
-      p.graph.centers.resize(nodes);
-      for (std::size_t i = 0; i < nodes; ++i) {
-        const auto c = r.get<std::int32_t>("a node class");
-        if (c < 0 || c >= kNumNodeClasses) r.fail(fmt::format("{}: node class {} (0..{})", at, c, kNumNodeClasses - 1));
-        p.graph.nodes[i] = c;
-        for (int a = 0; a < 3; ++a) p.graph.centers[i][a] = r.finite("a node centre", kMaxGraphCoordinate);
-      }
-      for (int i = 0; i < kSgprEmbeddingSize; ++i) p.embedding[i] = r.finite_float("an SGPR embedding value", 1.0e6F);
-    }
+    if (flags & kHasScanContext) p.context = read_scan_context(r, at);
+    if (flags & kHasSsc) p.ssc = read_ssc(r, at, config.loop.ssc);
+    if (flags & kHasSgpr) read_sgpr(r, at, p);
   }
   r.finish();
   return places;

@@ -126,6 +126,100 @@ void sort_keys_pushed_in_index_order(std::vector<std::uint64_t>& keys, std::vect
 }  // namespace
 
 namespace {
+/// A point's sort key: its roughness as float bits (order-preserving for
+/// non-negative values) above its index: ascending keys order by roughness,
+/// ties by position, and the ring's features are the same as with a
+/// comparison sort on (roughness, index).
+std::uint64_t roughness_key(double c, int i) {
+  std::uint32_t bits = 0;
+  const float f = static_cast<float>(c);
+  std::memcpy(&bits, &f, sizeof bits);
+  return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(i);
+}
+int key_index(std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); }
+std::uint64_t key_roughness_bits(std::uint64_t k) { return k >> 32; }
+
+/// Picks one ring's features sector by sector. One sort of a sector's usable
+/// points serves both kinds: edges are taken from its rough end down, planar
+/// points from its smooth end up, and each pick blocks its ring neighbours.
+/// Rounding to float keeps the order, so only keys whose float equals
+/// alpha's can be on either side, and the loops test each key's roughness.
+class RingFeaturePicker {
+ public:
+  RingFeaturePicker(const std::vector<double>& gap_sq, const std::vector<double>& roughness,
+                    const PointMask& unreliable, const FeatureConfig& config, const PointMask& not_edge)
+      : gap_sq_(gap_sq), roughness_(roughness), not_edge_(not_edge), config_(config), blocked_(unreliable),
+        alpha_bits_(key_roughness_bits(roughness_key(config.alpha, 0))) {}
+
+  /// The features among ring points [begin, end).
+  void pick_sector(int begin, int end, RingSelection& out) {
+    sort_usable(begin, end);
+    pick_edges(out.edges);
+    pick_planars(out.planars);
+  }
+
+ private:
+  void sort_usable(int begin, int end) {
+    keys_.resize(static_cast<std::size_t>(end - begin));
+    std::size_t count = 0;
+    for (int i = begin; i < end; ++i) {
+      const double c = roughness_[i];
+      keys_[count] = roughness_key(c, i);
+      count += !blocked_[i] && std::isfinite(c) && c != config_.alpha;  // no branch: roughness is unpredictable
+    }
+    keys_.resize(count);
+    sort_keys_pushed_in_index_order(keys_, scratch_);
+  }
+
+  void pick_edges(std::vector<int>& edges) {
+    int picked = 0;
+    for (auto it = keys_.rbegin(); it != keys_.rend() && picked < config_.edges_per_sector; ++it) {
+      if (key_roughness_bits(*it) < alpha_bits_) break;  // all smoother than alpha from here
+      const int i = key_index(*it);
+      if (!(roughness_[i] > config_.alpha) || blocked_[i] || (!not_edge_.empty() && not_edge_[i])) continue;
+      edges.push_back(i);
+      block_neighbours(i);
+      ++picked;
+    }
+  }
+
+  void pick_planars(std::vector<int>& planars) {
+    int picked = 0;
+    for (auto it = keys_.begin(); it != keys_.end() && picked < config_.planars_per_sector; ++it) {
+      if (key_roughness_bits(*it) > alpha_bits_) break;  // all rougher than alpha from here
+      const int i = key_index(*it);
+      if (!(roughness_[i] < config_.alpha) || blocked_[i]) continue;
+      planars.push_back(i);
+      block_neighbours(i);
+      ++picked;
+    }
+  }
+
+  /// Blocks the ring neighbours of a selected point, as long as they are
+  /// close in space (not across an occlusion).
+  void block_neighbours(int i) {
+    const int n = static_cast<int>(gap_sq_.size());
+    blocked_[i] = 1;
+    for (int step : {-1, 1}) {
+      for (int k = 1; k <= config_.roughness_half_window; ++k) {
+        const int j = i + step * k;
+        const int prev = j - step;
+        if (j < 0 || j >= n) break;
+        if (gap_sq_[std::min(j, prev)] > 0.05) break;
+        blocked_[j] = 1;
+      }
+    }
+  }
+
+  const std::vector<double>& gap_sq_;
+  const std::vector<double>& roughness_;
+  const PointMask& not_edge_;
+  const FeatureConfig& config_;
+  PointMask blocked_;
+  std::uint64_t alpha_bits_;
+  std::vector<std::uint64_t> keys_, scratch_;
+};
+
 RingSelection select_ring_features(const std::vector<double>& gap_sq, const std::vector<double>& roughness,
                                    const PointMask& unreliable, const FeatureConfig& config,
                                    const PointMask& not_edge) {
@@ -133,72 +227,13 @@ RingSelection select_ring_features(const std::vector<double>& gap_sq, const std:
   const int n = static_cast<int>(gap_sq.size());
   const int w = config.roughness_half_window;
   if (n < 2 * w + 1) return out;
-  PointMask blocked(unreliable);
   const int first = w, last = n - w;  // points with a full window
   const int sectors = std::max(1, config.num_sectors);
-  // Blocks the ring neighbours of a selected point, as long as they are
-  // close in space (not across an occlusion).
-  auto block_neighbours = [&](int i) {
-    blocked[i] = 1;
-    for (int step : {-1, 1}) {
-      for (int k = 1; k <= w; ++k) {
-        const int j = i + step * k;
-        const int prev = j - step;
-        if (j < 0 || j >= n) break;
-        if (gap_sq[std::min(j, prev)] > 0.05) break;
-        blocked[j] = 1;
-      }
-    }
-  };
-  // Sort keys: the roughness as float bits (order-preserving for
-  // non-negative values) above the index: ascending keys order by roughness,
-  // ties by position, and the ring's features are the same as with a
-  // comparison sort on (roughness, index).
-  auto key = [](double c, int i) {
-    std::uint32_t bits = 0;
-    const float f = static_cast<float>(c);
-    std::memcpy(&bits, &f, sizeof bits);
-    return (static_cast<std::uint64_t>(bits) << 32) | static_cast<std::uint32_t>(i);
-  };
-  auto index_of = [](std::uint64_t k) { return static_cast<int>(k & 0xffffffffu); };
-  // One sort of the sector's usable points serves both kinds: edges are
-  // taken from its rough end down, planar points from its smooth end up.
-  // Rounding to float keeps the order, so only keys whose float equals
-  // alpha's can be on either side, and the loops test each key's roughness.
-  const std::uint64_t alpha_bits = key(config.alpha, 0) >> 32;
-  auto roughness_bits = [](std::uint64_t k) { return k >> 32; };
-  std::vector<std::uint64_t> keys, scratch;
+  RingFeaturePicker picker(gap_sq, roughness, unreliable, config, not_edge);
   for (int s = 0; s < sectors; ++s) {
     const int begin = first + (last - first) * s / sectors;
     const int end = first + (last - first) * (s + 1) / sectors;
-    if (end <= begin) continue;
-    keys.resize(static_cast<std::size_t>(end - begin));
-    std::size_t count = 0;
-    for (int i = begin; i < end; ++i) {
-      const double c = roughness[i];
-      keys[count] = key(c, i);
-      count += !blocked[i] && std::isfinite(c) && c != config.alpha;  // no branch: roughness is unpredictable
-    }
-    keys.resize(count);
-    sort_keys_pushed_in_index_order(keys, scratch);
-    int picked = 0;
-    for (auto it = keys.rbegin(); it != keys.rend() && picked < config.edges_per_sector; ++it) {
-      if (roughness_bits(*it) < alpha_bits) break;  // all smoother than alpha from here
-      const int i = index_of(*it);
-      if (!(roughness[i] > config.alpha) || blocked[i] || (!not_edge.empty() && not_edge[i])) continue;
-      out.edges.push_back(i);
-      block_neighbours(i);
-      ++picked;
-    }
-    picked = 0;
-    for (auto it = keys.begin(); it != keys.end() && picked < config.planars_per_sector; ++it) {
-      if (roughness_bits(*it) > alpha_bits) break;  // all rougher than alpha from here
-      const int i = index_of(*it);
-      if (!(roughness[i] < config.alpha) || blocked[i]) continue;
-      out.planars.push_back(i);
-      block_neighbours(i);
-      ++picked;
-    }
+    if (end > begin) picker.pick_sector(begin, end, out);
   }
   return out;
 }
@@ -401,9 +436,93 @@ std::optional<double> ground_height(const LabelledCloud& cloud, const std::vecto
 }
 }  // namespace
 
+namespace {
+/// What every ring's feature extraction reads besides the ring itself.
+struct RingInputs {
+  const LabelledCloud& cloud;
+  const std::vector<float>& sweep_times;  ///< [s] per point, for de-skewing
+  const FeatureConfig& config;
+  const OdometryClassTable& class_table;
+  bool use_labels;
+  std::optional<double> no_edges_below;  ///< [m] sensor-frame height, without labels
+};
+
+/// With labels: points of classes odometry does not use are made unreliable
+/// (they must not take a sector's feature slots), and ground points rough
+/// enough for an edge but not for ground_edge_alpha are marked no edge.
+PointMask apply_labels(const RingInputs& in, const std::vector<std::uint32_t>& ring,
+                       const std::vector<double>& roughness, PointMask& unreliable) {
+  const FeatureConfig& config = in.config;
+  const bool ground_threshold = config.ground_edge_alpha > config.alpha;
+  PointMask not_edge;
+  if (ground_threshold) not_edge.assign(ring.size(), 0);
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const std::uint16_t label = in.cloud.label[ring[k]];
+    unreliable[k] |= odometry_class(in.class_table, label) < 0;
+    // Only points rough enough to be edges at all need the class lookup.
+    if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
+        is_ground(static_class(label))) {
+      not_edge[k] = 1;
+    }
+  }
+  return not_edge;
+}
+
+/// The selected ring points `indices` into `target` with class and sweep
+/// time; an edge of a thin round object stands for its axis (ThinObjectAxis).
+void emit_features(const RingInputs& in, const std::vector<std::uint32_t>& ring,
+                   const std::vector<Eigen::Vector3d>& ring_points, const std::vector<int>& indices, bool edges,
+                   FeatureCloud& target) {
+  const bool axes = in.use_labels && in.config.thin_object_axes;
+  for (const int k : indices) {
+    const std::uint32_t i = ring[k];
+    int c = 0;
+    if (in.use_labels) {
+      c = odometry_class(in.class_table, in.cloud.label[i]);
+      if (c < 0) continue;
+    }
+    if (edges && axes && is_thin_round(static_class(in.cloud.label[i]))) {
+      const auto axis = thin_object_axis(ring_points, k, in.config.thin_object_max_radius);
+      if (!axis) continue;
+      const std::uint32_t central = ring[static_cast<std::size_t>(axis->central)];
+      target.push_back(axis->point, static_cast<ClassIndex>(c), in.sweep_times[central]);
+      continue;
+    }
+    target.push_back(ring_points[k], static_cast<ClassIndex>(c), in.sweep_times[i]);
+  }
+}
+
+/// One ring's features (`ring`: point indices in azimuth order).
+ScanFeatures ring_features(const RingInputs& in, const std::vector<std::uint32_t>& ring) {
+  const FeatureConfig& config = in.config;
+  std::vector<Eigen::Vector3d> ring_points(ring.size());
+  for (std::size_t k = 0; k < ring.size(); ++k) ring_points[k] = in.cloud.points[ring[k]].cast<double>();
+  const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
+  const auto gap_sq = squared_gaps(ring_points);
+  auto unreliable =
+      unreliable_points(ring_points, gap_sq, config.roughness_half_window, config.min_range, config.max_range);
+  PointMask not_edge;
+  if (in.use_labels) not_edge = apply_labels(in, ring, roughness, unreliable);
+  if (in.no_edges_below) {
+    not_edge.assign(ring.size(), 0);
+    for (std::size_t k = 0; k < ring.size(); ++k) not_edge[k] = ring_points[k].z() < *in.no_edges_below;
+  }
+  const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
+  ScanFeatures out;
+  emit_features(in, ring, ring_points, selection.edges, true, out.edges);
+  emit_features(in, ring, ring_points, selection.planars, false, out.planars);
+  return out;
+}
+
+void append(FeatureCloud& to, const FeatureCloud& from) {
+  to.points.insert(to.points.end(), from.points.begin(), from.points.end());
+  to.classes.insert(to.classes.end(), from.classes.begin(), from.classes.end());
+  to.sweep_time.insert(to.sweep_time.end(), from.sweep_time.begin(), from.sweep_time.end());
+}
+}  // namespace
+
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
                               bool parallel) {
-  ScanFeatures out;
   // Rings (point indices in azimuth order) from the point order when the scan
   // is stored ring by ring (exact even for scans whose points were moved by
   // motion compensation), else from the elevation angle.
@@ -411,72 +530,16 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   const std::vector<std::vector<std::uint32_t>> rings = rings_from_times(cloud, times, config);
   // De-skewing takes the points' own times when the scan has them
   // (relative to the scan's timestamp), else the sweep model's.
-  const std::vector<float>& sweep_times = cloud.has_times() ? cloud.time : times;
+  RingInputs inputs{cloud, cloud.has_times() ? cloud.time : times, config, odometry_class_table(), use_labels, {}};
+  // Without labels, the ground is what lies near the lowest ring's height.
+  if (!use_labels && config.unlabelled_ground_margin > 0.0) {
+    if (const auto ground = ground_height(cloud, rings)) inputs.no_edges_below = *ground + config.unlabelled_ground_margin;
+  }
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.
   std::vector<ScanFeatures> per_ring(rings.size());
-  const OdometryClassTable& class_table = odometry_class_table();
-  // Without labels, the ground is what lies near the lowest ring's height.
-  std::optional<double> no_edges_below;
-  if (!use_labels && config.unlabelled_ground_margin > 0.0) {
-    if (const auto ground = ground_height(cloud, rings)) no_edges_below = *ground + config.unlabelled_ground_margin;
-  }
-  auto process_ring = [&](std::size_t r) {
-    const auto& ring = rings[r];
-    std::vector<Eigen::Vector3d> ring_points(ring.size());
-    for (std::size_t k = 0; k < ring.size(); ++k) ring_points[k] = cloud.points[ring[k]].cast<double>();
-    const auto roughness = ring_roughness(ring_points, config.roughness_half_window);
-    const auto gap_sq = squared_gaps(ring_points);
-    auto unreliable =
-        unreliable_points(ring_points, gap_sq, config.roughness_half_window, config.min_range, config.max_range);
-    PointMask not_edge;
-    if (use_labels) {  // unusable classes must not take a sector's feature slots
-      const bool ground_threshold = config.ground_edge_alpha > config.alpha;
-      if (ground_threshold) not_edge.assign(ring.size(), 0);
-      for (std::size_t k = 0; k < ring.size(); ++k) {
-        const std::uint16_t label = cloud.label[ring[k]];
-        unreliable[k] |= odometry_class(class_table, label) < 0;
-        // Only points rough enough to be edges at all need the class lookup.
-        if (ground_threshold && roughness[k] > config.alpha && !(roughness[k] > config.ground_edge_alpha) &&
-            is_ground(static_class(label))) {
-          not_edge[k] = 1;
-        }
-      }
-    }
-    if (no_edges_below) {
-      not_edge.assign(ring.size(), 0);
-      for (std::size_t k = 0; k < ring.size(); ++k) not_edge[k] = ring_points[k].z() < *no_edges_below;
-    }
-    const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
-    // An edge of a thin round object stands for its axis (ThinObjectAxis).
-    const bool axes = use_labels && config.thin_object_axes;
-    auto emit = [&](const std::vector<int>& indices, bool edges, FeatureCloud& target) {
-      for (const int k : indices) {
-        const std::uint32_t i = ring[k];
-        int c = 0;
-        if (use_labels) {
-          c = odometry_class(class_table, cloud.label[i]);
-          if (c < 0) continue;
-        }
-        if (edges && axes && is_thin_round(static_class(cloud.label[i]))) {
-          const auto axis = thin_object_axis(ring_points, k, config.thin_object_max_radius);
-          if (!axis) continue;
-          const std::uint32_t central = ring[static_cast<std::size_t>(axis->central)];
-          target.push_back(axis->point, static_cast<ClassIndex>(c), sweep_times[central]);
-          continue;
-        }
-        target.push_back(ring_points[k], static_cast<ClassIndex>(c), sweep_times[i]);
-      }
-    };
-    emit(selection.edges, true, per_ring[r].edges);
-    emit(selection.planars, false, per_ring[r].planars);
-  };
-  for_each_index(rings.size(), parallel, 1, process_ring);
-  auto append = [](FeatureCloud& to, const FeatureCloud& from) {
-    to.points.insert(to.points.end(), from.points.begin(), from.points.end());
-    to.classes.insert(to.classes.end(), from.classes.begin(), from.classes.end());
-    to.sweep_time.insert(to.sweep_time.end(), from.sweep_time.begin(), from.sweep_time.end());
-  };
+  for_each_index(rings.size(), parallel, 1, [&](std::size_t r) { per_ring[r] = ring_features(inputs, rings[r]); });
+  ScanFeatures out;
   for (const auto& f : per_ring) {
     append(out.edges, f.edges);
     append(out.planars, f.planars);

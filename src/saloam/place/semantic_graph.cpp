@@ -175,43 +175,63 @@ std::string_view node_class_name(int node_class) {
   return kNodeClassNames[static_cast<std::size_t>(node_class)];
 }
 
-std::vector<std::vector<std::uint32_t>> euclidean_clusters(std::span<const Eigen::Vector3f> points,
-                                                           std::span<const std::uint32_t> indices,
-                                                           double tolerance, std::size_t min_size,
-                                                           std::size_t max_size) {
-  std::vector<std::vector<std::uint32_t>> clusters;
-  if (indices.empty() || !(tolerance > 0)) return clusters;
-  // Cells of edge tolerance / sqrt(3): two points in one cell are at most
-  // `tolerance` apart, so a cell is connected without tests and only the
-  // 5x5x5 block of cells around it can hold neighbours.
-  const double cell = tolerance / std::sqrt(3.0) * (1.0 - 1e-9);
-  const float tol_sq = static_cast<float>(tolerance * tolerance);
+namespace {
+
+/// Points binned into cubic cells: `keyed` holds (cell key, position in
+/// indices) sorted by key, and cell c holds keyed[start[c] .. start[c + 1]).
+struct CellBins {
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed;
+  std::vector<std::uint32_t> start;
+  [[nodiscard]] std::size_t cells() const { return start.size() - 1; }
+  [[nodiscard]] std::uint64_t key(std::size_t c) const { return keyed[start[c]].first; }
+};
+
+CellBins bin_points(std::span<const Eigen::Vector3f> points, std::span<const std::uint32_t> indices, double cell) {
+  CellBins bins;
   const std::size_t n = indices.size();
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);  // (cell key, position in indices)
+  bins.keyed.resize(n);
   for (std::size_t k = 0; k < n; ++k) {
     const Eigen::Vector3f& p = points[indices[k]];
-    keyed[k] = {pack_cell(static_cast<std::int64_t>(std::floor(p.x() / cell)),
-                          static_cast<std::int64_t>(std::floor(p.y() / cell)),
-                          static_cast<std::int64_t>(std::floor(p.z() / cell))),
-                static_cast<std::uint32_t>(k)};
+    bins.keyed[k] = {pack_cell(static_cast<std::int64_t>(std::floor(p.x() / cell)),
+                               static_cast<std::int64_t>(std::floor(p.y() / cell)),
+                               static_cast<std::int64_t>(std::floor(p.z() / cell))),
+                     static_cast<std::uint32_t>(k)};
   }
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<std::uint32_t> cell_start;  // cell c holds keyed[cell_start[c] .. cell_start[c+1])
+  std::sort(bins.keyed.begin(), bins.keyed.end());
   for (std::size_t k = 0; k < n; ++k)
-    if (k == 0 || keyed[k].first != keyed[k - 1].first) cell_start.push_back(static_cast<std::uint32_t>(k));
-  const std::size_t num_cells = cell_start.size();
-  cell_start.push_back(static_cast<std::uint32_t>(n));
-  CellTable table(num_cells);
-  for (std::size_t c = 0; c < num_cells; ++c) table.insert(keyed[cell_start[c]].first, static_cast<std::uint32_t>(c));
+    if (k == 0 || bins.keyed[k].first != bins.keyed[k - 1].first) bins.start.push_back(static_cast<std::uint32_t>(k));
+  bins.start.push_back(static_cast<std::uint32_t>(n));
+  return bins;
+}
 
-  const auto unpack = [](std::uint64_t key, int shift) {
-    const auto mask = (std::uint64_t{1} << kCellBits) - 1;
-    return static_cast<std::int64_t>((key >> shift) & mask) - kCellOffset;
-  };
+std::int64_t unpack_cell(std::uint64_t key, int shift) {
+  const auto mask = (std::uint64_t{1} << kCellBits) - 1;
+  return static_cast<std::int64_t>((key >> shift) & mask) - kCellOffset;
+}
+
+/// Whether a point of cell `a` and one of cell `b` are at most sqrt(tol_sq) apart.
+bool cells_touch(std::span<const Eigen::Vector3f> points, std::span<const std::uint32_t> indices,
+                 const CellBins& bins, std::uint32_t a, std::uint32_t b, float tol_sq) {
+  for (std::uint32_t i = bins.start[a]; i < bins.start[a + 1]; ++i) {
+    const Eigen::Vector3f& p = points[indices[bins.keyed[i].second]];
+    for (std::uint32_t j = bins.start[b]; j < bins.start[b + 1]; ++j) {
+      if ((points[indices[bins.keyed[j].second]] - p).squaredNorm() <= tol_sq) return true;
+    }
+  }
+  return false;
+}
+
+/// Cells joined into components: each cell with every cell of the 5x5x5
+/// block around it that holds a point within tolerance of one of its own.
+DisjointSets connect_cells(std::span<const Eigen::Vector3f> points, std::span<const std::uint32_t> indices,
+                           const CellBins& bins, float tol_sq) {
+  const std::size_t num_cells = bins.cells();
+  CellTable table(num_cells);
+  for (std::size_t c = 0; c < num_cells; ++c) table.insert(bins.key(c), static_cast<std::uint32_t>(c));
   DisjointSets sets(num_cells);
   for (std::size_t a = 0; a < num_cells; ++a) {
-    const std::uint64_t key = keyed[cell_start[a]].first;
-    const std::int64_t cx = unpack(key, 2 * kCellBits), cy = unpack(key, kCellBits), cz = unpack(key, 0);
+    const std::uint64_t key = bins.key(a);
+    const std::int64_t cx = unpack_cell(key, 2 * kCellBits), cy = unpack_cell(key, kCellBits), cz = unpack_cell(key, 0);
     for (int dx = -2; dx <= 2; ++dx)
       for (int dy = -2; dy <= 2; ++dy)
         for (int dz = -2; dz <= 2; ++dz) {
@@ -221,26 +241,26 @@ std::vector<std::vector<std::uint32_t>> euclidean_clusters(std::span<const Eigen
           if (b < 0) continue;
           const auto cb = static_cast<std::uint32_t>(b);
           if (sets.find(static_cast<std::uint32_t>(a)) == sets.find(cb)) continue;
-          bool joined = false;
-          for (std::uint32_t i = cell_start[a]; i < cell_start[a + 1] && !joined; ++i) {
-            const Eigen::Vector3f& p = points[indices[keyed[i].second]];
-            for (std::uint32_t j = cell_start[cb]; j < cell_start[cb + 1]; ++j) {
-              if ((points[indices[keyed[j].second]] - p).squaredNorm() <= tol_sq) {
-                joined = true;
-                break;
-              }
-            }
+          if (cells_touch(points, indices, bins, static_cast<std::uint32_t>(a), cb, tol_sq)) {
+            sets.unite(static_cast<std::uint32_t>(a), cb);
           }
-          if (joined) sets.unite(static_cast<std::uint32_t>(a), cb);
         }
   }
+  return sets;
+}
 
-  // Components in order of their first input position; points in input order.
+/// The components of min_size..max_size points as clusters of `indices`, in
+/// order of their first input position; points in input order.
+std::vector<std::vector<std::uint32_t>> components_in_input_order(std::span<const std::uint32_t> indices,
+                                                                  const CellBins& bins, DisjointSets& sets,
+                                                                  std::size_t min_size, std::size_t max_size) {
+  const std::size_t n = indices.size(), num_cells = bins.cells();
   std::vector<std::uint32_t> cell_of(n);
   for (std::size_t c = 0; c < num_cells; ++c)
-    for (std::uint32_t k = cell_start[c]; k < cell_start[c + 1]; ++k) cell_of[keyed[k].second] = static_cast<std::uint32_t>(c);
+    for (std::uint32_t k = bins.start[c]; k < bins.start[c + 1]; ++k) cell_of[bins.keyed[k].second] = static_cast<std::uint32_t>(c);
   std::vector<std::uint32_t> root_size(num_cells, 0);
   for (std::size_t k = 0; k < n; ++k) ++root_size[sets.find(cell_of[k])];
+  std::vector<std::vector<std::uint32_t>> clusters;
   std::vector<std::int64_t> cluster_of_root(num_cells, -1);
   for (std::size_t k = 0; k < n; ++k) {
     const std::uint32_t root = sets.find(cell_of[k]);
@@ -253,6 +273,22 @@ std::vector<std::vector<std::uint32_t>> euclidean_clusters(std::span<const Eigen
     clusters[static_cast<std::size_t>(cluster_of_root[root])].push_back(indices[k]);
   }
   return clusters;
+}
+
+}  // namespace
+
+std::vector<std::vector<std::uint32_t>> euclidean_clusters(std::span<const Eigen::Vector3f> points,
+                                                           std::span<const std::uint32_t> indices,
+                                                           double tolerance, std::size_t min_size,
+                                                           std::size_t max_size) {
+  if (indices.empty() || !(tolerance > 0)) return {};
+  // Cells of edge tolerance / sqrt(3): two points in one cell are at most
+  // `tolerance` apart, so a cell is connected without tests and only the
+  // 5x5x5 block of cells around it can hold neighbours.
+  const double cell = tolerance / std::sqrt(3.0) * (1.0 - 1e-9);
+  const CellBins bins = bin_points(points, indices, cell);
+  DisjointSets sets = connect_cells(points, indices, bins, static_cast<float>(tolerance * tolerance));
+  return components_in_input_order(indices, bins, sets, min_size, max_size);
 }
 
 std::vector<Cluster> extract_clusters(const LabelledCloud& cloud, const GraphBuilderConfig& config) {

@@ -153,11 +153,15 @@ Eigen::MatrixXf SgprNetwork::edge_conv(const EdgeConvLayer& layer, const Eigen::
   return out;
 }
 
-SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* activations) const {
+namespace {
+
+/// The network's input (FORMAT.md 4): per node its centre [m] (rows 0-2)
+/// and its one-hot class (rows 3-14), for the first kSgprNodes nodes. Padding
+/// nodes stay all zero (position 0 and no class) and take part in everything.
+Eigen::MatrixXf network_input(const SemanticGraph& graph) {
   if (graph.centers.size() != graph.nodes.size())
     throw std::invalid_argument("SGPR: graph has " + std::to_string(graph.nodes.size()) + " node classes but " +
                                 std::to_string(graph.centers.size()) + " centres");
-  // Padding nodes stay all zero (position 0 and no class) and take part in everything.
   Eigen::MatrixXf input = Eigen::MatrixXf::Zero(kInputRows, kSgprNodes);
   const int used = static_cast<int>(std::min<std::size_t>(graph.size(), kSgprNodes));
   for (int n = 0; n < used; ++n) {
@@ -172,10 +176,33 @@ SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* ac
     input.block<3, 1>(0, n) = centre.cast<float>();
     input(3 + label, n) = 1.0F;
   }
+  return input;
+}
 
-  Eigen::MatrixXf p = input.topRows(3);
-  Eigen::MatrixXf s = input.bottomRows(kNumNodeClasses);
-  std::array<Eigen::MatrixXf, 3> xyz, sem;
+struct AttentionPooling {
+  Eigen::VectorXf context;    ///< t = tanh(g)
+  Eigen::VectorXf attention;  ///< a_n per node
+  SgprEmbedding pooled;       ///< h
+};
+
+/// Attention pooling (FORMAT.md 5.4) of the 32 x N node embeddings E:
+/// g = mean_n(E_n Wa), t = tanh(g), a_n = sigmoid(E_n . t), h = sum_n a_n E_n
+/// (a weighted sum, padding included).
+AttentionPooling attention_pool(const Eigen::MatrixXf& embedding, const Eigen::MatrixXf& attention_weight) {
+  AttentionPooling out;
+  const Eigen::VectorXf mean = embedding.rowwise().sum() / static_cast<float>(kSgprNodes);
+  out.context = (attention_weight.transpose() * mean).array().tanh();
+  out.attention = (embedding.transpose() * out.context).unaryExpr([](float v) { return 1.0F / (1.0F + std::exp(-v)); });
+  out.pooled = embedding * out.attention;
+  return out;
+}
+
+}  // namespace
+
+void SgprNetwork::edge_convolutions(const Eigen::MatrixXf& input, std::array<Eigen::MatrixXf, 3>& xyz,
+                                    std::array<Eigen::MatrixXf, 3>& sem, SgprActivations* activations) const {
+  const Eigen::MatrixXf p = input.topRows(3);
+  const Eigen::MatrixXf s = input.bottomRows(kNumNodeClasses);
   for (int l = 0; l < 3; ++l) {
     xyz[l] = edge_conv(xyz_layers_[l], l == 0 ? p : xyz[l - 1],
                        (activations && l == 0) ? &activations->knn_xyz1 : nullptr);
@@ -186,25 +213,25 @@ SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* ac
       overflowed(source_, fmt::format("the output of edge convolution {}", l + 1));
     }
   }
+}
 
-  // Fusion: u = [p3, s3] per node, 1x1 conv + BN + LeakyReLU (FORMAT.md 5.3).
+Eigen::MatrixXf SgprNetwork::fuse(const Eigen::MatrixXf& xyz, const Eigen::MatrixXf& sem) const {
   Eigen::MatrixXf fused(64, kSgprNodes);
-  fused.topRows(32) = xyz[2];
-  fused.bottomRows(32) = sem[2];
+  fused.topRows(32) = xyz;
+  fused.bottomRows(32) = sem;
   Eigen::MatrixXf embedding = fusion_weight_ * fused;  // 32 x N
   for (int n = 0; n < kSgprNodes; ++n)
     for (int c = 0; c < 32; ++c) embedding(c, n) = leaky_relu(embedding(c, n) * fusion_scale_[c] + fusion_shift_[c]);
+  return embedding;
+}
 
-  // Attention pooling (FORMAT.md 5.4): g = mean_n(E_n Wa), t = tanh(g),
-  // a_n = sigmoid(E_n . t), h = sum_n a_n E_n (a weighted sum, padding included).
-  const Eigen::VectorXf mean = embedding.rowwise().sum() / static_cast<float>(kSgprNodes);
-  const Eigen::VectorXf context = (attention_weight_.transpose() * mean).array().tanh();
-  const Eigen::VectorXf attention = (embedding.transpose() * context).unaryExpr([](float v) {
-    return 1.0F / (1.0F + std::exp(-v));
-  });
-  const SgprEmbedding pooled = embedding * attention;
-  if (!pooled.allFinite()) overflowed(source_, "the pooled embedding");
-
+SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* activations) const {
+  const Eigen::MatrixXf input = network_input(graph);
+  std::array<Eigen::MatrixXf, 3> xyz, sem;
+  edge_convolutions(input, xyz, sem, activations);
+  const Eigen::MatrixXf embedding = fuse(xyz[2], sem[2]);
+  AttentionPooling pooling = attention_pool(embedding, attention_weight_);
+  if (!pooling.pooled.allFinite()) overflowed(source_, "the pooled embedding");
   if (activations) {
     activations->input = input;
     activations->xyz1 = xyz[0];
@@ -214,11 +241,11 @@ SgprEmbedding SgprNetwork::embed(const SemanticGraph& graph, SgprActivations* ac
     activations->sem2 = sem[1];
     activations->sem3 = sem[2];
     activations->embedding = embedding;
-    activations->attention_context = context;
-    activations->attention_weights = attention;
-    activations->pooled = pooled;
+    activations->attention_context = pooling.context;
+    activations->attention_weights = pooling.attention;
+    activations->pooled = pooling.pooled;
   }
-  return pooled;
+  return pooling.pooled;
 }
 
 double SgprNetwork::score(const SgprEmbedding& first, const SgprEmbedding& second,

@@ -103,6 +103,12 @@ class SgprNetwork {
                                       std::uint32_t out_channels);
   static Eigen::MatrixXf edge_conv(const EdgeConvLayer& layer, const Eigen::MatrixXf& features,
                                    std::vector<std::array<int, kSgprNeighbours>>* knn_out);
+  /// The three EdgeConv layers of each branch (FORMAT.md 5.2) on the input's
+  /// xyz rows and one-hot rows; throws when a layer's output is not finite.
+  void edge_convolutions(const Eigen::MatrixXf& input, std::array<Eigen::MatrixXf, 3>& xyz,
+                         std::array<Eigen::MatrixXf, 3>& sem, SgprActivations* activations) const;
+  /// Fusion (FORMAT.md 5.3): u = [p3, s3] per node, 1x1 conv + BN + LeakyReLU; 32 x N.
+  [[nodiscard]] Eigen::MatrixXf fuse(const Eigen::MatrixXf& xyz, const Eigen::MatrixXf& sem) const;
 
   std::filesystem::path source_;  ///< the weights' file, named in errors
   std::array<EdgeConvLayer, 3> xyz_layers_, sem_layers_;

@@ -94,18 +94,13 @@ void write_relocalizations_csv(const std::filesystem::path& file, const Localize
 
 }  // namespace
 
-LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, const PriorMap& map,
-                               std::optional<SgprNetwork> network, const std::filesystem::path& out_dir,
-                               const LocalizeRunOptions& options) {
-  const SourceInfo& info = source.info();
-  if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
-  OutputFolder folder = open_run_folder(out_dir, info.folder, "localize", kLocalizeOutputs);
-  const std::optional<Pose> tr = output_velo_to_cam(info);
-  TrajectoryWriter writer(folder / "poses.txt", folder / "poses_tum.txt", tr);
+namespace {
 
-  Localizer localizer(config, map, std::move(network));
-  LocalizeRunResult result;
-  ProgressBar progress(info.size(), "localize", options.show_progress);
+// The frame loop: every frame of `source` through the localiser, the placed
+// frames' poses written as they come; returns the loop's wall time [s].
+double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWriter& writer, bool show_progress) {
+  const SourceInfo& info = source.info();
+  ProgressBar progress(info.size(), "localize", show_progress);
   const StageTimer timer;
   for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
     const LabelledCloud scan = source.scan(i);
@@ -115,20 +110,17 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
     progress.advance();
   }
   progress.finish();
-  result.seconds = timer.elapsed_s();
-  result.interrupted = stop_requested();
-  writer.commit();
+  return timer.elapsed_s();
+}
 
-  // Counts and the evaluation.
+// Counts of the frames and relocalisations, and their errors against the
+// source's reference poses (`truth`: the same in the map's frame) when known.
+void evaluate_frames(const Localizer& localizer, const std::optional<std::vector<Pose>>& reference,
+                     const std::optional<std::vector<Pose>>& truth, const LocalizeRunOptions& options,
+                     LocalizeRunResult& result) {
   const auto& frames = localizer.frames();
   result.frames = frames.size();
-  std::vector<Pose> placed_estimates, placed_references, localized_references, localized_estimates;
-  const std::optional<std::vector<Pose>> reference = reference_lidar_poses(info, frames.size());
-  std::optional<std::vector<Pose>> truth;
-  if (reference && options.truth_map_from_source) {
-    truth.emplace();
-    for (const Pose& p : *reference) truth->push_back(orthonormalized(*options.truth_map_from_source * p));
-  }
+  std::vector<Pose> placed_estimates, placed_references;
   const auto aligned = [&](const Pose& p) { return options.map_alignment ? Pose(*options.map_alignment * p) : p; };
   std::vector<double> placed_errors, localized_errors;
   for (const LocalizedFrame& f : frames) {
@@ -172,17 +164,12 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
   if (placed_estimates.size() >= 3) {
     result.aligned_ate_m = compute_ate(placed_references, placed_estimates, Alignment::kSE3).aligned.rmse;
   }
-  std::vector<double> total;
-  for (const auto& f : frames) total.push_back(f.timing.total_ms());
-  const Summary frame_summary = summarize(total);
-  result.median_frame_ms = frame_summary.median;
-  result.mean_frame_ms = frame_summary.mean;
-  result.peak_rss_mib = peak_rss_mib();
-  result.map_loads = map.loads();
+}
 
-  const std::vector<Pose>* truth_ptr = truth ? &*truth : nullptr;
-  write_frames_csv(folder / "frames.csv", localizer, truth_ptr);
-  write_relocalizations_csv(folder / "relocalizations.csv", localizer, truth_ptr);
+// timing.json: per-stage timings, Hz, memory and the map's feature cache.
+nlohmann::json localize_timing_json(const std::vector<LocalizedFrame>& frames, const std::vector<double>& total,
+                                    const Summary& frame_summary, const LocalizeRunResult& result,
+                                    const PriorMap& map) {
   const auto column_of = [&](double LocalizeFrameTimings::*member) {
     std::vector<double> v;
     for (const auto& f : frames) v.push_back(f.timing.*member);
@@ -201,8 +188,10 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
                           {"relocalization", stage_stats(column_of(&LocalizeFrameTimings::relocalization_ms))},
                           {"tracking", stage_stats(column_of(&LocalizeFrameTimings::tracking_ms))},
                           {"total", stage_stats(total)}}}};
-  write_file_atomically(folder / "timing.json", timing.dump(2) + '\n');
+  return timing;
+}
 
+nlohmann::json localize_summary_json(const SourceInfo& info, const PriorMap& map, const LocalizeRunResult& result) {
   nlohmann::json summary{{"command", "localize"},
                          {"first_frame", info.first_frame},
                          {"map", std::filesystem::absolute(map.saved().folder).lexically_normal().string()},
@@ -223,7 +212,49 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
   if (result.localized_rmse_m) summary["localized_rmse_in_map_m"] = *result.localized_rmse_m;
   if (result.placed_rmse_m) summary["placed_rmse_in_map_m"] = *result.placed_rmse_m;
   if (info.folder) summary["sequence"] = std::filesystem::absolute(*info.folder).lexically_normal().string();
-  write_run_summary(folder, std::move(summary));
+  return summary;
+}
+
+}  // namespace
+
+LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, const PriorMap& map,
+                               std::optional<SgprNetwork> network, const std::filesystem::path& out_dir,
+                               const LocalizeRunOptions& options) {
+  const SourceInfo& info = source.info();
+  if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
+  OutputFolder folder = open_run_folder(out_dir, info.folder, "localize", kLocalizeOutputs);
+  const std::optional<Pose> tr = output_velo_to_cam(info);
+  TrajectoryWriter writer(folder / "poses.txt", folder / "poses_tum.txt", tr);
+
+  Localizer localizer(config, map, std::move(network));
+  LocalizeRunResult result;
+  result.seconds = localize_frames(source, localizer, writer, options.show_progress);
+  result.interrupted = stop_requested();
+  writer.commit();
+
+  // Counts and the evaluation.
+  const auto& frames = localizer.frames();
+  const std::optional<std::vector<Pose>> reference = reference_lidar_poses(info, frames.size());
+  std::optional<std::vector<Pose>> truth;
+  if (reference && options.truth_map_from_source) {
+    truth.emplace();
+    for (const Pose& p : *reference) truth->push_back(orthonormalized(*options.truth_map_from_source * p));
+  }
+  evaluate_frames(localizer, reference, truth, options, result);
+  std::vector<double> total;
+  for (const auto& f : frames) total.push_back(f.timing.total_ms());
+  const Summary frame_summary = summarize(total);
+  result.median_frame_ms = frame_summary.median;
+  result.mean_frame_ms = frame_summary.mean;
+  result.peak_rss_mib = peak_rss_mib();
+  result.map_loads = map.loads();
+
+  const std::vector<Pose>* truth_ptr = truth ? &*truth : nullptr;
+  write_frames_csv(folder / "frames.csv", localizer, truth_ptr);
+  write_relocalizations_csv(folder / "relocalizations.csv", localizer, truth_ptr);
+  write_file_atomically(folder / "timing.json",
+                        localize_timing_json(frames, total, frame_summary, result, map).dump(2) + '\n');
+  write_run_summary(folder, localize_summary_json(info, map, result));
   result.interrupted = stop_requested();
   result.files = folder.files();
   return result;

@@ -342,6 +342,38 @@ JoinedSession join_session(const SlamSystem& slam, const SaloamConfig& config, c
   return s;
 }
 
+// What a saved map records of the run's source: sensor, folder, first frame
+// and the camera frame of its outputs.
+MapManifest run_manifest(const SourceInfo& info, const std::optional<Pose>& tr, const std::string& sensor) {
+  MapManifest manifest;
+  manifest.sensor = sensor;
+  if (info.folder) manifest.source = std::filesystem::absolute(*info.folder).lexically_normal().string();
+  manifest.first_frame = info.first_frame;
+  manifest.camera_frame_outputs = tr.has_value();
+  if (tr) manifest.velo_to_cam = *tr;
+  return manifest;
+}
+
+// Saves the run's map (joined to `join_map` when `joined`) into `folder`;
+// notes its size and time in `result` and returns them for the summary.
+nlohmann::json save_run_map(const std::filesystem::path& folder, const SlamSystem& slam, const SaloamConfig& config,
+                            const MapManifest& manifest, const JoinedSession* joined, const PriorMap* join_map,
+                            SlamRunResult& result) {
+  const StageTimer save_timer;
+  if (joined) {
+    write_joined_map(folder, joined->joined, *join_map, *joined->joining);
+  } else {
+    write_slam_map(folder, slam, config, manifest);
+  }
+  result.map_save_seconds = save_timer.elapsed_s();
+  result.map_bytes = map_disk_bytes(folder);
+  result.map_keyframes = joined ? joined->joined.map.keyframes.size() : slam.keyframes().size();
+  return {{"folder", std::filesystem::absolute(folder).lexically_normal().string()},
+          {"bytes", *result.map_bytes},
+          {"keyframes", result.map_keyframes},
+          {"seconds", result.map_save_seconds}};
+}
+
 }  // namespace
 
 SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::optional<SgprNetwork> network,
@@ -376,12 +408,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   result.registration_failures = health.failures();
   result.degenerate_frames = health.degenerate_frames();
   odometry_writer.commit();
-  MapManifest manifest;
-  manifest.sensor = options.sensor;
-  if (info.folder) manifest.source = std::filesystem::absolute(*info.folder).lexically_normal().string();
-  manifest.first_frame = info.first_frame;
-  manifest.camera_frame_outputs = tr.has_value();
-  if (tr) manifest.velo_to_cam = *tr;
+  const MapManifest manifest = run_manifest(info, tr, options.sensor);
   std::optional<JoinedSession> joined;
   if (options.join_map && !stop_requested() && !slam.keyframes().empty()) {
     joined.emplace(join_session(slam, config, manifest, *options.join_map));
@@ -391,21 +418,9 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   const std::vector<Pose> optimized = joined ? joined->frame_poses : slam.optimized_poses();
   nlohmann::json summary = write_results(slam, optimized, slam_writer, config, source, tr, out_dir, result);
   if (joined) summary["session_join"] = join_summary_json(joined->joined);
-
   if (options.save_map && !stop_requested() && !slam.keyframes().empty()) {
-    const StageTimer save_timer;
-    if (joined) {
-      write_joined_map(*options.save_map, joined->joined, *options.join_map, *joined->joining);
-    } else {
-      write_slam_map(*options.save_map, slam, config, manifest);
-    }
-    result.map_save_seconds = save_timer.elapsed_s();
-    result.map_bytes = map_disk_bytes(*options.save_map);
-    result.map_keyframes = joined ? joined->joined.map.keyframes.size() : slam.keyframes().size();
-    summary["saved_map"] = {{"folder", std::filesystem::absolute(*options.save_map).lexically_normal().string()},
-                            {"bytes", *result.map_bytes},
-                            {"keyframes", result.map_keyframes},
-                            {"seconds", result.map_save_seconds}};
+    summary["saved_map"] = save_run_map(*options.save_map, slam, config, manifest, joined ? &*joined : nullptr,
+                                        options.join_map, result);
   }
   if (options.write_map && !stop_requested()) {
     const LabelledCloud map = map_scans ? map_scans->build(optimized, options.show_progress)

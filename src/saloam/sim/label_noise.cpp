@@ -42,34 +42,46 @@ Confusion confusion_of(std::uint8_t c) {
   }
 }
 
-}  // namespace
+/// Ground-truth learning class per range-image cell (kNoReturn where none).
+class ClassImage {
+ public:
+  static constexpr std::uint8_t kNoReturn = 0xFF;
+  ClassImage(int beams, int columns)
+      : beams_(beams), columns_(columns),
+        cells_(static_cast<std::size_t>(beams) * static_cast<std::size_t>(columns), kNoReturn) {}
+  [[nodiscard]] int beams() const { return beams_; }
+  [[nodiscard]] int columns() const { return columns_; }
+  [[nodiscard]] std::uint8_t at(int ring, int column) const { return cells_[cell(ring, column)]; }
+  void set(int ring, int column, std::uint8_t c) { cells_[cell(ring, column)] = c; }
 
-std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int beams, int columns, std::uint64_t seed,
-                                                const LabelNoiseOptions& options) {
-  const std::size_t n = scan.cloud.size();
-  if (scan.ring.size() != n || scan.column.size() != n) throw ConfigError("scan without range-image indices");
-  if (beams <= 0 || columns <= 0 || options.boundary_columns < 0 || options.boundary_columns >= columns ||
-      options.block_rings <= 0 || options.block_columns <= 0) {
-    throw ConfigError("label noise: range image or neighbourhood sizes out of range");
+ private:
+  [[nodiscard]] std::size_t cell(int ring, int column) const {
+    return static_cast<std::size_t>(ring) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(column);
   }
-  // Ground-truth learning class per range-image cell (kNoReturn where none).
-  constexpr std::uint8_t kNoReturn = 0xFF;
-  const auto cell = [columns](int ring, int column) {
-    return static_cast<std::size_t>(ring) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column);
-  };
-  std::vector<std::uint8_t> image(static_cast<std::size_t>(beams) * static_cast<std::size_t>(columns), kNoReturn);
-  std::vector<std::uint8_t> truth(n);
-  for (std::size_t i = 0; i < n; ++i) {
+  int beams_, columns_;
+  std::vector<std::uint8_t> cells_;
+};
+
+/// Each point's learning class, also written into `image`; unlabelled
+/// structure counts as building (the network calls it something solid).
+std::vector<std::uint8_t> true_classes(const SimulatedScan& scan, ClassImage& image) {
+  std::vector<std::uint8_t> truth(scan.cloud.size());
+  for (std::size_t i = 0; i < truth.size(); ++i) {
     std::uint8_t c = to_learning_class(scan.cloud.label[i]);
-    if (c == 0) c = kBuilding;  // other-structure etc.: the network calls it something solid
+    if (c == 0) c = kBuilding;  // other-structure etc.
     truth[i] = c;
-    image[cell(scan.ring[i], scan.column[i])] = c;
+    image.set(scan.ring[i], scan.column[i], c);
   }
-  std::vector<std::uint8_t> out(truth);
-  Rng rng(hash_combine(seed, 0x1abe1ull));
+  return truth;
+}
 
-  // 1. Blurry class boundaries: range-image networks smear labels across edges.
-  for (std::size_t i = 0; i < n; ++i) {
+/// 1. Blurry class boundaries: range-image networks smear labels across
+/// edges; a point takes a neighbour's other class the more likely the more of
+/// its neighbourhood (adjacent rings, +-boundary_columns) has other classes.
+void blur_boundaries(const SimulatedScan& scan, const ClassImage& image, const std::vector<std::uint8_t>& truth,
+                     const LabelNoiseOptions& options, Rng& rng, std::vector<std::uint8_t>& out) {
+  const int beams = image.beams(), columns = image.columns();
+  for (std::size_t i = 0; i < truth.size(); ++i) {
     const int r = scan.ring[i], c = scan.column[i];
     std::array<std::uint8_t, 16> other{};
     int n_other = 0, n_seen = 0;
@@ -79,28 +91,30 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
         int cc = c + dc;  // wraps around the turn
         if (cc < 0) cc += columns;
         if (cc >= columns) cc -= columns;
-        const std::uint8_t k = image[cell(rr, cc)];
-        if (k == kNoReturn) continue;
+        const std::uint8_t k = image.at(rr, cc);
+        if (k == ClassImage::kNoReturn) continue;
         ++n_seen;
         if (k != truth[i] && n_other < 16) other[static_cast<std::size_t>(n_other++)] = k;
       }
     }
     const double u = rng.uniform(), v = rng.uniform();
-    // More likely the more of the neighbourhood belongs to other classes.
     const double share = static_cast<double>(n_other) / static_cast<double>(n_seen);
     if (n_other > 0 && u < options.boundary_flip * share) out[i] = other[static_cast<std::size_t>(v * n_other)];
   }
+}
 
-  // 2. Correlated confusions between similar classes, blob by blob: every
-  // point of one class in one block of the range image shares the outcome
-  // (drawn from the block's own seed; remembered while the points, stored
-  // ring by ring, stay in the same block and class).
+/// 2. Correlated confusions between similar classes, blob by blob: every
+/// point of one class in one block of the range image shares the outcome
+/// (drawn from the block's own seed; remembered while the points, stored
+/// ring by ring, stay in the same block and class).
+void confuse_blobs(const SimulatedScan& scan, const std::vector<std::uint8_t>& truth, std::uint64_t seed,
+                   const LabelNoiseOptions& options, std::vector<std::uint8_t>& out) {
   struct Blob {
     int block_ring = -1, block_column = -1;
     std::uint8_t truth = 0;
     std::uint8_t label = 0;  // what its points are called; 0 = their true class
   } blob;
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < truth.size(); ++i) {
     const int block_ring = scan.ring[i] / options.block_rings, block_column = scan.column[i] / options.block_columns;
     if (block_ring != blob.block_ring || block_column != blob.block_column || truth[i] != blob.truth) {
       blob = {block_ring, block_column, truth[i], 0};
@@ -113,15 +127,35 @@ std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int b
     }
     if (blob.label != 0) out[i] = blob.label;
   }
+}
 
-  // 3. A few plainly wrong labels, drawn from the common classes (networks
-  // do not hallucinate rare ones like signs out of nothing).
+/// 3. A few plainly wrong labels, drawn from the common classes (networks
+/// do not hallucinate rare ones like signs out of nothing).
+void add_wrong_labels(const LabelNoiseOptions& options, Rng& rng, std::vector<std::uint8_t>& out) {
   constexpr std::array<std::uint8_t, 7> kCommon{kRoad, kSidewalk, kBuilding, kVegetation, kTerrain, kCar, kFence};
-  for (std::size_t i = 0; i < n; ++i) {
+  for (auto& label : out) {
     const double u = rng.uniform(), v = rng.uniform();
-    if (u < options.random_label) out[i] = kCommon[static_cast<std::size_t>(v * kCommon.size())];
+    if (u < options.random_label) label = kCommon[static_cast<std::size_t>(v * kCommon.size())];
   }
+}
 
+}  // namespace
+
+std::vector<std::uint16_t> emulate_segmentation(const SimulatedScan& scan, int beams, int columns, std::uint64_t seed,
+                                                const LabelNoiseOptions& options) {
+  const std::size_t n = scan.cloud.size();
+  if (scan.ring.size() != n || scan.column.size() != n) throw ConfigError("scan without range-image indices");
+  if (beams <= 0 || columns <= 0 || options.boundary_columns < 0 || options.boundary_columns >= columns ||
+      options.block_rings <= 0 || options.block_columns <= 0) {
+    throw ConfigError("label noise: range image or neighbourhood sizes out of range");
+  }
+  ClassImage image(beams, columns);
+  const std::vector<std::uint8_t> truth = true_classes(scan, image);
+  std::vector<std::uint8_t> out(truth);
+  Rng rng(hash_combine(seed, 0x1abe1ull));
+  blur_boundaries(scan, image, truth, options, rng, out);
+  confuse_blobs(scan, truth, seed, options, out);
+  add_wrong_labels(options, rng, out);
   std::vector<std::uint16_t> labels(n);
   for (std::size_t i = 0; i < n; ++i) labels[i] = from_learning_class(out[i]);
   return labels;

@@ -109,90 +109,123 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
   return simulate_scan(world, lidar, SweepRays(lidar), sweep);
 }
 
-SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepRays& rays, const SweepSpec& sweep) {
-  const int columns = lidar.azimuth_steps, beams = lidar.beams();
-  if (rays.columns != columns || static_cast<int>(rays.sin_el.size()) != beams) {
-    throw ConfigError("ray table of another lidar model");
+namespace {
+
+/// One range-image cell's return, in the sensor frame at its column's instant.
+struct CellReturn {
+  Eigen::Vector3f point = Eigen::Vector3f::Zero();
+  float remission = 0;
+  float range = 0;  ///< [m]
+  std::uint16_t label = 0, instance = 0;
+  bool valid = false;
+};
+
+/// The moving objects `agents` near a column's vertical plane: not behind the
+/// sensor at `origin` looking along `heading`, and within their footprint
+/// radius of the plane.
+void agents_near_plane(const std::vector<Primitive>& agents, const Eigen::Vector2d& origin,
+                       const Eigen::Vector3d& heading, std::vector<Primitive>& near) {
+  Eigen::Vector2d h2 = heading.head<2>();
+  if (h2.norm() > 1e-9) h2.normalize();
+  near.clear();
+  for (const auto& p : agents) {
+    const Eigen::Vector2d rel = p.center.cast<double>() - origin;
+    const double along = rel.dot(h2), across = std::abs(rel.x() * h2.y() - rel.y() * h2.x());
+    const double radius = p.footprint_radius();
+    if (along > -radius && across < radius + 0.05) near.push_back(p);
   }
-  struct Return {
-    Eigen::Vector3f point;
-    float remission;
-    float range;
-    std::uint16_t label, instance;
-    bool valid;
-  };
-  std::vector<Return> grid(static_cast<std::size_t>(columns) * static_cast<std::size_t>(beams));
+}
 
-  std::vector<float> column_offset(static_cast<std::size_t>(columns), 0.0f);
-  tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
-    std::vector<Primitive> agents, near;
-    for (int c = range.begin(); c < range.end(); ++c) {
-      const double frac = lidar.column_fraction(c);
-      const Pose sensor = column_pose(lidar, sweep, c);
-      const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
-      const double cos_az = rays.cos_az[static_cast<std::size_t>(c)], sin_az = rays.sin_az[static_cast<std::size_t>(c)];
-      // The sensor stays on a car on the ground (World::sensor_origin); the
-      // points are in the sensor frame, so a height error of the pose, if
-      // any, shows up as it does in real data: between poses and scans.
-      const World::RayOrigin rays_from = world.ray_origin(world.sensor_origin(sensor.translation()));
-      const Eigen::Vector3d& origin = rays_from.position;
-      column_offset[static_cast<std::size_t>(c)] = static_cast<float>(origin.z() - sensor.translation().z());
-      // Moving objects at this column's time, kept only near the column's vertical plane.
-      world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
-      const Eigen::Vector3d heading = sensor.linear() * Eigen::Vector3d(cos_az, sin_az, 0.0);
-      Eigen::Vector2d h2 = heading.head<2>();
-      if (h2.norm() > 1e-9) h2.normalize();
-      near.clear();
-      for (const auto& p : agents) {
-        const Eigen::Vector2d rel = p.center.cast<double>() - origin.head<2>();
-        const double along = rel.dot(h2), across = std::abs(rel.x() * h2.y() - rel.y() * h2.x());
-        const double radius = p.footprint_radius();
-        if (along > -radius && across < radius + 0.05) near.push_back(p);
-      }
-      Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
-      for (int b = 0; b < beams; ++b) {
-        const Eigen::Vector3d dir_s = rays.direction(b, c);
-        const Eigen::Vector3d dir = sensor.linear() * dir_s;
-        Return& out = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
-        out.valid = false;
-        if (rays.is_blocked(b, c)) continue;
-        const RayHit hit = world.cast_ray(rays_from, dir, lidar.max_range, t, near, rng);
-        // Draw every random number whether or not it is used, so that one
-        // ray's outcome never shifts the noise of the next.
-        const double noise = rng.normal() * lidar.range_noise;
-        const double drop = rng.uniform();
-        const double rem_noise = rng.normal() * lidar.remission_noise;
-        if (!hit.hit) continue;
-        const double range_m = hit.range + noise;
-        if (range_m < lidar.min_range || range_m > lidar.max_range) continue;
-        // Weak far returns from dark surfaces are lost more often.
-        const double far = range_m / lidar.max_range;
-        const double p_drop = lidar.dropout + 0.25 * far * far * (1.0 - std::min(1.0, static_cast<double>(hit.remission) * 2.0));
-        if (drop < p_drop) continue;
-        // A spinning LiDAR reports each return in its own frame at the
-        // column's instant: the scan is distorted by the motion during the
-        // sweep (pose `start` names the sweep, not every point's frame).
-        out.point = (range_m * dir_s).cast<float>();
-        out.remission = static_cast<float>(std::clamp(hit.remission + rem_noise, 0.0, 0.99));
-        out.range = static_cast<float>(range_m);
-        out.label = hit.label;
-        out.instance = hit.instance;
-        out.valid = true;
-      }
-    }
-  });
+/// What the sensor reports of a ray (direction `dir_s` in the sensor frame)
+/// that met `hit`: range noise, dropout (weak far returns from dark surfaces
+/// are lost more often) and remission noise. Every random number is drawn
+/// whether or not it is used, so that one ray's outcome never shifts the
+/// noise of the next.
+CellReturn sensor_return(const RayHit& hit, const Eigen::Vector3d& dir_s, const LidarModel& lidar, Rng& rng) {
+  const double noise = rng.normal() * lidar.range_noise;
+  const double drop = rng.uniform();
+  const double rem_noise = rng.normal() * lidar.remission_noise;
+  CellReturn out;
+  if (!hit.hit) return out;
+  const double range_m = hit.range + noise;
+  if (range_m < lidar.min_range || range_m > lidar.max_range) return out;
+  const double far = range_m / lidar.max_range;
+  const double p_drop = lidar.dropout + 0.25 * far * far * (1.0 - std::min(1.0, static_cast<double>(hit.remission) * 2.0));
+  if (drop < p_drop) return out;
+  // A spinning LiDAR reports each return in its own frame at the
+  // column's instant: the scan is distorted by the motion during the
+  // sweep (pose `start` names the sweep, not every point's frame).
+  out.point = (range_m * dir_s).cast<float>();
+  out.remission = static_cast<float>(std::clamp(hit.remission + rem_noise, 0.0, 0.99));
+  out.range = static_cast<float>(range_m);
+  out.label = hit.label;
+  out.instance = hit.instance;
+  out.valid = true;
+  return out;
+}
 
+/// A range image of returns, ring by ring.
+class ReturnGrid {
+ public:
+  ReturnGrid(int beams, int columns)
+      : beams_(beams), columns_(columns), cells_(static_cast<std::size_t>(columns) * static_cast<std::size_t>(beams)) {}
+  CellReturn& at(int beam, int column) { return cells_[index(beam, column)]; }
+  [[nodiscard]] const CellReturn& at(int beam, int column) const { return cells_[index(beam, column)]; }
+  [[nodiscard]] int beams() const { return beams_; }
+  [[nodiscard]] int columns() const { return columns_; }
+  [[nodiscard]] std::size_t valid() const {
+    return static_cast<std::size_t>(std::count_if(cells_.begin(), cells_.end(), [](const CellReturn& r) { return r.valid; }));
+  }
+
+ private:
+  [[nodiscard]] std::size_t index(int beam, int column) const {
+    return static_cast<std::size_t>(beam) * static_cast<std::size_t>(columns_) + static_cast<std::size_t>(column);
+  }
+  int beams_, columns_;
+  std::vector<CellReturn> cells_;
+};
+
+/// Casts column `c`'s rays into `grid` (`agents`, `near`: scratch); returns
+/// the height of the rays' origin over the sensor pose [m].
+float render_column(const World& world, const LidarModel& lidar, const SweepRays& rays, const SweepSpec& sweep, int c,
+                    std::vector<Primitive>& agents, std::vector<Primitive>& near, ReturnGrid& grid) {
+  const double frac = lidar.column_fraction(c);
+  const Pose sensor = column_pose(lidar, sweep, c);
+  const double t = sweep.skew ? sweep.time_start + frac * (sweep.time_end - sweep.time_start) : sweep.time_start;
+  const double cos_az = rays.cos_az[static_cast<std::size_t>(c)], sin_az = rays.sin_az[static_cast<std::size_t>(c)];
+  // The sensor stays on a car on the ground (World::sensor_origin); the
+  // points are in the sensor frame, so a height error of the pose, if
+  // any, shows up as it does in real data: between poses and scans.
+  const World::RayOrigin rays_from = world.ray_origin(world.sensor_origin(sensor.translation()));
+  const Eigen::Vector3d& origin = rays_from.position;
+  // Moving objects at this column's time, kept only near the column's vertical plane.
+  world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
+  agents_near_plane(agents, origin.head<2>(), sensor.linear() * Eigen::Vector3d(cos_az, sin_az, 0.0), near);
+  Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
+  for (int b = 0; b < grid.beams(); ++b) {
+    CellReturn& out = grid.at(b, c);
+    out.valid = false;
+    if (rays.is_blocked(b, c)) continue;
+    const Eigen::Vector3d dir_s = rays.direction(b, c);
+    const RayHit hit = world.cast_ray(rays_from, sensor.linear() * dir_s, lidar.max_range, t, near, rng);
+    out = sensor_return(hit, dir_s, lidar, rng);
+  }
+  return static_cast<float>(origin.z() - sensor.translation().z());
+}
+
+/// The scan of the grid's returns, ring by ring, with each point's ring and
+/// time in the sweep.
+SimulatedScan scan_of(const ReturnGrid& grid, const LidarModel& lidar, const SweepSpec& sweep) {
   SimulatedScan scan;
   const double sweep_span = sweep.skew ? sweep.time_end - sweep.time_start : 0.0;
-  std::size_t count = 0;
-  for (const auto& r : grid) count += r.valid ? 1 : 0;
+  const std::size_t count = grid.valid();
   scan.cloud.reserve(count);
   scan.ring.reserve(count);
   scan.column.reserve(count);
   scan.range.reserve(count);
-  for (int b = 0; b < beams; ++b) {
-    for (int c = 0; c < columns; ++c) {
-      const Return& r = grid[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)];
+  for (int b = 0; b < grid.beams(); ++b) {
+    for (int c = 0; c < grid.columns(); ++c) {
+      const CellReturn& r = grid.at(b, c);
       if (!r.valid) continue;
       scan.cloud.push_back(r.point, r.remission, r.label, r.instance);
       scan.ring.push_back(static_cast<std::uint16_t>(b));
@@ -207,6 +240,25 @@ SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const S
     scan.cloud.time[i] = static_cast<float>(lidar.column_fraction(scan.column[i]) * sweep_span);
   }
   scan.cloud.has_labels = true;
+  return scan;
+}
+
+}  // namespace
+
+SimulatedScan simulate_scan(const World& world, const LidarModel& lidar, const SweepRays& rays, const SweepSpec& sweep) {
+  const int columns = lidar.azimuth_steps, beams = lidar.beams();
+  if (rays.columns != columns || static_cast<int>(rays.sin_el.size()) != beams) {
+    throw ConfigError("ray table of another lidar model");
+  }
+  ReturnGrid grid(beams, columns);
+  std::vector<float> column_offset(static_cast<std::size_t>(columns), 0.0f);
+  tbb::parallel_for(tbb::blocked_range<int>(0, columns, 16), [&](const tbb::blocked_range<int>& range) {
+    std::vector<Primitive> agents, near;
+    for (int c = range.begin(); c < range.end(); ++c) {
+      column_offset[static_cast<std::size_t>(c)] = render_column(world, lidar, rays, sweep, c, agents, near, grid);
+    }
+  });
+  SimulatedScan scan = scan_of(grid, lidar, sweep);
   for (const float dz : column_offset) {
     if (std::abs(dz) > std::abs(scan.sensor_offset)) scan.sensor_offset = dz;
   }

@@ -215,6 +215,9 @@ class World {
 
 
  private:
+  /// Where agent `a` stands at time t (ground-plane position [m]) and the
+  /// path's direction there; false when it is not on the path then.
+  bool agent_place(const Agent& a, double t, Eigen::Vector2d& xy, Eigen::Vector2d& direction) const;
   [[nodiscard]] double bilinear(const std::vector<float>& field, double x, double y) const;
   /// Distance, height and bump interpolated together, plus the cell index
   /// (the ray marcher's hot path: one set of weights for all three).

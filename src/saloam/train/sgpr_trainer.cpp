@@ -279,12 +279,13 @@ void write_checkpoint(const fs::path& out, const SgprTrainer& trainer, const Sgp
   });
 }
 
-struct ResumedRun {
+/// A run's trainer and what it has done so far.
+struct TrainingRun {
   std::unique_ptr<SgprTrainer> trainer;
   SgprTrainResult result;
 };
 
-ResumedRun resume_run(const fs::path& out, const nlohmann::json& options, const SgprOptimizerOptions& optimizer) {
+TrainingRun resume_run(const fs::path& out, const nlohmann::json& options, const SgprOptimizerOptions& optimizer) {
   const fs::path dir = out / "checkpoint";
   const nlohmann::json state = read_checkpoint_state(out);
   // The initial weights matter only for the first epoch: a resumed run need not name them again.
@@ -296,13 +297,40 @@ ResumedRun resume_run(const fs::path& out, const nlohmann::json& options, const 
     throw ConfigError(fmt::format("--resume: the options differ from those of the run in {} ({} there, {} now); resume "
                                   "with the same options (only --epochs may change)",
                                   out.string(), before.dump(), now.dump()));
-  ResumedRun run;
+  TrainingRun run;
   run.trainer = std::make_unique<SgprTrainer>(read_sgpr_weights(dir / "model.sgw"), optimizer);
   run.trainer->load_optimizer(dir / "optimizer.pt");
   run.result.initial_val_max_f1 = state.at("initial_val_max_f1").get<double>();
   run.result.best_epoch = state.at("best_epoch").get<int>();
   for (const auto& r : state.at("history")) run.result.history.push_back(record_from_json(r));
+  spdlog::info("resuming after epoch {} of {}", run.result.history.empty() ? 0 : run.result.history.back().epoch,
+               out.string());
   return run;
+}
+
+/// A new run from seeded or given (--init) weights; their validation F1 is
+/// the one to beat, and they are the best weights until an epoch beats it.
+TrainingRun start_run(const SgprTrainOptions& options, std::span<const GraphSequence> validation) {
+  TrainingRun run;
+  run.trainer = options.init.empty()
+                    ? std::make_unique<SgprTrainer>(options.seed, options.optimizer)
+                    : std::make_unique<SgprTrainer>(read_sgpr_weights(options.init), options.optimizer);
+  run.result.initial_val_max_f1 =
+      validate_sgpr(SgprNetwork(run.trainer->weights()), validation, options.validation).max_f1;
+  write_sgpr_weights(options.out / "best.sgw", run.trainer->weights());
+  return run;
+}
+
+EpochRecord epoch_record(int epoch, const EpochLoss& trained, const PrSummary& val, double seconds) {
+  EpochRecord record;
+  record.epoch = epoch;
+  record.loss = trained.loss;
+  record.pairs = trained.pairs;
+  record.pairs_per_second = trained.seconds > 0 ? static_cast<double>(trained.pairs) / trained.seconds : 0.0;
+  record.val_max_f1 = val.max_f1;
+  record.val_recall_at_full_precision = val.recall_at_full_precision;
+  record.seconds = seconds;
+  return record;
 }
 
 double best_f1(const SgprTrainResult& r) {
@@ -310,6 +338,16 @@ double best_f1(const SgprTrainResult& r) {
   for (const auto& e : r.history)
     if (e.epoch == r.best_epoch) best = e.val_max_f1;
   return best;
+}
+
+/// training.json: `log` (the run's description and options) with the epochs so far.
+nlohmann::json training_log(nlohmann::json log, const SgprTrainResult& result) {
+  log["initial_val_max_f1"] = result.initial_val_max_f1;
+  log["best_epoch"] = result.best_epoch;
+  log["best_val_max_f1"] = best_f1(result);
+  log["epochs"] = nlohmann::json::array();
+  for (const auto& r : result.history) log["epochs"].push_back(record_json(r));
+  return log;
 }
 
 }  // namespace
@@ -327,21 +365,9 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
   set_training_threads(options.threads);
   create_folder(options.out);
   const nlohmann::json options_key = options_json(options);
-
-  std::unique_ptr<SgprTrainer> trainer;
-  SgprTrainResult result;
-  if (options.resume) {
-    auto resumed = resume_run(options.out, options_key, options.optimizer);
-    trainer = std::move(resumed.trainer);
-    result = std::move(resumed.result);
-    spdlog::info("resuming after epoch {} of {}", result.history.empty() ? 0 : result.history.back().epoch,
-                 options.out.string());
-  } else {
-    trainer = options.init.empty() ? std::make_unique<SgprTrainer>(options.seed, options.optimizer)
-                                   : std::make_unique<SgprTrainer>(read_sgpr_weights(options.init), options.optimizer);
-    result.initial_val_max_f1 = validate_sgpr(SgprNetwork(trainer->weights()), validation, options.validation).max_f1;
-    write_sgpr_weights(options.out / "best.sgw", trainer->weights());
-  }
+  TrainingRun run = options.resume ? resume_run(options.out, options_key, options.optimizer)
+                                   : start_run(options, validation);
+  SgprTrainResult& result = run.result;
   spdlog::info("{} positive pairs in the training data; validation max F1 of the initial weights {:.4f}",
                positives.size(), result.initial_val_max_f1);
 
@@ -349,24 +375,17 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
   for (int epoch = first_epoch; epoch <= options.epochs; ++epoch) {
     const StageTimer timer;
     std::mt19937_64 rng = epoch_generator(options.seed, epoch);
-    const auto pairs = epoch_pairs(trainer->weights(), train, positives, options, rng);
-    const EpochLoss trained = train_epoch(*trainer, train, pairs, options, epoch, rng);
+    const auto pairs = epoch_pairs(run.trainer->weights(), train, positives, options, rng);
+    const EpochLoss trained = train_epoch(*run.trainer, train, pairs, options, epoch, rng);
     if (trained.interrupted) {
       result.interrupted = true;
       spdlog::warn("interrupted in epoch {}: it is dropped; the checkpoint after epoch {} is kept (continue with --resume)",
                    epoch, epoch - 1);
       break;
     }
-    const SgprWeights weights = trainer->weights();
+    const SgprWeights weights = run.trainer->weights();
     const PrSummary val = validate_sgpr(SgprNetwork(weights), validation, options.validation);
-    EpochRecord record;
-    record.epoch = epoch;
-    record.loss = trained.loss;
-    record.pairs = trained.pairs;
-    record.pairs_per_second = trained.seconds > 0 ? static_cast<double>(trained.pairs) / trained.seconds : 0.0;
-    record.val_max_f1 = val.max_f1;
-    record.val_recall_at_full_precision = val.recall_at_full_precision;
-    record.seconds = timer.elapsed_s();
+    const EpochRecord record = epoch_record(epoch, trained, val, timer.elapsed_s());
     const bool best = val.max_f1 > best_f1(result);
     result.history.push_back(record);
     if (best) {
@@ -374,18 +393,12 @@ SgprTrainResult train_sgpr(std::span<const GraphSequence> train, std::span<const
       write_sgpr_weights(options.out / "best.sgw", weights);
     }
     write_sgpr_weights(options.out / "model.sgw", weights);
-    write_checkpoint(options.out, *trainer, result, options_key);
-
+    write_checkpoint(options.out, *run.trainer, result, options_key);
     nlohmann::json log = run_info;
     log["options"] = options_key;
     log["epochs_planned"] = options.epochs;
     log["positive_pairs_available"] = positives.size();
-    log["initial_val_max_f1"] = result.initial_val_max_f1;
-    log["best_epoch"] = result.best_epoch;
-    log["best_val_max_f1"] = best_f1(result);
-    log["epochs"] = nlohmann::json::array();
-    for (const auto& r : result.history) log["epochs"].push_back(record_json(r));
-    write_json_atomically(options.out / "training.json", log);
+    write_json_atomically(options.out / "training.json", training_log(std::move(log), result));
     plot_curves(options.out / "curves.png", result);
     if (on_epoch) on_epoch(record);
   }
