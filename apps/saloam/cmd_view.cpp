@@ -1,5 +1,5 @@
 // `saloam view`: the map, the trajectories and the loops of a `saloam slam`
-// run in the browser. Writes one self-contained page (src/saloam/viewer/), or
+// run, or the sessions of a saved map, in the browser. Writes one self-contained page (src/saloam/viewer/), or
 // with --serve serves it from 127.0.0.1 and loads scans on demand.
 
 #include <atomic>
@@ -36,20 +36,29 @@ ViewerOptions viewer_options(const ViewOptions& options) {
 }
 
 /// Writes the page while no run writes the run folder (its lock, joined:
-/// the page is added to the run's record when it lies in the folder).
+/// the page is added to the run's record when it lies in the folder); a
+/// saved map's page goes beside the map.
 int write_page(const ViewOptions& options) {
   const std::filesystem::path page =
-      options.page.empty() ? std::filesystem::path(options.run_dir) / "view.html" : std::filesystem::path(options.page);
+      options.page.empty() ? default_viewer_page(options.run_dir) : std::filesystem::path(options.page);
   std::error_code error;
   std::unique_ptr<OutputFolder> lock;
-  if (std::filesystem::is_directory(options.run_dir, error)) {
+  if (std::filesystem::is_directory(options.run_dir, error) && !is_map_folder(options.run_dir)) {
     lock.reset(new OutputFolder(OutputFolder::join(options.run_dir, "view")));
   }
   const ViewerPageStats s = write_viewer_page(options.run_dir, page, viewer_options(options));
-  std::cout << fmt::format(
-      "wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n", page.string(),
-      static_cast<double>(s.bytes) / 1e6, s.map_points, s.map_points_total, s.frames,
-      s.ground_truth ? " with ground truth" : "", s.loops, s.scans, s.scan_points);
+  if (s.sessions > 0) {
+    std::cout << fmt::format(
+        "wrote {} ({:.1f} MB): {} of {} map points, {} keyframes in {} sessions, {} loops within sessions, {} across, "
+        "{} scans of {} points in all\n",
+        page.string(), static_cast<double>(s.bytes) / 1e6, s.map_points, s.map_points_total, s.frames, s.sessions,
+        s.loops, s.cross_session_loops, s.scans, s.scan_points);
+  } else {
+    std::cout << fmt::format(
+        "wrote {} ({:.1f} MB): {} of {} map points, {} frames{}, {} loops, {} scans of {} points in all\n",
+        page.string(), static_cast<double>(s.bytes) / 1e6, s.map_points, s.map_points_total, s.frames,
+        s.ground_truth ? " with ground truth" : "", s.loops, s.scans, s.scan_points);
+  }
   std::cout << fmt::format("open file://{}\n", std::filesystem::absolute(page).lexically_normal().string());
   return 0;
 }
@@ -77,12 +86,15 @@ int serve(const ViewOptions& options) {
 }
 
 const CommandRegistration kRegistration{Command{
-    "view", "3D viewer in the browser: the semantic map, trajectories, loops and scans of a `saloam slam` run", 27,
+    "view", "3D viewer in the browser: the semantic map, trajectories, loops and scans of a `saloam slam` run or of a saved map's "
+    "sessions",
+    27,
     [](CLI::App& app) {
       auto options = std::make_shared<ViewOptions>();
-      app.add_option("OUT_DIR", options->run_dir, "Output folder of `saloam slam` (map.ply, poses_tum.txt, loops.csv)")
+      app.add_option("OUT_DIR", options->run_dir,
+                     "Output folder of `saloam slam` (map.ply, poses_tum.txt, loops.csv), or a saved map (map.json)")
           ->required();
-      app.add_option("--out", options->page, "Page to write (default OUT_DIR/view.html)");
+      app.add_option("--out", options->page, "Page to write (default OUT_DIR/view.html; for a map MAP.view.html beside it)");
       app.add_option("--max-points", options->viewer.max_map_points, "Map point budget: decimated to at most this many")
           ->capture_default_str()
           ->check(non_negative_integer())
@@ -94,7 +106,7 @@ const CommandRegistration kRegistration{Command{
                      "Budget of the scans embedded in the page, all together (0: none)")
           ->capture_default_str()
           ->check(non_negative_integer());
-      app.add_option("--sequence", options->sequence, "Sequence folder (default: the one recorded in summary.json)");
+      app.add_option("--sequence", options->sequence, "Sequence folder (default: the one recorded in summary.json; not for a map)");
       app.add_flag("--serve", options->serve, "Serve the page from 127.0.0.1 instead, scans loaded on demand");
       app.add_option("--port", options->port, "Port for --serve (0: any free one)")
           ->capture_default_str()

@@ -1,6 +1,6 @@
 // End-to-end: `saloam view` writes the page, a headless Chromium draws it
-// (no JavaScript error, a map in class colours on the canvas), and --serve
-// serves it until Ctrl-C.
+// (no JavaScript error, a map in class colours on the canvas; a saved map's
+// sessions each in its colour), and --serve serves it until Ctrl-C.
 
 #include <fcntl.h>
 #include <signal.h>
@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
+#include <iostream>
 #include <regex>
 #include <string>
 #include <thread>
@@ -20,6 +21,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "saloam/maps/map_format.hpp"
 #include "testing/test_support.hpp"
 #include "viewer/viewer_fixture.hpp"
 
@@ -162,6 +164,94 @@ TEST(ViewCli, HeadlessChromiumDrawsTheMapWithoutErrors) {
   EXPECT_GT(counts.road, 200U);
   EXPECT_GT(counts.building, 200U);
   EXPECT_GT(counts.vegetation, 100U);
+}
+
+/// Pixels of the screenshot's centre within 10 of `color` in each channel.
+std::size_t pixels_of(const fs::path& png, Rgb color) {
+  std::size_t count = 0;
+  cairo_surface_t* surface = cairo_image_surface_create_from_png(png.c_str());
+  if (cairo_surface_status(surface) == CAIRO_STATUS_SUCCESS) {
+    cairo_surface_flush(surface);
+    const int width = cairo_image_surface_get_width(surface), height = cairo_image_surface_get_height(surface);
+    const int stride = cairo_image_surface_get_stride(surface);
+    const unsigned char* data = cairo_image_surface_get_data(surface);
+    for (int y = height / 8; y < height * 7 / 8; ++y)
+      for (int x = width * 3 / 10; x < width * 9 / 10; ++x) count += near(data + y * stride + 4 * x, color);
+  }
+  cairo_surface_destroy(surface);
+  return count;
+}
+
+// Two simulated passes along one street (16 beams, 60 and 70 frames,
+// overlapping over 30), mapped and joined by `saloam slam --map`: a map of
+// two linked sessions. The page has one trajectory per session, in its own
+// colour, and the map's cross-session loop edges.
+TEST(ViewCli, SavedMapShowsOneTrajectoryPerSession) {
+  TempDir tmp;
+  std::string output;
+  for (const char* pass : {"0", "1"}) {
+    ASSERT_EQ(run_command(saloam_cmd(fmt::format("simulate --preset straight --passes 0:60,30:100 --pass {} --beams 16 "
+                                                 "--labels noisy --out {}",
+                                                 pass, quoted(tmp / (std::string("pass") + pass)))),
+                          &output),
+              0)
+        << output;
+  }
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {} --save-map {} --no-map", quoted(tmp / "pass0"),
+                                               quoted(tmp / "slamA"), quoted(tmp / "mapA"))),
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {} --map {} --save-map {} --no-map",
+                                               quoted(tmp / "pass1"), quoted(tmp / "slamAB"), quoted(tmp / "mapA"),
+                                               quoted(tmp / "mapAB"))),
+                        &output),
+            0)
+      << output;
+  const SavedMap map = read_map(tmp / "mapAB");
+  ASSERT_EQ(map.manifest.sessions.size(), 2U);
+  ASSERT_TRUE(map.manifest.sessions[1].linked) << "the second pass did not join the first";
+  ASSERT_GT(map.manifest.cross_session_loops, 0U);
+
+  ASSERT_EQ(run_command(saloam_cmd("view " + quoted(tmp / "mapAB")), &output), 0) << output;
+  EXPECT_NE(output.find(fmt::format("{} keyframes in 2 sessions", map.keyframes.size())), std::string::npos) << output;
+  EXPECT_NE(output.find(fmt::format("{} across", map.manifest.cross_session_loops)), std::string::npos) << output;
+  const fs::path page = tmp / "mapAB.view.html";
+  ASSERT_TRUE(fs::exists(page)) << "the page goes beside the map";
+  EXPECT_FALSE(fs::exists(tmp / "mapAB/view.html")) << "the map folder holds only the map";
+  const auto data = testing::page_data(testing::read_text(page));
+  ASSERT_EQ(data["trajectories"].size(), 2U);
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_EQ(data["trajectories"][s]["count"], fmt::format("{} keyframes", map.manifest.sessions[s].keyframes));
+  }
+  EXPECT_EQ(data["cross_loops"].size(), map.manifest.cross_session_loops);
+
+  SALOAM_REQUIRE_CHROMIUM();
+  const std::string dom = chromium(tmp, "--dump-dom", page);
+  std::smatch title;
+  ASSERT_TRUE(std::regex_search(dom, title, std::regex("<title>([^<]*)</title>"))) << dom.substr(0, 2000);
+  EXPECT_EQ(title[1].str().rfind("ready:", 0), 0U) << title[1];
+  EXPECT_NE(title[1].str().find("trajectories:2 "), std::string::npos) << title[1];
+  EXPECT_EQ(dom.find(":CONSOLE"), std::string::npos) << "console output:\n" << dom.substr(0, 4000);
+  // The legend (built by the page's script): both sessions with their keyframe counts.
+  const std::string legend = dom.substr(0, dom.find("const SALOAM_DATA"));
+  for (std::size_t s = 0; s < 2; ++s) {
+    EXPECT_NE(legend.find(fmt::format("session {}: pass{}", s, s)), std::string::npos) << legend.substr(0, 4000);
+    EXPECT_NE(legend.find(fmt::format("{} keyframes", map.manifest.sessions[s].keyframes)), std::string::npos);
+  }
+  EXPECT_NE(legend.find("cross-session loop edges"), std::string::npos);
+
+  // At the last keyframe (view.html#frame=N opens there): its scan, drawn
+  // over the trajectories, lies at session 1's end, away from session 0's
+  // start, the part of session 0 that session 1 (drawn after it) does not cover.
+  const fs::path png = tmp / "map.png";
+  const fs::path at_last = page.string() + fmt::format("#frame={}", map.keyframes.size() - 1);
+  const std::string shot = chromium(tmp, fmt::format("--screenshot={} --window-size=1600,1200", quoted(png)), at_last);
+  ASSERT_TRUE(fs::exists(png)) << shot;
+  const std::size_t first = pixels_of(png, Rgb{0x3b, 0x9c, 0xff}), second = pixels_of(png, Rgb{0xff, 0x98, 0x00});
+  std::cout << fmt::format("session pixels: {} and {}\n", first, second);
+  EXPECT_GT(first, 20U) << "session 0's trajectory is not drawn";
+  EXPECT_GT(second, 20U) << "session 1's trajectory is not drawn";
 }
 
 /// `saloam ARGS...` as a child process, its output into `log`.

@@ -1,5 +1,5 @@
-// The viewer page: its data, the point budgets, the encodings, bad input, and
-// the local server.
+// The viewer page: its data, the point budgets, the encodings, bad input,
+// the local server, and a saved map's sessions.
 
 #include <gtest/gtest.h>
 
@@ -16,6 +16,9 @@
 
 #include <fmt/format.h>
 
+#include "saloam/core/semantic_classes.hpp"
+#include "saloam/maps/map_format.hpp"
+#include "saloam/place/scan_context.hpp"
 #include "saloam/viewer/point_encoding.hpp"
 #include "saloam/viewer/viewer_page.hpp"
 #include "saloam/viewer/viewer_server.hpp"
@@ -316,6 +319,128 @@ TEST(Viewer, IdleConnectionsDoNotStallTheServer) {
   EXPECT_EQ(answer->status, 200);
   EXPECT_LT(seconds, 1.5);
   for (const int fd : idle) ::close(fd);
+}
+
+// A saved map of two sessions made by hand: session 0 six keyframes 5 m
+// apart along x, session 1 four keyframes from x = 10 m, 2 m beside it.
+// Keyframe k has 20 + k road points along its x axis and 5 building points
+// above y = 10 m. Odometry edges within each session, one loop edge within
+// session 0 (0-5) and two across (2-7, 3-8).
+constexpr std::size_t kMapKeyframes = 10;
+std::size_t keyframe_points(std::size_t k) { return 20 + k + 5; }
+
+void write_two_session_map(const fs::path& folder) {
+  SavedMap map;
+  map.manifest.sessions = {MapSession{"/data/first", 0, 6, true}, MapSession{"/data/second", 10, 4, true}};
+  std::vector<StoredFeatures> features;
+  for (std::size_t k = 0; k < kMapKeyframes; ++k) {
+    MapKeyframe kf;
+    kf.session = k < 6 ? 0 : 1;
+    kf.frame = kf.session == 0 ? k : k - 6;
+    kf.pose.translation() = kf.session == 0 ? Eigen::Vector3d(5.0 * static_cast<double>(k), 0, 0)
+                                            : Eigen::Vector3d(10 + 5.0 * static_cast<double>(k - 6), 2, 0);
+    map.keyframes.push_back(kf);
+    PlaceDescriptor place;  // the default detector's (Scan Context's 20 x 60); the viewer does not read it
+    place.context = scan_context_from_descriptor(Eigen::MatrixXf::Zero(20, 60));
+    map.places.push_back(place);
+    StoredFeatures f;
+    for (std::size_t i = 0; i < 20 + k; ++i) {
+      f.planar_points.emplace_back(static_cast<float>(i), 0.0F, -1.7F);
+      f.planar_classes.push_back(to_learning_class(cls::kRoad));
+    }
+    for (std::size_t i = 0; i < 5; ++i) {
+      f.edge_points.emplace_back(0.0F, 10.0F, static_cast<float>(i));
+      f.edge_classes.push_back(to_learning_class(cls::kBuilding));
+    }
+    features.push_back(f);
+  }
+  const auto edge = [&](std::size_t from, std::size_t to, EdgeKind kind) {
+    map.edges.push_back({from, to, map.keyframes[from].pose.inverse() * map.keyframes[to].pose, Matrix6d::Identity(),
+                         kind});
+  };
+  for (std::size_t k = 1; k < kMapKeyframes; ++k)
+    if (k != 6) edge(k - 1, k, EdgeKind::kOdometry);
+  edge(0, 5, EdgeKind::kLoop);
+  edge(2, 7, EdgeKind::kLoop);
+  edge(3, 8, EdgeKind::kLoop);
+  write_map(folder, map, [&](std::size_t k) -> const StoredFeatures& { return features[k]; });
+}
+
+TEST(Viewer, SavedMapGivesATrajectoryPerSessionAndItsLoopEdges) {
+  TempDir tmp;
+  write_two_session_map(tmp / "map");
+  ASSERT_TRUE(is_map_folder(tmp / "map"));
+  const ViewerScene scene = load_viewer_scene(tmp / "map");
+  ASSERT_EQ(scene.sessions.size(), 2U);
+  EXPECT_EQ(scene.sessions[0].frames, (std::vector<std::size_t>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(scene.sessions[1].frames, (std::vector<std::size_t>{6, 7, 8, 9}));
+  EXPECT_EQ(scene.sessions[1].name, "/data/second");
+  EXPECT_TRUE(scene.sessions[1].linked);
+  ASSERT_EQ(scene.loop_closed.size(), kMapKeyframes);
+  EXPECT_NEAR((scene.loop_closed[7].translation() - Eigen::Vector3d(15, 2, 0)).norm(), 0.0, 1e-12);
+  using Edges = std::vector<std::pair<std::size_t, std::size_t>>;
+  EXPECT_EQ(scene.loops, (Edges{{0, 5}}));
+  EXPECT_EQ(scene.cross_session_loops, (Edges{{2, 7}, {3, 8}}));
+
+  // The map: every feature point, placed by its keyframe's pose.
+  std::size_t points = 0;
+  for (std::size_t k = 0; k < kMapKeyframes; ++k) points += keyframe_points(k);
+  EXPECT_EQ(scene.map_points_total, points);
+  ASSERT_EQ(scene.map.size(), points);
+  float max_x = 0;
+  std::size_t buildings = 0;
+  for (std::size_t i = 0; i < scene.map.size(); ++i) {
+    max_x = std::max(max_x, scene.map.points[i].x());
+    buildings += scene.map.label[i] == cls::kBuilding;
+  }
+  EXPECT_FLOAT_EQ(max_x, 25.0F + 28.0F);  // keyframe 9 at x = 25 m, its last road point 28 m ahead
+  EXPECT_EQ(buildings, 5 * kMapKeyframes);
+  // The scan at the slider: the keyframe's features in its own frame.
+  const LabelledCloud scan = load_viewer_scan(scene, 7, 1000);
+  EXPECT_EQ(scan.size(), keyframe_points(7));
+
+  ViewerPageStats stats;
+  const auto data = testing::page_data(viewer_page(scene, {}, ViewerDataSource::kEmbedded, &stats));
+  EXPECT_EQ(data["kind"], "map");
+  ASSERT_EQ(data["trajectories"].size(), 2U);
+  EXPECT_EQ(data["trajectories"][0]["count"], "6 keyframes");
+  EXPECT_EQ(data["trajectories"][1]["count"], "4 keyframes");
+  EXPECT_EQ(data["trajectories"][1]["name"], "session 1: second");
+  EXPECT_NE(data["trajectories"][0]["color"], data["trajectories"][1]["color"]);
+  EXPECT_EQ(decoded_size(data["trajectories"][1]["positions"].get<std::string>()), 4U * 3U * sizeof(float));
+  EXPECT_EQ(data["loops"].size(), 1U);
+  EXPECT_EQ(data["cross_loops"].size(), 2U);
+  EXPECT_EQ(data["frames"], kMapKeyframes);
+  EXPECT_EQ(stats.sessions, 2U);
+  EXPECT_EQ(stats.cross_session_loops, 2U);
+  EXPECT_EQ(stats.scans, kMapKeyframes);
+  EXPECT_EQ(default_viewer_page(tmp / "map"), tmp / "map.view.html");
+  EXPECT_EQ(default_viewer_page(tmp / "map/"), tmp / "map.view.html");
+}
+
+TEST(Viewer, SavedMapKeepsToTheBudgetOneKeyframeAtATime) {
+  TempDir tmp;
+  write_two_session_map(tmp / "map");
+  ViewerOptions options;
+  options.max_map_points = 100;  // 10 points a keyframe
+  const ViewerScene scene = load_viewer_scene(tmp / "map", options);
+  EXPECT_EQ(scene.map.size(), 100U);
+  EXPECT_GT(scene.map_points_total, 100U);
+  float max_x = 0;
+  for (const auto& p : scene.map.points) max_x = std::max(max_x, p.x());
+  EXPECT_GT(max_x, 25.0F) << "the last keyframe has its share";
+}
+
+TEST(Viewer, BadSavedMapGivesClearErrors) {
+  TempDir tmp;
+  write_two_session_map(tmp / "map");
+  ViewerOptions options;
+  options.sequence = tmp.path();
+  EXPECT_NE(testing::input_error_of([&] { load_viewer_scene(tmp / "map", options); }).find("drop --sequence"),
+            std::string::npos);
+  fs::resize_file(tmp / "map/keyframes.bin", fs::file_size(tmp / "map/keyframes.bin") - 5);
+  const std::string error = testing::input_error_of([&] { load_viewer_scene(tmp / "map"); });
+  EXPECT_NE(error.find("keyframes.bin"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -65,9 +65,8 @@ void remove_stale_partials(const fs::path& target) {
 
 // The manifest's sessions with their keyframe counts from the keyframes (a
 // map of one session without a list gets one from the manifest's source).
-std::vector<MapSession> sessions_of(const SavedMap& map) {
-  std::vector<MapSession> sessions = map.manifest.sessions;
-  if (sessions.empty()) sessions.push_back({map.manifest.source, map.manifest.first_frame, 0, true});
+std::vector<MapSession> counted_sessions(const SavedMap& map) {
+  std::vector<MapSession> sessions = map_sessions(map);
   for (MapSession& s : sessions) s.keyframes = 0;
   for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
     const std::uint32_t s = map.keyframes[k].session;
@@ -123,7 +122,7 @@ MapManifest manifest_to_write(const SavedMap& map) {
   manifest.loop_edges = static_cast<std::uint64_t>(
       std::count_if(map.edges.begin(), map.edges.end(), [](const PoseGraphEdge& e) { return e.kind == EdgeKind::kLoop; }));
   manifest.detector = map.config.loop.detector;
-  manifest.sessions = sessions_of(map);
+  manifest.sessions = counted_sessions(map);
   manifest.cross_session_loops = static_cast<std::uint64_t>(
       std::count_if(map.edges.begin(), map.edges.end(), [&](const PoseGraphEdge& e) {
         return e.kind == EdgeKind::kLoop && map.keyframes[e.from].session != map.keyframes[e.to].session;

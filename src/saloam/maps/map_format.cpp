@@ -316,6 +316,11 @@ std::vector<std::byte> encode_map_features(const StoredFeatures& f) {
 
 // ---------------------------------------------------------------- parsers
 
+std::vector<MapSession> map_sessions(const SavedMap& map) {
+  if (!map.manifest.sessions.empty()) return map.manifest.sessions;
+  return {MapSession{map.manifest.source, map.manifest.first_frame, map.keyframes.size(), true}};
+}
+
 MapManifest parse_map_manifest(std::string_view text, const fs::path& origin) {
   nlohmann::json j;
   try {

@@ -123,6 +123,11 @@ void check_map_destination(const std::filesystem::path& folder);
 /// the file and the problem.
 SavedMap read_map(const std::filesystem::path& folder);
 
+/// The map's sessions: the manifest's list, or for a version 1 map (no
+/// list) one linked session of every keyframe, from the manifest's source
+/// and first_frame.
+std::vector<MapSession> map_sessions(const SavedMap& map);
+
 /// Path of keyframe k's feature file.
 std::filesystem::path map_features_path(const std::filesystem::path& folder, std::size_t keyframe);
 /// Reads and validates one keyframe's features.

@@ -267,15 +267,6 @@ void SessionJoiner::search_loop(std::size_t q) {
 
 }  // namespace
 
-namespace {
-
-std::vector<MapSession> sessions_or_one(const SavedMap& map) {
-  if (!map.manifest.sessions.empty()) return map.manifest.sessions;
-  return {MapSession{map.manifest.source, map.manifest.first_frame, map.keyframes.size(), true}};
-}
-
-}  // namespace
-
 JoinedMaps SessionJoiner::assemble() const {
   const SavedMap& a = base_.saved();
   const SavedMap& b = joining_.saved();
@@ -283,9 +274,9 @@ JoinedMaps SessionJoiner::assemble() const {
   out.base_keyframes = a.keyframes.size();
   out.map.manifest = a.manifest;
   out.map.config = config_;
-  out.map.manifest.sessions = sessions_or_one(a);
+  out.map.manifest.sessions = map_sessions(a);
   const auto offset = static_cast<std::uint32_t>(out.map.manifest.sessions.size());
-  for (MapSession s : sessions_or_one(b)) {
+  for (MapSession s : map_sessions(b)) {
     s.linked = s.linked && linked_at_.has_value();
     out.map.manifest.sessions.push_back(s);
   }

@@ -60,11 +60,6 @@ std::vector<Pose> read_sequence_truth(const std::filesystem::path& folder) {
 
 namespace {
 
-std::vector<MapSession> sessions_of(const SavedMap& map) {
-  if (!map.manifest.sessions.empty()) return map.manifest.sessions;
-  return {MapSession{map.manifest.source, map.manifest.first_frame, map.keyframes.size(), true}};
-}
-
 // The truth of each keyframe (world frame); throws when one is missing.
 std::vector<Pose> keyframe_truth(const SavedMap& map, const std::vector<MapSession>& sessions,
                                  const std::vector<std::vector<Pose>>& truth) {
@@ -86,7 +81,7 @@ std::vector<Pose> keyframe_truth(const SavedMap& map, const std::vector<MapSessi
 }  // namespace
 
 SessionEvaluation evaluate_sessions(const SavedMap& map, const std::vector<std::vector<Pose>>& truth) {
-  const std::vector<MapSession> sessions = sessions_of(map);
+  const std::vector<MapSession> sessions = map_sessions(map);
   const std::vector<Pose> world = keyframe_truth(map, sessions, truth);
   // The map frame: the LiDAR frame of session 0's first keyframe.
   const Pose map_from_world = world.front().inverse();

@@ -73,7 +73,30 @@ std::string poses_base64(const std::vector<Pose>& poses) {
   return base64(encode_floats(values));
 }
 
+// Session colours, apart from the loop edges' cyan and magenta and the slider's yellow.
+constexpr const char* kSessionColors[] = {"#3b9cff", "#ff9800", "#8bc34a", "#7c4dff", "#f44336", "#00bfa5", "#a1887f"};
+
+/// A saved map: one trajectory per session (its keyframes), in its colour.
+json session_trajectories_json(const ViewerScene& scene) {
+  json list = json::array();
+  for (std::size_t i = 0; i < scene.sessions.size(); ++i) {
+    const ViewerSession& session = scene.sessions[i];
+    std::vector<Pose> poses;
+    for (const std::size_t k : session.frames) poses.push_back(scene.loop_closed[k]);
+    std::string name = fmt::format("session {}", i);
+    if (!session.name.empty()) name += ": " + std::filesystem::path(session.name).filename().string();
+    if (!session.linked) name += " (not linked: own frame)";
+    list.push_back({{"name", name},
+                    {"color", kSessionColors[i % std::size(kSessionColors)]},
+                    {"count", fmt::format("{} keyframes", session.frames.size())},
+                    {"session", i},
+                    {"positions", positions_base64(poses)}});
+  }
+  return list;
+}
+
 json trajectories_json(const ViewerScene& scene) {
+  if (!scene.sessions.empty()) return session_trajectories_json(scene);
   json list = json::array();
   const auto add = [&](const char* name, const char* color, const std::vector<Pose>& poses) {
     if (!poses.empty()) list.push_back({{"name", name}, {"color", color}, {"positions", positions_base64(poses)}});
@@ -105,11 +128,14 @@ json scans_json(const ViewerScene& scene, const ViewerOptions& options, ViewerDa
 
 json page_data(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
                ViewerPageStats& stats) {
-  json loops = json::array();
+  json loops = json::array(), cross_loops = json::array();
   for (const auto& [query, match] : scene.loops) loops.push_back({query, match});
+  for (const auto& [query, match] : scene.cross_session_loops) cross_loops.push_back({query, match});
   return json{{"title", scene.run_dir.filename().empty() ? scene.run_dir.parent_path().filename().string()
                                                          : scene.run_dir.filename().string()},
               {"source", source == ViewerDataSource::kEmbedded ? "embedded" : "server"},
+              {"kind", scene.sessions.empty() ? "run" : "map"},
+              {"sessions", scene.sessions.size()},
               {"classes", class_table()},
               {"map", map_json(scene, source)},
               {"trajectories", trajectories_json(scene)},
@@ -118,6 +144,7 @@ json page_data(const ViewerScene& scene, const ViewerOptions& options, ViewerDat
               {"poses", poses_base64(scene.loop_closed)},
               {"loops", loops},
               {"loops_verified", scene.loops_verified},
+              {"cross_loops", cross_loops},
               {"scans", scans_json(scene, options, source, stats)}};
 }
 
@@ -159,6 +186,8 @@ std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, 
   s.map_points_total = scene.map_points_total;
   s.frames = scene.loop_closed.size();
   s.loops = scene.loops.size();
+  s.cross_session_loops = scene.cross_session_loops.size();
+  s.sessions = scene.sessions.size();
   s.ground_truth = !scene.ground_truth.empty();
   return page;
 }
@@ -180,6 +209,17 @@ void check_replaceable(const std::filesystem::path& page) {
 }
 
 }  // namespace
+
+std::filesystem::path default_viewer_page(const std::filesystem::path& folder) {
+  if (!is_map_folder(folder)) return folder / "view.html";
+  std::filesystem::path map = folder.lexically_normal();
+  if (map.filename().empty()) map = map.parent_path();  // "MAP/"
+  if (map.filename().empty() || map.filename() == "." || map.filename() == "..") {
+    map = std::filesystem::absolute(map).lexically_normal();
+    if (map.filename().empty()) map = map.parent_path();
+  }
+  return map.parent_path() / (map.filename().string() + ".view.html");
+}
 
 ViewerPageStats write_viewer_page(const std::filesystem::path& run_dir, const std::filesystem::path& page,
                                   const ViewerOptions& options) {

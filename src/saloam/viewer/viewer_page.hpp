@@ -22,7 +22,9 @@ struct ViewerPageStats {
   std::size_t map_points = 0;        ///< in the page (after decimation)
   std::size_t map_points_total = 0;  ///< in map.ply
   std::size_t frames = 0;
-  std::size_t loops = 0;        ///< accepted loop edges drawn
+  std::size_t loops = 0;        ///< accepted loop edges drawn (a saved map: those within a session)
+  std::size_t cross_session_loops = 0;  ///< a saved map's loop edges between sessions
+  std::size_t sessions = 0;     ///< a saved map's sessions (0: a run folder)
   std::size_t scans = 0;        ///< embedded scans
   std::size_t scan_points = 0;  ///< in the embedded scans, all together
   bool ground_truth = false;
@@ -35,8 +37,13 @@ bool viewer_has_three_js();
 std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
                         ViewerPageStats* stats = nullptr);
 
-/// Reads the output folder of `saloam slam` and writes its self-contained
-/// page to `page` (the demo and `saloam view` call this). InputError when
+/// Where `saloam view FOLDER` writes its page by default: FOLDER/view.html
+/// for a run folder; beside a saved map, MAP.view.html (the map folder holds
+/// only the map: write_map replaces it whole).
+std::filesystem::path default_viewer_page(const std::filesystem::path& folder);
+
+/// Reads the output folder of `saloam slam` (or a saved map) and writes its
+/// self-contained page to `page` (the demo and `saloam view` call this). InputError when
 /// `page` exists and is not a viewer page: it never replaces another file.
 ViewerPageStats write_viewer_page(const std::filesystem::path& run_dir, const std::filesystem::path& page,
                                   const ViewerOptions& options = {});

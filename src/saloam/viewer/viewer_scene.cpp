@@ -13,10 +13,12 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/semantic_classes.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/ply.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/maps/map_format.hpp"
 
 namespace saloam {
 
@@ -182,7 +184,70 @@ void attach_sequence(ViewerScene& scene, const RunSummary& summary, const Viewer
   };
 }
 
+/// A keyframe's features as a labelled cloud (SemanticKITTI ids of their
+/// training classes), moved by `pose` (T_map<-sensor; identity: sensor frame).
+LabelledCloud features_cloud(const StoredFeatures& features, const Pose& pose) {
+  LabelledCloud cloud;
+  cloud.has_labels = true;
+  cloud.reserve(features.edge_points.size() + features.planar_points.size());
+  const Eigen::Isometry3f to_map = pose.cast<float>();
+  const auto add = [&](const std::vector<Eigen::Vector3f>& points, const std::vector<ClassIndex>& classes) {
+    for (std::size_t i = 0; i < points.size(); ++i)
+      cloud.push_back(to_map * points[i], 0.0F, from_learning_class(classes[i]));
+  };
+  add(features.edge_points, features.edge_classes);
+  add(features.planar_points, features.planar_classes);
+  return cloud;
+}
+
 }  // namespace
+
+bool is_map_folder(const fs::path& folder) {
+  std::error_code error;
+  return fs::is_regular_file(folder / "map.json", error);
+}
+
+ViewerScene load_map_viewer_scene(const fs::path& map_folder, const ViewerOptions& options) {
+  if (options.sequence || options.ground_truth || options.scans) {
+    throw InputError(map_folder, "a saved map is viewed without a sequence: its keyframes' features are the scans "
+                                 "at the slider (drop --sequence)");
+  }
+  const SavedMap saved = read_map(map_folder);
+  ViewerScene scene;
+  scene.run_dir = map_folder;
+  for (const MapSession& s : map_sessions(saved)) scene.sessions.push_back({s.source, {}, s.linked});
+  for (std::size_t k = 0; k < saved.keyframes.size(); ++k) {
+    const MapKeyframe& kf = saved.keyframes[k];
+    if (kf.session >= scene.sessions.size()) {
+      throw InputError(map_folder / "keyframes.bin",
+                       fmt::format("keyframe {}: session {} of {}", k, kf.session, scene.sessions.size()));
+    }
+    scene.loop_closed.push_back(kf.pose);
+    scene.sessions[kf.session].frames.push_back(k);
+  }
+  for (const PoseGraphEdge& e : saved.edges) {
+    if (e.kind != EdgeKind::kLoop) continue;
+    const bool across = saved.keyframes[e.from].session != saved.keyframes[e.to].session;
+    (across ? scene.cross_session_loops : scene.loops).emplace_back(e.from, e.to);
+  }
+  scene.loops_verified = scene.loops.size();  // a map keeps only accepted loops
+  // The map: each keyframe's share of the budget, one keyframe in memory at a time.
+  const std::size_t keyframes = saved.keyframes.size();
+  const std::size_t share = keyframes == 0 ? 0 : (options.max_map_points + keyframes - 1) / keyframes;
+  LabelledCloud map;
+  map.has_labels = true;
+  for (std::size_t k = 0; k < keyframes; ++k) {
+    const LabelledCloud cloud = features_cloud(read_map_features(map_folder, k), saved.keyframes[k].pose);
+    scene.map_points_total += cloud.size();
+    const LabelledCloud part = decimate_cloud(cloud, share);
+    for (std::size_t i = 0; i < part.size(); ++i) map.push_back_from(part, i);
+  }
+  scene.map = decimate_cloud(map, options.max_map_points);
+  scene.scan_of = [map_folder](std::size_t frame) {
+    return features_cloud(read_map_features(map_folder, frame), Pose::Identity());
+  };
+  return scene;
+}
 
 std::vector<std::pair<std::size_t, std::size_t>> read_accepted_loops(const fs::path& file, std::size_t* verified) {
   std::istringstream in(read_file(file, kMaxLoopFileBytes, "loop file"));
@@ -226,6 +291,7 @@ LabelledCloud decimate_cloud(const LabelledCloud& cloud, std::size_t budget) {
 
 ViewerScene load_viewer_scene(const fs::path& run_dir, const ViewerOptions& options) {
   if (!fs::is_directory(run_dir)) throw InputError(run_dir, "run folder not found (the --out folder of `saloam slam`)");
+  if (is_map_folder(run_dir)) return load_map_viewer_scene(run_dir, options);
   ViewerScene scene;
   scene.run_dir = run_dir;
   const fs::path map_file = required_file(run_dir, "map.ply", "the global map (run `saloam slam` without --no-map)");

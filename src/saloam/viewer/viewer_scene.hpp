@@ -8,6 +8,12 @@
 //   summary.json                 the sequence folder and the first processed frame
 //   SEQ/poses.txt + calib.txt    ground truth, when present
 //   SEQ/velodyne, SEQ/labels     the scans for the frame slider
+// or from a saved map (`slam --save-map`, `merge`; docs/map_format.md), a
+// folder with map.json: the keyframes' optimised poses as the trajectory
+// (one per session), the loop edges of its pose graph (within a session and
+// across sessions apart), the keyframes' feature clouds placed by their poses
+// as the map, and each keyframe's features as the scan at the slider. A
+// session that is not linked keeps its own frame (MapSession::linked).
 
 #include <cstddef>
 #include <cstdint>
@@ -15,6 +21,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -36,6 +43,13 @@ struct ViewerOptions {
   std::function<LabelledCloud(std::size_t frame)> scans;
 };
 
+/// One drive of a saved map.
+struct ViewerSession {
+  std::string name;                  ///< its source (informational)
+  std::vector<std::size_t> frames;   ///< its keyframes (indices of ViewerScene::loop_closed)
+  bool linked = true;                ///< in the map frame (else in its own)
+};
+
 struct ViewerScene {
   std::filesystem::path run_dir;
   std::shared_ptr<const SequenceReader> sequence;          ///< for the ground truth and the scans, when found
@@ -45,13 +59,29 @@ struct ViewerScene {
   std::vector<Pose> loop_closed, odometry, ground_truth;   ///< LiDAR frame; ground truth may be empty
   std::vector<std::pair<std::size_t, std::size_t>> loops;  ///< accepted loops (query, match), processed-frame indices
   std::size_t loops_verified = 0;
+  /// A saved map's drives (empty for a run folder, whose frames are one drive).
+  std::vector<ViewerSession> sessions;
+  /// A saved map's loop edges between keyframes of different sessions (in
+  /// `loops`: those within a session).
+  std::vector<std::pair<std::size_t, std::size_t>> cross_session_loops;
   LabelledCloud map;                 ///< decimated to the budget, sorted by class
   std::size_t map_points_total = 0;  ///< before decimation
 };
 
-/// Reads a run folder. InputError (naming the file) when the folder, map.ply
-/// or poses_tum.txt is missing or unreadable, or when the sequence does not match.
+/// Reads a run folder, or a saved map (a folder with map.json). InputError
+/// (naming the file) when the folder, map.ply or poses_tum.txt is missing or
+/// unreadable, when the sequence does not match, or when the map does not
+/// read (read_map's checks).
 ViewerScene load_viewer_scene(const std::filesystem::path& run_dir, const ViewerOptions& options = {});
+
+/// True when `folder` holds a saved map (map.json) rather than a run's outputs.
+bool is_map_folder(const std::filesystem::path& folder);
+
+/// Reads a saved map. The map cloud takes at most options.max_map_points
+/// points: each keyframe's features are decimated to an equal share as they
+/// are read, one keyframe at a time. options.sequence, ground_truth and
+/// scans do not apply (InputError when given).
+ViewerScene load_map_viewer_scene(const std::filesystem::path& map_folder, const ViewerOptions& options = {});
 
 /// At most `budget` points of `cloud`, an evenly spread deterministic random
 /// subset (all of them when it fits), sorted by label.
