@@ -1,6 +1,8 @@
 // Segmentation speed on one core: the stages of Segmenter::labels on a
 // simulated 64-beam HDL-64E scan (rings, projection, network, k-nearest-
-// neighbour vote) and the whole stage, for 64/32/16 beams. The network is
+// neighbour vote) and the whole stage, for 64/32/16 beams. Scans come as a
+// KITTI .bin file gives them (rings from the storage order; second argument
+// 0) or with a ring field as PCD, PLY and bags give them (1). The network is
 // the shipped model (models/segmenter/saloam.yaml) or $SALOAM_BENCH_SEGMENTER;
 // the network benchmarks are skipped when there is none or when this build
 // has no network plugin (no libtorch).
@@ -24,7 +26,7 @@ namespace {
 using namespace saloam;
 namespace fs = std::filesystem;
 
-const LabelledCloud& scan(int beams) {
+const LabelledCloud& simulated_scan(int beams) {
   static std::map<int, LabelledCloud> scans;
   if (auto it = scans.find(beams); it != scans.end()) return it->second;
   SimulationOptions options;
@@ -35,6 +37,17 @@ const LabelledCloud& scan(int beams) {
   options.show_progress = false;
   const SimulatedSequence sequence(options);
   return scans.emplace(beams, sequence.render(0).cloud).first->second;
+}
+
+/// The simulated scan with its ring field (with_ring_field) or without.
+const LabelledCloud& scan(int beams, bool with_ring_field = false) {
+  static std::map<int, LabelledCloud> stripped;
+  const LabelledCloud& cloud = simulated_scan(beams);
+  if (with_ring_field) return cloud;
+  if (auto it = stripped.find(beams); it != stripped.end()) return it->second;
+  LabelledCloud copy = cloud;
+  copy.ring.clear();
+  return stripped.emplace(beams, std::move(copy)).first->second;
 }
 
 fs::path model_description() {
@@ -54,10 +67,10 @@ const Segmenter* segmenter() {
 }
 
 void BM_PointRings(benchmark::State& state) {
-  const LabelledCloud& cloud = scan(static_cast<int>(state.range(0)));
+  const LabelledCloud& cloud = scan(static_cast<int>(state.range(0)), state.range(1) != 0);
   for (auto _ : state) benchmark::DoNotOptimize(point_rings(cloud, FeatureConfig{}));
 }
-BENCHMARK(BM_PointRings)->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PointRings)->Args({64, 0})->Args({64, 1})->Unit(benchmark::kMillisecond);
 
 void BM_ProjectScan(benchmark::State& state) {
   const LabelledCloud& cloud = scan(64);
@@ -80,7 +93,8 @@ void BM_KnnVote(benchmark::State& state) {
 }
 BENCHMARK(BM_KnnVote)->Unit(benchmark::kMillisecond);
 
-// The whole stage (rings, projection, network, vote) on one thread; arg: beams.
+// The whole stage (rings, projection, network, vote) on one thread; args:
+// beams, ring field.
 void BM_SegmentScan(benchmark::State& state) {
   const Segmenter* s = segmenter();
   if (s == nullptr) {
@@ -88,16 +102,22 @@ void BM_SegmentScan(benchmark::State& state) {
     return;
   }
   const int beams = static_cast<int>(state.range(0));
+  const bool ring_field = state.range(1) != 0;
   const auto& accepted = s->spec().beams;
   if (s->spec().projection.row_mode == RowMode::kRing && std::find(accepted.begin(), accepted.end(), beams) == accepted.end()) {
     state.SkipWithError("the model does not take this beam count");
     return;
   }
-  const LabelledCloud& cloud = scan(beams);
+  const LabelledCloud& cloud = scan(beams, ring_field);
   for (auto _ : state) benchmark::DoNotOptimize(s->labels(cloud));
   state.counters["points"] = static_cast<double>(cloud.size());
 }
-BENCHMARK(BM_SegmentScan)->Arg(64)->Arg(32)->Arg(16)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SegmentScan)
+    ->Args({64, 0})
+    ->Args({32, 0})
+    ->Args({16, 0})
+    ->Args({64, 1})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

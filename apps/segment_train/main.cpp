@@ -32,6 +32,7 @@ namespace fs = std::filesystem;
 
 struct SegmentTrainArgs {
   std::string data, out, resume, widths = "16,32,64";
+  std::vector<std::string> class_weights;  ///< NAME=FACTOR
   bool no_cache = false;
   SegmentTrainOptions options;
 };
@@ -68,6 +69,26 @@ std::vector<TrainingScanSet> build_sequences(const std::vector<SourceSpec>& spec
   return sequences;
 }
 
+/// --class-weight NAME=FACTOR, each class once, FACTOR in (0, 100].
+std::array<double, kNumLearningClasses> parse_class_weights(const std::vector<std::string>& items) {
+  auto factors = uniform_class_factors();
+  std::vector<bool> given(kNumLearningClasses, false);
+  for (const std::string& item : items) {
+    const auto eq = item.find('=');
+    const auto c = learning_class_id(item.substr(0, std::min(eq, item.size())));
+    double factor = 0;
+    std::istringstream in(eq == std::string::npos ? std::string() : item.substr(eq + 1));
+    if (!c || !(in >> factor) || !(in >> std::ws).eof() || !(factor > 0 && factor <= 100))
+      throw ConfigError(fmt::format("--class-weight: expected CLASS=FACTOR with a learning class (e.g. pole) and a factor "
+                                    "in (0, 100], not '{}'",
+                                    item));
+    if (given[*c]) throw ConfigError(fmt::format("--class-weight: {} is given twice", item.substr(0, eq)));
+    given[*c] = true;
+    factors[*c] = factor;
+  }
+  return factors;
+}
+
 SegmentTrainOptions run_options(const SegmentTrainArgs& args, const CLI::App& app) {
   SegmentTrainOptions options = args.options;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
@@ -79,6 +100,7 @@ SegmentTrainOptions run_options(const SegmentTrainArgs& args, const CLI::App& ap
       throw ConfigError(fmt::format("{} already holds a training run: continue it with --resume {} or choose another --out",
                                     args.out, args.out));
     options.shape.widths = parse_widths(args.widths);
+    options.class_weight_factors = parse_class_weights(args.class_weights);
     return options;
   }
   for (const auto* option : app.get_options())
@@ -147,6 +169,9 @@ std::function<int()> add_segment_train_options(CLI::App& app) {
   app.add_option("--lovasz", o.lovasz_weight, "Weight of the Lovasz-softmax loss (0: cross-entropy only)")
       ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
+  app.add_option("--class-weight", args->class_weights,
+                 "CLASS=FACTOR: multiply a class's loss weight (1 / sqrt of its frequency) by FACTOR, e.g. pole=2 to "
+                 "favour its recall (repeatable; weights are then scaled to mean 1)");
   app.add_option("--seed", o.seed, "Seed of the initialisation, samples and augmentations")->capture_default_str();
   app.add_option("--threads", o.threads, "libtorch threads (results are reproducible for a fixed count)")
       ->check(CLI::Range(1, 256))

@@ -1,5 +1,6 @@
 #include "saloam/segmentation/range_projection.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -27,6 +28,30 @@ TEST(RangeProjection, ColumnsFollowRangeNetsConvention) {
   EXPECT_EQ(projection_column(10.0f, 0.0f, 2048), 1024);
   EXPECT_EQ(projection_column(0.0f, -10.0f, 2048), 1536);  // right
   EXPECT_EQ(projection_column(-10.0f, -1e-6f, 2048), 2047);
+}
+
+TEST(RangeProjection, ColumnsAreThoseOfTheDoubleAtan2EvenAtColumnEdges) {
+  // Points on and beside every column edge of a 2048- and a 1000-column
+  // image, at ranges from 1 to 120 m: the column the double-precision
+  // atan2 gives (the definition) is the column.
+  constexpr double kPi = 3.14159265358979323846;
+  int compared = 0;
+  for (const int columns : {2048, 1000}) {
+    for (int edge = 0; edge < columns; edge += 3) {
+      for (const double offset : {-1e-6, -1e-7, 0.0, 1e-7, 1e-6, 0.3}) {
+        const double azimuth = kPi * (1.0 - 2.0 * (edge + offset) / columns);
+        for (const double range : {1.0, 17.3, 120.0}) {
+          const auto x = static_cast<float>(range * std::cos(azimuth));
+          const auto y = static_cast<float>(range * std::sin(azimuth));
+          const double u = 0.5 * (1.0 - std::atan2(static_cast<double>(y), static_cast<double>(x)) / kPi);
+          const int expected = std::clamp(static_cast<int>(std::floor(u * columns)), 0, columns - 1);
+          ASSERT_EQ(projection_column(x, y, columns), expected) << "x " << x << " y " << y << " columns " << columns;
+          ++compared;
+        }
+      }
+    }
+  }
+  EXPECT_GT(compared, 10000);
 }
 
 TEST(RangeProjection, RingRowsAndTheClosestPointPerPixel) {

@@ -93,6 +93,23 @@ TEST(SegmentTrainer, ClassWeightsFavourRareClasses) {
   EXPECT_NEAR(w[9] + w[18], 2.0, 1e-9);  // mean 1 over the classes present
 }
 
+TEST(SegmentTrainer, ClassWeightFactorsScaleTheirClassAndKeepTheMean) {
+  std::array<std::uint64_t, kNumLearningClasses> counts{};
+  counts[9] = 900;   // road
+  counts[18] = 100;  // pole
+  counts[16] = 100;  // trunk
+  auto factors = uniform_class_factors();
+  factors[*learning_class_id("pole")] = 2.0;
+  const auto plain = class_weights_from_counts(counts);
+  const auto w = class_weights_from_counts(counts, factors);
+  EXPECT_NEAR(w[18] / w[16], 2.0, 1e-9);
+  EXPECT_NEAR(w[16] / w[9], plain[16] / plain[9], 1e-9);
+  EXPECT_NEAR(w[9] + w[16] + w[18], 3.0, 1e-9);
+  EXPECT_EQ(learning_class_id("pole"), std::optional<std::uint8_t>(18));
+  EXPECT_FALSE(learning_class_id("unlabeled").has_value());
+  EXPECT_FALSE(learning_class_id("moving-car").has_value());
+}
+
 std::string text_of(const fs::path& file) {
   std::ifstream in(file);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};

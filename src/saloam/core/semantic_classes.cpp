@@ -101,6 +101,12 @@ std::string_view learning_class_name(std::uint8_t learning_id) {
   return class_name(from_learning_class(learning_id));
 }
 
+std::optional<std::uint8_t> learning_class_id(std::string_view name) {
+  for (int c = 1; c < kNumLearningClasses; ++c)
+    if (learning_class_name(static_cast<std::uint8_t>(c)) == name) return static_cast<std::uint8_t>(c);
+  return std::nullopt;
+}
+
 bool is_moving(std::uint16_t raw_id) {
   const auto* c = lookup(raw_id);
   return c != nullptr && c->moving;

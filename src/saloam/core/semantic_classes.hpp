@@ -84,6 +84,8 @@ std::uint8_t to_learning_class(std::uint16_t raw_id);
 std::uint16_t from_learning_class(std::uint8_t learning_id);
 /// Name of a training class ("unlabeled", "car", ..., "traffic-sign").
 std::string_view learning_class_name(std::uint8_t learning_id);
+/// The training class 1..19 of that name, none for another name.
+std::optional<std::uint8_t> learning_class_id(std::string_view name);
 
 /// A moving-* class (252..259).
 bool is_moving(std::uint16_t raw_id);

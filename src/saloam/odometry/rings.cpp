@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numeric>
 
 namespace saloam {
@@ -14,32 +13,46 @@ double elevation_deg(const Eigen::Vector3f& p) {
 }
 
 /// Sorts every ring's indices by sweep time (stable: ties keep storage order).
+/// Drivers and the simulator store a ring in firing order already: then the
+/// check is all it costs.
 void order_by_time(RingIndices& rings, const std::vector<float>& times) {
-  for (auto& ring : rings) {
-    std::stable_sort(ring.begin(), ring.end(), [&](std::uint32_t a, std::uint32_t b) { return times[a] < times[b]; });
-  }
+  const auto earlier = [&](std::uint32_t a, std::uint32_t b) { return times[a] < times[b]; };
+  for (auto& ring : rings)
+    if (!std::is_sorted(ring.begin(), ring.end(), earlier)) std::stable_sort(ring.begin(), ring.end(), earlier);
+}
+
+/// Mean elevation [deg] of a ring's points, from every 8th point of a ring
+/// of more than 64 (the elevation only orders rings, which lie a few tenths
+/// of a degree apart or more; a ring's points agree far closer than that).
+double mean_elevation_deg(const LabelledCloud& cloud, const std::vector<std::uint32_t>& ring) {
+  const std::size_t step = ring.size() > 64 ? 8 : 1;
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (std::size_t k = 0; k < ring.size(); k += step, ++n) sum += elevation_deg(cloud.points[ring[k]]);
+  return sum / static_cast<double>(n);
 }
 
 }  // namespace
 
 RingIndices rings_from_ring_field(const LabelledCloud& cloud, const std::vector<float>& times) {
-  std::map<std::uint16_t, std::size_t> bucket_of;
+  // Rings in the order their values first occur; bucket_of[value] + 1 is the
+  // ring of a value (0: not seen yet).
+  std::vector<std::uint32_t> bucket_of(std::size_t{*std::max_element(cloud.ring.begin(), cloud.ring.end())} + 1, 0);
   RingIndices rings;
-  std::vector<double> elevation_sum;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (times[i] < 0.0f) continue;
-    const auto [it, added] = bucket_of.try_emplace(cloud.ring[i], rings.size());
-    if (added) {
-      rings.emplace_back();
-      elevation_sum.push_back(0.0);
+    std::uint32_t& bucket = bucket_of[cloud.ring[i]];
+    if (bucket == 0) {
+      rings.emplace_back().reserve(cloud.size() / 32);
+      bucket = static_cast<std::uint32_t>(rings.size());
     }
-    rings[it->second].push_back(static_cast<std::uint32_t>(i));
-    elevation_sum[it->second] += elevation_deg(cloud.points[i]);
+    rings[bucket - 1].push_back(static_cast<std::uint32_t>(i));
   }
+  std::vector<double> elevation(rings.size());
+  for (std::size_t r = 0; r < rings.size(); ++r) elevation[r] = mean_elevation_deg(cloud, rings[r]);
   std::vector<std::size_t> order(rings.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  const auto mean = [&](std::size_t r) { return elevation_sum[r] / static_cast<double>(rings[r].size()); };
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return mean(a) > mean(b); });
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return elevation[a] > elevation[b]; });
   RingIndices sorted;
   sorted.reserve(rings.size());
   for (const std::size_t r : order) sorted.push_back(std::move(rings[r]));

@@ -49,12 +49,20 @@ struct Window {
   int half = 0;
 };
 
+/// Column c of an image `cols` wide, wrapped around in azimuth (the division
+/// only at the seam).
+int wrapped_column(int c, int cols) {
+  if (c >= 0 && c < cols) return c;
+  c %= cols;
+  return c < 0 ? c + cols : c;
+}
+
 Window window_at(const RangeImage& image, int row, int col, int half) {
   Window w;
   w.half = half;
   w.first_row = std::max(row - half, 0);
   w.last_row = std::min(row + half, image.rows - 1);
-  for (int dx = -half; dx <= half; ++dx) w.cols[static_cast<std::size_t>(dx + half)] = (col + dx + image.cols) % image.cols;
+  for (int dx = -half; dx <= half; ++dx) w.cols[static_cast<std::size_t>(dx + half)] = wrapped_column(col + dx, image.cols);
   return w;
 }
 
@@ -70,7 +78,7 @@ std::vector<std::int16_t> row_classes(const RangeImage& image, const std::vector
     for (int x = 0; x < image.cols; ++x) {
       std::int16_t c = kNoPoint;
       for (int dx = -half; dx <= half && c != kMixed; ++dx) {
-        const std::size_t p = row + static_cast<std::size_t>((x + dx + image.cols) % image.cols);
+        const std::size_t p = row + static_cast<std::size_t>(wrapped_column(x + dx, image.cols));
         if (image.range[p] < 0) continue;
         c = c == kNoPoint || c == pixel_class[p] ? pixel_class[p] : kMixed;
       }
@@ -115,50 +123,81 @@ class NearestK {
 
  private:
   std::size_t k_, n_ = 0;
-  std::array<Candidate, kMaxWindow * kMaxWindow> best_{};
+  std::array<Candidate, kMaxWindow * kMaxWindow> best_;  // [0, n_) is set; left uninitialised (one per point)
 };
+
+/// The pixels of a point's window that can vote: those showing a point within
+/// the cutoff of its range (distance = |range difference| x the offset's
+/// weight; the point's own pixel at distance 0), in window order. Only they
+/// can vote: every farther pixel ranks behind all of them.
+struct Voters {
+  std::array<Candidate, kMaxWindow * kMaxWindow> near;  // [0, n) is set
+  std::size_t n = 0;
+  bool one_label = true;  ///< all of them show one class
+};
+
+struct VoteWindow {
+  int half = 0, side = 0;
+  std::vector<float> weight;  ///< per window offset, row-major
+  float cutoff = 0.0f;
+};
+
+Voters voters(const RangeImage& image, const std::vector<std::int16_t>& pixel_class, const VoteWindow& vw,
+              std::int32_t pixel, float range) {
+  Voters v;
+  const int row = pixel / image.cols;
+  const Window w = window_at(image, row, pixel % image.cols, vw.half);
+  for (int y = w.first_row; y <= w.last_row; ++y)
+    for (int j = 0; j < vw.side; ++j) {
+      const auto p = static_cast<std::size_t>(y * image.cols + w.cols[static_cast<std::size_t>(j)]);
+      const bool self = static_cast<std::int32_t>(p) == pixel;
+      if (!self && image.range[p] < 0) continue;
+      const float wt = vw.weight[static_cast<std::size_t>((y - row + vw.half) * vw.side + j)];
+      const float distance = self ? 0.0f : std::abs(image.range[p] - range) * wt;
+      if (!(distance <= vw.cutoff)) continue;
+      v.near[v.n++] = {distance, pixel_class[p]};
+      v.one_label = v.one_label && pixel_class[p] == v.near[0].label;
+    }
+  return v;
+}
+
+/// The class most of the k nearest voters show (the lowest class on a tie;
+/// class 0 and classes beyond the network's do not count), `own` when none
+/// counts. `votes` is scratch space, one per class.
+std::int16_t voted_class(const Voters& v, std::size_t k, int classes, std::int16_t own, std::vector<int>& votes) {
+  const auto counts = [classes](std::int16_t c) { return c > 0 && c < classes; };
+  if (v.n == 0) return own;
+  if (v.one_label) return counts(v.near[0].label) ? v.near[0].label : own;
+  NearestK nearest(k);
+  for (std::size_t j = 0; j < v.n; ++j) nearest.offer(v.near[j].distance, v.near[j].label);
+  std::fill(votes.begin(), votes.end(), 0);
+  for (std::size_t j = 0; j < nearest.size(); ++j)
+    if (counts(nearest[j].label)) ++votes[static_cast<std::size_t>(nearest[j].label)];
+  const auto best = std::max_element(votes.begin() + 1, votes.end());
+  return *best > 0 ? static_cast<std::int16_t>(best - votes.begin()) : own;
+}
 
 }  // namespace
 
 std::vector<std::int16_t> point_classes(const RangeImage& image, const std::vector<std::int16_t>& pixel_class,
                                         const std::vector<float>& point_range, int classes,
                                         const KnnOptions& options) {
-  const int half = std::min(options.window, kMaxWindow) / 2;
-  const int side = 2 * half + 1;
-  const std::vector<float> weight = inverse_gaussian(side, options.sigma);
-  const auto cutoff = static_cast<float>(options.cutoff);
+  VoteWindow vw;
+  vw.half = std::min(options.window, kMaxWindow) / 2;
+  vw.side = 2 * vw.half + 1;
+  vw.weight = inverse_gaussian(vw.side, options.sigma);
+  vw.cutoff = static_cast<float>(options.cutoff);
+  const auto k = static_cast<std::size_t>(std::max(options.k, 1));
   std::vector<std::int16_t> out(image.point_pixel.size(), 0);
   std::vector<int> votes(static_cast<std::size_t>(classes));
-  const std::vector<std::uint8_t> uniform = uniform_windows(image, pixel_class, half);
-
+  const std::vector<std::uint8_t> uniform = uniform_windows(image, pixel_class, vw.half);
   for (std::size_t i = 0; i < image.point_pixel.size(); ++i) {
     const std::int32_t pixel = image.point_pixel[i];
     if (pixel < 0) continue;
     const std::int16_t own = pixel_class[static_cast<std::size_t>(pixel)];
-    if (own > 0 && own < classes && uniform[static_cast<std::size_t>(pixel)]) {
-      out[i] = own;
-      continue;
-    }
-    const int row = pixel / image.cols;
-    const Window w = window_at(image, row, pixel % image.cols, half);
-    // The point's own pixel votes at distance 0; every other pixel with a
-    // point at its range difference, weighted by its offset.
-    NearestK nearest(static_cast<std::size_t>(std::max(options.k, 1)));
-    const float r = point_range[i];
-    for (int y = w.first_row; y <= w.last_row; ++y)
-      for (int j = 0; j < side; ++j) {
-        const auto p = static_cast<std::size_t>(y * image.cols + w.cols[static_cast<std::size_t>(j)]);
-        const bool self = static_cast<std::int32_t>(p) == pixel;
-        if (!self && image.range[p] < 0) continue;
-        const float wt = weight[static_cast<std::size_t>((y - row + half) * side + j)];
-        nearest.offer(self ? 0.0f : std::abs(image.range[p] - r) * wt, pixel_class[p]);
-      }
-    std::fill(votes.begin(), votes.end(), 0);
-    for (std::size_t j = 0; j < nearest.size(); ++j)
-      if (nearest[j].distance <= cutoff && nearest[j].label > 0 && nearest[j].label < classes)
-        ++votes[static_cast<std::size_t>(nearest[j].label)];
-    const auto best = std::max_element(votes.begin() + 1, votes.end());
-    out[i] = *best > 0 ? static_cast<std::int16_t>(best - votes.begin()) : own;
+    out[i] = own > 0 && own < classes && uniform[static_cast<std::size_t>(pixel)]
+                 ? own
+                 : voted_class(voters(image, pixel_class, vw, pixel, point_range[i]), k, classes, own, votes);
   }
   return out;
 }

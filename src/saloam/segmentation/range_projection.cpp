@@ -1,6 +1,7 @@
 #include "saloam/segmentation/range_projection.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -38,16 +39,24 @@ RowAssignment rows_by_elevation(const LabelledCloud& cloud, const ProjectionSpec
   return out;
 }
 
-float channel_value(ImageChannel channel, const Eigen::Vector3f& p, float range, float remission) {
-  switch (channel) {
-    case ImageChannel::kRange: return range;
-    case ImageChannel::kX: return p.x();
-    case ImageChannel::kY: return p.y();
-    case ImageChannel::kZ: return p.z();
-    case ImageChannel::kRemission: return remission;
-    case ImageChannel::kMask: return 1.0f;
+/// image.data from the points the pixels show: every channel of a pixel is
+/// written together, so that each point is read once.
+void fill_channels(RangeImage& image, const LabelledCloud& cloud, const ProjectionSpec& spec) {
+  const std::size_t pixels = image.pixels();
+  const auto channels = static_cast<std::size_t>(image.channels);
+  image.data.assign(channels * pixels, 0.0f);
+  std::vector<float> inv_std(channels);
+  for (std::size_t c = 0; c < channels; ++c) inv_std[c] = 1.0f / spec.stds[c];
+  for (std::size_t px = 0; px < pixels; ++px) {
+    const std::int32_t i = image.shown[px];
+    if (i < 0) continue;
+    const auto k = static_cast<std::size_t>(i);
+    const Eigen::Vector3f& p = cloud.points[k];
+    const std::array<float, 6> raw{image.range[px], p.x(), p.y(), p.z(), cloud.remission[k], 1.0f};  // ImageChannel order
+    float* value = image.data.data() + px;
+    for (std::size_t c = 0; c < channels; ++c, value += pixels)
+      *value = (raw[static_cast<std::size_t>(spec.channels[c])] - spec.means[c]) * inv_std[c];
   }
-  return 0.0f;
 }
 
 }  // namespace
@@ -71,8 +80,15 @@ std::string_view channel_name(ImageChannel channel) {
 }
 
 int projection_column(float x, float y, int columns) {
-  const double u = 0.5 * (1.0 - std::atan2(static_cast<double>(y), static_cast<double>(x)) / kPi);
-  return std::clamp(static_cast<int>(std::floor(u * columns)), 0, columns - 1);
+  // The float atan2 (glibc: within 2 ulp, 5e-7 rad) decides unless the point
+  // lies within 1e-5 rad of a column edge, where the double one does: the
+  // same column as from the double atan2 alone, at a fraction of its cost.
+  const double edge_margin = 1e-5 / (2.0 * kPi) * columns;  // [columns]
+  const double quick = (0.5 - static_cast<double>(std::atan2(y, x)) * (0.5 / kPi)) * columns;
+  double u = quick;
+  if (std::abs(quick - std::floor(quick + 0.5)) < edge_margin)
+    u = 0.5 * (1.0 - std::atan2(static_cast<double>(y), static_cast<double>(x)) / kPi) * columns;
+  return std::clamp(static_cast<int>(std::floor(u)), 0, columns - 1);
 }
 
 RangeImage project_scan(const LabelledCloud& cloud, std::span<const std::int16_t> rings, int beams,
@@ -102,18 +118,7 @@ RangeImage project_scan(const LabelledCloud& cloud, std::span<const std::int16_t
     }
   }
 
-  image.data.assign(static_cast<std::size_t>(image.channels) * pixels, 0.0f);
-  for (int c = 0; c < image.channels; ++c) {
-    const ImageChannel channel = spec.channels[c];
-    const float mean = spec.means[c], inv_std = 1.0f / spec.stds[c];
-    float* plane = image.data.data() + static_cast<std::size_t>(c) * pixels;
-    for (std::size_t px = 0; px < pixels; ++px) {
-      const std::int32_t i = image.shown[px];
-      if (i < 0) continue;
-      const auto k = static_cast<std::size_t>(i);
-      plane[px] = (channel_value(channel, cloud.points[k], image.range[px], cloud.remission[k]) - mean) * inv_std;
-    }
-  }
+  fill_channels(image, cloud, spec);
   return image;
 }
 

@@ -165,7 +165,8 @@ void SegmentTrainer::load_optimizer(const fs::path& file) {
   }
 }
 
-std::array<double, kNumLearningClasses> class_weights_from_counts(const std::array<std::uint64_t, kNumLearningClasses>& counts) {
+std::array<double, kNumLearningClasses> class_weights_from_counts(const std::array<std::uint64_t, kNumLearningClasses>& counts,
+                                                                 const std::array<double, kNumLearningClasses>& factors) {
   std::array<double, kNumLearningClasses> weights{};
   double total = 0, sum = 0;
   int present = 0;
@@ -173,7 +174,7 @@ std::array<double, kNumLearningClasses> class_weights_from_counts(const std::arr
   if (total <= 0) return weights;
   for (int c = 1; c < kNumLearningClasses; ++c)
     if (counts[c] > 0) {
-      weights[c] = 1.0 / std::sqrt(static_cast<double>(counts[c]) / total);
+      weights[c] = factors[c] / std::sqrt(static_cast<double>(counts[c]) / total);
       sum += weights[c];
       ++present;
     }

@@ -7,7 +7,7 @@
 //     `pixels_per_sample` pixels (64 x 512, 32 x 1024, 16 x 2048 with the
 //     defaults); a batch holds scans of one beam count;
 //   - the loss is the class-weighted cross-entropy (weights 1 / sqrt of the
-//     class frequency, mean 1) plus the Lovasz-softmax loss (Berman et al.,
+//     class frequency times a factor per class, 1 unless given; mean 1) plus the Lovasz-softmax loss (Berman et al.,
 //     CVPR 2018), as SalsaNext trains; class 0 (unlabeled) is ignored;
 //   - Adam, the learning rate rising linearly over the first epoch and
 //     falling along a cosine to 1 % at the last;
@@ -31,6 +31,13 @@
 
 namespace saloam {
 
+/// 1 for every learning class.
+constexpr std::array<double, kNumLearningClasses> uniform_class_factors() {
+  std::array<double, kNumLearningClasses> f{};
+  f.fill(1.0);
+  return f;
+}
+
 struct SegmentTrainOptions {
   std::filesystem::path out;   ///< output folder: models, checkpoint/, training.json, curves.png, scans/ (cache)
   bool resume = false;         ///< continue the run in `out` from its last checkpoint
@@ -43,6 +50,9 @@ struct SegmentTrainOptions {
   double learning_rate = 2e-3;
   double weight_decay = 1e-4;          ///< Adam's L2 term
   double lovasz_weight = 0.0;          ///< weight of the Lovasz-softmax term (0: off; it costs 3x the step)
+  /// Factors on the loss weights of chosen learning classes (others 1), e.g.
+  /// to favour the recall of thin classes; index 0 unused.
+  std::array<double, kNumLearningClasses> class_weight_factors = uniform_class_factors();
   std::uint64_t seed = 1;
   int threads = 1;
   SegNetShape shape;                   ///< in_channels and classes are set by the trainer
@@ -113,8 +123,11 @@ class SegmentTrainer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Loss weights from class point counts: 1 / sqrt(frequency) for classes
-/// present (mean 1 over them), 0 for absent ones and class 0.
-std::array<double, kNumLearningClasses> class_weights_from_counts(const std::array<std::uint64_t, kNumLearningClasses>& counts);
+/// Loss weights from class point counts: 1 / sqrt(frequency) times the
+/// class's factor for classes present (mean 1 over them), 0 for absent ones
+/// and class 0.
+std::array<double, kNumLearningClasses> class_weights_from_counts(
+    const std::array<std::uint64_t, kNumLearningClasses>& counts,
+    const std::array<double, kNumLearningClasses>& factors = uniform_class_factors());
 
 }  // namespace saloam

@@ -31,6 +31,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// The factors other than 1, by class name (runs before the option had none).
+nlohmann::json class_factors_json(const std::array<double, kNumLearningClasses>& factors) {
+  nlohmann::json j = nlohmann::json::object();
+  for (int c = 1; c < kNumLearningClasses; ++c)
+    if (factors[c] != 1.0) j[std::string(learning_class_name(static_cast<std::uint8_t>(c)))] = factors[c];
+  return j;
+}
+
+std::array<double, kNumLearningClasses> class_factors_from_json(const nlohmann::json& j) {
+  auto factors = uniform_class_factors();
+  for (const auto& [name, factor] : j.items()) {
+    const auto c = learning_class_id(name);
+    if (!c) throw std::runtime_error("class_weight_factors: no learning class '" + name + "'");
+    factors[*c] = factor.get<double>();
+  }
+  return factors;
+}
+
 nlohmann::json options_json(const SegmentTrainOptions& o) {
   const auto& a = o.augment;
   return {{"samples_per_epoch", o.samples_per_epoch},
@@ -40,6 +58,7 @@ nlohmann::json options_json(const SegmentTrainOptions& o) {
           {"learning_rate", o.learning_rate},
           {"weight_decay", o.weight_decay},
           {"lovasz_weight", o.lovasz_weight},
+          {"class_weight_factors", class_factors_json(o.class_weight_factors)},
           {"seed", o.seed},
           {"threads", o.threads},
           {"widths", o.shape.widths},
@@ -71,6 +90,7 @@ SegmentTrainOptions options_from_json(const nlohmann::json& j, SegmentTrainOptio
   o.learning_rate = j.at("learning_rate").get<double>();
   o.weight_decay = j.at("weight_decay").get<double>();
   o.lovasz_weight = j.at("lovasz_weight").get<double>();
+  o.class_weight_factors = class_factors_from_json(j.value("class_weight_factors", nlohmann::json::object()));
   o.seed = j.at("seed").get<std::uint64_t>();
   o.threads = j.at("threads").get<int>();
   o.shape.widths = j.at("widths").get<std::array<int, 3>>();
@@ -347,7 +367,7 @@ RunState start_run(const std::vector<TrainingScanSet>& train, const SegmentTrain
   RunState run;
   run.spec = initial_spec(train, options);
   run.trainer = std::make_unique<SegmentTrainer>(run.spec.network.shape, options.seed, options);
-  run.trainer->set_class_weights(class_weights_from_counts(class_counts(train)));
+  run.trainer->set_class_weights(class_weights_from_counts(class_counts(train), options.class_weight_factors));
   if (options.resume) {
     const nlohmann::json state = read_checkpoint_state(options.out);
     if (state["options"] != options_key)
