@@ -6,6 +6,7 @@
 // `saloam segment-train`, which hands its arguments over: a program of its
 // own, so that only training loads libtorch.
 
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -69,22 +70,21 @@ std::vector<TrainingScanSet> build_sequences(const std::vector<SourceSpec>& spec
   return sequences;
 }
 
-/// --class-weight NAME=FACTOR, each class once, FACTOR in (0, 100].
+/// --class-weight NAME=FACTOR, each class once (set_class_weight_factor checks the pair).
 std::array<double, kNumLearningClasses> parse_class_weights(const std::vector<std::string>& items) {
   auto factors = uniform_class_factors();
-  std::vector<bool> given(kNumLearningClasses, false);
+  std::vector<std::string> given;
   for (const std::string& item : items) {
     const auto eq = item.find('=');
-    const auto c = learning_class_id(item.substr(0, std::min(eq, item.size())));
+    const std::string name = item.substr(0, eq);
     double factor = 0;
     std::istringstream in(eq == std::string::npos ? std::string() : item.substr(eq + 1));
-    if (!c || !(in >> factor) || !(in >> std::ws).eof() || !(factor > 0 && factor <= 100))
-      throw ConfigError(fmt::format("--class-weight: expected CLASS=FACTOR with a learning class (e.g. pole) and a factor "
-                                    "in (0, 100], not '{}'",
-                                    item));
-    if (given[*c]) throw ConfigError(fmt::format("--class-weight: {} is given twice", item.substr(0, eq)));
-    given[*c] = true;
-    factors[*c] = factor;
+    if (!(in >> factor) || !(in >> std::ws).eof())
+      throw ConfigError(fmt::format("--class-weight: expected CLASS=FACTOR, not '{}'", item));
+    if (std::find(given.begin(), given.end(), name) != given.end())
+      throw ConfigError(fmt::format("--class-weight: {} is given twice", name));
+    given.push_back(name);
+    set_class_weight_factor(factors, name, factor);
   }
   return factors;
 }

@@ -6,6 +6,7 @@
 
 #include <fstream>
 
+#include "saloam/core/error.hpp"
 #include "saloam/segmentation/segmenter_spec.hpp"
 #include "saloam/train/segment_trainer.hpp"
 #include "saloam/train/training_run.hpp"
@@ -99,7 +100,11 @@ TEST(SegmentTrainer, ClassWeightFactorsScaleTheirClassAndKeepTheMean) {
   counts[18] = 100;  // pole
   counts[16] = 100;  // trunk
   auto factors = uniform_class_factors();
-  factors[*learning_class_id("pole")] = 2.0;
+  set_class_weight_factor(factors, "pole", 2.0);
+  EXPECT_THROW(set_class_weight_factor(factors, "pol", 2.0), ConfigError);
+  EXPECT_THROW(set_class_weight_factor(factors, "trunk", 0.0), ConfigError);
+  EXPECT_THROW(set_class_weight_factor(factors, "trunk", 101.0), ConfigError);
+  EXPECT_EQ(factors[*learning_class_id("trunk")], 1.0);
   const auto plain = class_weights_from_counts(counts);
   const auto w = class_weights_from_counts(counts, factors);
   EXPECT_NEAR(w[18] / w[16], 2.0, 1e-9);

@@ -15,9 +15,6 @@ namespace {
 constexpr std::size_t kRingKeyCandidates = 100;
 // Proposals closer than this to a better one are the same place.
 constexpr double kSamePlace = 5.0;  // [m]
-// Two fits this close are the same solution (as the verification's uniqueness test).
-constexpr double kSameFitTranslation = 0.5;            // [m]
-constexpr double kSameFitRotation = 2.0 * M_PI / 180;  // [rad]
 
 // The kRingKeyCandidates candidates with the nearest ring keys, ascending.
 std::vector<std::size_t> nearest_ring_keys(const PriorMap& map, const PlaceDescriptor& query,
@@ -96,11 +93,8 @@ void require_measured_motion(LoopVerification& fit, const ScanFeatures& query, c
   if (!fit.accepted) return;
   const std::vector<Pose> guesses{last_fix};
   const LoopVerification again = verify_loop(query, submap, guesses, settings);
+  if (again.registration.ok && same_fit(fit.relative, again.relative)) return;
   const Pose difference = fit.relative.inverse() * again.relative;
-  if (again.registration.ok && difference.translation().norm() <= kSameFitTranslation &&
-      rotation_angle(difference) <= kSameFitRotation) {
-    return;
-  }
   fit.accepted = false;
   fit.reason = fmt::format("the fit follows the predicted motion: registered from the last fix it lands {:.1f} m, "
                            "{:.1f} deg elsewhere", difference.translation().norm(), rotation_angle(difference) * 180 / M_PI);

@@ -21,11 +21,11 @@ constexpr double kCoarseKernel = 0.5;       // [m]
 constexpr int kCoarseRounds = 5;
 constexpr std::size_t kCoarseStride = 3;
 // Uniqueness test: fine fits started this far [m] along the least
-// constrained direction; a fit farther than 0.5 m or 2 deg from the best is
-// a different solution.
+// constrained direction; a fit that is not same_fit() as the best is a
+// different solution.
 constexpr double kAmbiguityShifts[] = {-3.0, -1.5, 1.5, 3.0};
-constexpr double kDistinctTranslation = 0.5;
-constexpr double kDistinctRotation = 2.0 * M_PI / 180;
+constexpr double kSameFitTranslation = 0.5;            // [m]
+constexpr double kSameFitRotation = 2.0 * M_PI / 180;  // [rad]
 // The fine stage re-associates until a round moves the pose less than the
 // odometry's reassociation_min_translation / _rotation_deg, at most this
 // often: a fit from a descriptor's yaw (no translation known) slides along
@@ -110,10 +110,8 @@ double runner_up_ratio(const RegistrationResult& fit, const QueryFeatures& query
     const RegistrationResult other =
         register_scan(query.all.edges, query.all.planars, submap.fine(), start, settings.fine);
     if (!other.ok) continue;
-    const Pose difference = fit.pose.inverse() * other.pose;
-    if (difference.translation().norm() > kDistinctTranslation || rotation_angle(difference) > kDistinctRotation) {
+    if (!same_fit(fit.pose, other.pose))
       ratio = std::max(ratio, static_cast<double>(other.inliers) / std::max(1, fit.inliers));
-    }
   }
   return ratio;
 }
@@ -185,6 +183,11 @@ constexpr double kSameGuessRotation = 5.0 * M_PI / 180;  // [rad]
 // a little information (the edge stays positive definite).
 constexpr double kInformationFloor = 1e-3;
 }  // namespace
+
+bool same_fit(const Pose& a, const Pose& b) {
+  const Pose difference = a.inverse() * b;
+  return difference.translation().norm() <= kSameFitTranslation && rotation_angle(difference) <= kSameFitRotation;
+}
 
 Pose place_match_guess(const PlaceMatch& match) {
   Pose guess = Pose::Identity();

@@ -96,6 +96,10 @@ LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap
 /// identity without either.
 Pose place_match_guess(const PlaceMatch& match);
 
+/// True when two fits of one query lie within 0.5 m and 2 degrees of each
+/// other: the verification counts them one solution (its uniqueness test).
+bool same_fit(const Pose& a, const Pose& b);
+
 /// Appends `guess` unless a guess already in `guesses` lies within 1 m and
 /// 5 degrees of it (the registration would converge to the same fit).
 void add_distinct_guess(std::vector<Pose>& guesses, const Pose& guess);

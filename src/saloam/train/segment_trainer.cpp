@@ -165,6 +165,14 @@ void SegmentTrainer::load_optimizer(const fs::path& file) {
   }
 }
 
+void set_class_weight_factor(std::array<double, kNumLearningClasses>& factors, std::string_view name, double factor) {
+  const auto c = learning_class_id(name);
+  if (!c || !(factor > 0 && factor <= 100))
+    throw ConfigError(fmt::format("class weight '{}={}': expected a learning class (e.g. pole) and a factor in (0, 100]",
+                                  name, factor));
+  factors[*c] = factor;
+}
+
 std::array<double, kNumLearningClasses> class_weights_from_counts(const std::array<std::uint64_t, kNumLearningClasses>& counts,
                                                                  const std::array<double, kNumLearningClasses>& factors) {
   std::array<double, kNumLearningClasses> weights{};

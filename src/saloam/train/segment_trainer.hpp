@@ -7,8 +7,9 @@
 //     `pixels_per_sample` pixels (64 x 512, 32 x 1024, 16 x 2048 with the
 //     defaults); a batch holds scans of one beam count;
 //   - the loss is the class-weighted cross-entropy (weights 1 / sqrt of the
-//     class frequency times a factor per class, 1 unless given; mean 1) plus the Lovasz-softmax loss (Berman et al.,
-//     CVPR 2018), as SalsaNext trains; class 0 (unlabeled) is ignored;
+//     class frequency times a factor per class, 1 unless given; mean 1)
+//     plus the Lovasz-softmax loss (Berman et al., CVPR 2018), as SalsaNext
+//     trains; class 0 (unlabeled) is ignored;
 //   - Adam, the learning rate rising linearly over the first epoch and
 //     falling along a cosine to 1 % at the last;
 //   - every epoch, the mean IoU of whole validation scans through the
@@ -22,6 +23,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -37,6 +39,11 @@ constexpr std::array<double, kNumLearningClasses> uniform_class_factors() {
   f.fill(1.0);
   return f;
 }
+
+/// Sets the loss-weight factor of the learning class `name`: the one check of
+/// a factor whether it comes from the command line or a resumed run's state.
+/// ConfigError for an unknown class or a factor outside (0, 100].
+void set_class_weight_factor(std::array<double, kNumLearningClasses>& factors, std::string_view name, double factor);
 
 struct SegmentTrainOptions {
   std::filesystem::path out;   ///< output folder: models, checkpoint/, training.json, curves.png, scans/ (cache)

@@ -41,11 +41,7 @@ nlohmann::json class_factors_json(const std::array<double, kNumLearningClasses>&
 
 std::array<double, kNumLearningClasses> class_factors_from_json(const nlohmann::json& j) {
   auto factors = uniform_class_factors();
-  for (const auto& [name, factor] : j.items()) {
-    const auto c = learning_class_id(name);
-    if (!c) throw std::runtime_error("class_weight_factors: no learning class '" + name + "'");
-    factors[*c] = factor.get<double>();
-  }
+  for (const auto& [name, factor] : j.items()) set_class_weight_factor(factors, name, factor.get<double>());
   return factors;
 }
 
