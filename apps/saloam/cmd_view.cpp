@@ -35,6 +35,16 @@ ViewerOptions viewer_options(const ViewOptions& options) {
   return viewer;
 }
 
+/// Points from a run to the map it saved (`slam --save-map`), which has a
+/// page of its own.
+void print_saved_map(const std::filesystem::path& map) {
+  if (is_map_folder(map)) {
+    std::cout << fmt::format("this run saved a map: saloam view {}\n", map.string());
+  } else {
+    std::cout << fmt::format("this run saved a map to {}, which holds no map now\n", map.string());
+  }
+}
+
 /// Writes the page while no run writes the run folder (its lock, joined:
 /// the page is added to the run's record when it lies in the folder); a
 /// saved map's page goes beside the map.
@@ -60,6 +70,7 @@ int write_page(const ViewOptions& options) {
         s.ground_truth ? " with ground truth" : "", s.loops, s.scans, s.scan_points);
   }
   std::cout << fmt::format("open file://{}\n", std::filesystem::absolute(page).lexically_normal().string());
+  if (s.saved_map) print_saved_map(*s.saved_map);
   return 0;
 }
 

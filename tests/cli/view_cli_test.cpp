@@ -74,6 +74,32 @@ TEST(ViewCli, SlamWritesThePageBesideItsResults) {
   EXPECT_EQ(data["scans"]["frames"].size(), 6U);
 }
 
+TEST(ViewCli, ARunThatSavedAMapPointsToIt) {
+  TempDir tmp;
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("simulate --out {} --preset straight --frames 0:10 --beams 16",
+                                               quoted(tmp / "seq"))),
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("slam {} --out {} --save-map {}", quoted(tmp / "seq"),
+                                               quoted(tmp / "out"), quoted(tmp / "map"))),
+                        &output),
+            0)
+      << output;
+  ASSERT_EQ(run_command(saloam_cmd("view " + quoted(tmp / "out")), &output), 0) << output;
+  const std::string map = fs::absolute(tmp / "map").lexically_normal().string();
+  EXPECT_NE(output.find("this run saved a map: saloam view " + map + "\n"), std::string::npos) << output;
+  // Moved away, the map is not offered.
+  fs::rename(tmp / "map", tmp / "moved");
+  ASSERT_EQ(run_command(saloam_cmd("view " + quoted(tmp / "out")), &output), 0) << output;
+  EXPECT_NE(output.find("this run saved a map to " + map + ", which holds no map now"), std::string::npos) << output;
+  // A run that saved none says nothing of maps.
+  const auto run = testing::write_fake_run(tmp / "fake", 100);
+  ASSERT_EQ(run_command(saloam_cmd("view " + quoted(run.run_dir)), &output), 0) << output;
+  EXPECT_EQ(output.find("saved a map"), std::string::npos) << output;
+}
+
 TEST(ViewCli, MissingMapIsAClearError) {
   TempDir tmp;
   const auto run = testing::write_fake_run(tmp.path(), 100);

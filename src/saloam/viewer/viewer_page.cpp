@@ -227,6 +227,7 @@ ViewerPageStats write_viewer_page(const std::filesystem::path& run_dir, const st
   const ViewerScene scene = load_viewer_scene(run_dir, options);
   ViewerPageStats stats;
   const std::string html = viewer_page(scene, options, ViewerDataSource::kEmbedded, &stats);
+  stats.saved_map = scene.saved_map;
   write_file_atomically(page, html);
   return stats;
 }

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "saloam/viewer/viewer_scene.hpp"
@@ -28,6 +29,7 @@ struct ViewerPageStats {
   std::size_t scans = 0;        ///< embedded scans
   std::size_t scan_points = 0;  ///< in the embedded scans, all together
   bool ground_truth = false;
+  std::optional<std::filesystem::path> saved_map;  ///< a run's saved map (ViewerScene::saved_map)
 };
 
 /// True when saloam was built with three.js (Debian's libjs-three).

@@ -73,7 +73,18 @@ std::size_t parse_index(const std::string& text, const fs::path& file, std::size
 struct RunSummary {
   std::optional<fs::path> sequence;
   std::size_t first_frame = 0;
+  std::optional<fs::path> saved_map;
 };
+
+// The map folder that summary.json's "saved_map" names (slam --save-map), if any.
+std::optional<fs::path> saved_map_of(const nlohmann::json& summary, const fs::path& file) {
+  const auto saved = summary.find("saved_map");
+  if (saved == summary.end()) return std::nullopt;
+  if (!saved->is_object() || !saved->contains("folder") || !saved->at("folder").is_string()) {
+    throw InputError(file, "\"saved_map\" is not an object with a \"folder\" path");
+  }
+  return fs::path(saved->at("folder").get<std::string>());
+}
 
 RunSummary read_run_summary(const fs::path& run_dir) {
   RunSummary summary;
@@ -94,6 +105,7 @@ RunSummary read_run_summary(const fs::path& run_dir) {
     summary.sequence = fs::path(*bytes);
   }
   if (first != json.end()) summary.first_frame = first->get<std::size_t>();
+  summary.saved_map = saved_map_of(json, file);
   return summary;
 }
 
@@ -296,7 +308,9 @@ ViewerScene load_viewer_scene(const fs::path& run_dir, const ViewerOptions& opti
   scene.run_dir = run_dir;
   const fs::path map_file = required_file(run_dir, "map.ply", "the global map (run `saloam slam` without --no-map)");
   read_trajectories_and_loops(scene);
-  attach_sequence(scene, read_run_summary(run_dir), options);
+  const RunSummary summary = read_run_summary(run_dir);
+  attach_sequence(scene, summary, options);
+  scene.saved_map = summary.saved_map;
   const LabelledCloud map = read_ply(map_file);
   scene.map_points_total = map.size();
   scene.map = decimate_cloud(map, options.max_map_points);

@@ -64,6 +64,9 @@ struct ViewerScene {
   /// A saved map's loop edges between keyframes of different sessions (in
   /// `loops`: those within a session).
   std::vector<std::pair<std::size_t, std::size_t>> cross_session_loops;
+  /// The map a run saved (`slam --save-map`, as its summary.json names it);
+  /// none for a saved map or a run that saved none.
+  std::optional<std::filesystem::path> saved_map;
   LabelledCloud map;                 ///< decimated to the budget, sorted by class
   std::size_t map_points_total = 0;  ///< before decimation
 };
