@@ -73,12 +73,15 @@ struct Followed {
 };
 
 /// The drive of `options` registered by the odometry set up with the same
-/// profile (and `level_line_max_rise`), its scans delivered as `delivery` says.
-Followed follow_drive(const SimulationOptions& options, double level_line_max_rise, Delivery delivery) {
+/// profile (and `level_line_max_rise`, `use_semantics`), its scans delivered
+/// as `delivery` says.
+Followed follow_drive(const SimulationOptions& options, double level_line_max_rise, Delivery delivery,
+                      bool use_semantics = true) {
   const SimulatedSequence sequence(options);
   OdometryConfig config;
   apply_sensor_profile(*options.sensor, config.features);
   config.level_line_max_rise = level_line_max_rise;
+  config.use_semantics = use_semantics;
   SemanticOdometry odometry(config);
   for (std::size_t i = 0; i < sequence.size(); ++i) {
     odometry.register_frame(delivered(sequence.render(i).cloud, delivery, static_cast<std::uint32_t>(i)),
@@ -125,16 +128,16 @@ TEST(SensorProfilesOdometry, Vlp16WithoutRingsOrTimes) {
 
 /// [deg] rotation error of the drive's end relative to its start: the
 /// odometry set up with the VLP-16 (1 m mount) on 120 frames of the urban
-/// loop with emulated network labels.
-double vlp16_end_rotation_error_deg(double level_line_max_rise) {
+/// loop with emulated network labels (or without labels).
+double vlp16_end_rotation_error_deg(double level_line_max_rise, bool use_semantics = true) {
   SimulationOptions options = drive_options(named("vlp16"), 120, 3);
   options.labels = LabelMode::kNoisy;
-  const auto [truth, estimate] = follow_drive(options, level_line_max_rise, Delivery::kDriver);
+  const auto [truth, estimate] = follow_drive(options, level_line_max_rise, Delivery::kDriver, use_semantics);
   const Pose moved = truth.front().inverse() * truth.back();
   const Pose estimated = estimate.front().inverse() * estimate.back();
   const double error = rotation_angle(moved.inverse() * estimated) * 180.0 / M_PI;
-  std::printf("vlp16, level_line_max_rise %.2f: end rotation error %.3f deg, end %.1f m from the start\n",
-              level_line_max_rise, error, moved.translation().norm());
+  std::printf("vlp16, level_line_max_rise %.2f, semantics %d: end rotation error %.3f deg, end %.1f m from the start\n",
+              level_line_max_rise, use_semantics, error, moved.translation().norm());
   return error;
 }
 
@@ -148,6 +151,16 @@ TEST(SensorProfilesOdometry, Vlp16LevelLinesDoNotTiltThePose) {
   EXPECT_LT(fixed, 0.25);
   const double as_lines = vlp16_end_rotation_error_deg(0.0);
   EXPECT_GT(as_lines, 2 * fixed);  // the route shows the problem
+}
+
+// The same without labels, where the ground's edges add level lines of
+// their own. Measured here: 0.45 deg at the end, 4.17 deg with level lines
+// matched as lines.
+TEST(SensorProfilesOdometry, Vlp16LevelLinesDoNotTiltThePoseWithoutLabels) {
+  const double fixed = vlp16_end_rotation_error_deg(0.5, false);
+  EXPECT_LT(fixed, 0.9);
+  const double as_lines = vlp16_end_rotation_error_deg(0.0, false);
+  EXPECT_GT(as_lines, 4 * fixed);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "saloam/segmentation/segmenter_spec.hpp"
 
+#include <algorithm>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -108,6 +109,47 @@ TEST(SegmenterSpec, TheDynamicBiasOffsetsTheDynamicClassesOnly) {
   EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {dynamic_bias: -1}\n").find("decision.dynamic_bias: -1 is outside"),
             std::string::npos);
   EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {static_bias: 1}\n").find("decision.static_bias: unknown key"),
+            std::string::npos);
+}
+
+TEST(SegmenterSpec, ClassBiasesOffsetTheirClassesOnTopOfTheDynamicBias) {
+  const SegmenterSpec spec = parse_segmenter_spec(
+      std::string(kRangeNet) + "decision: {dynamic_bias: 2, class_bias: {building: 0.5, person: -0.25}}\n",
+      "/models/m.yaml");
+  const auto offsets = decision_offsets(spec);
+  ASSERT_EQ(offsets.size(), spec.classes.size());
+  for (std::size_t k = 0; k < offsets.size(); ++k) {
+    const auto id = spec.classes[k];
+    const float expected = id == cls::kBuilding ? 0.5f
+                           : id == cls::kPerson ? 1.75f
+                           : (id == cls::kBicyclist || id == cls::kMotorcyclist) ? 2.0f
+                                                                                  : 0.0f;
+    EXPECT_EQ(offsets[k], expected) << class_name(id);
+  }
+  const SegmenterSpec again = parse_segmenter_spec(segmenter_spec_yaml(spec, "/models"), "/models/m.yaml");
+  EXPECT_EQ(decision_offsets(again), offsets) << segmenter_spec_yaml(spec, "/models");
+
+  const SegmenterSpec only = parse_segmenter_spec(std::string(kRangeNet) + "decision: {class_bias: {fence: 1}}\n",
+                                                  "/models/m.yaml");
+  EXPECT_EQ(only.dynamic_bias, 0.0);
+  const auto only_offsets = decision_offsets(only);
+  EXPECT_EQ(std::count(only_offsets.begin(), only_offsets.end(), 1.0f), 1);
+  EXPECT_EQ(std::count(only_offsets.begin(), only_offsets.end(), 0.0f), static_cast<long>(only_offsets.size()) - 1);
+  const SegmenterSpec zero = parse_segmenter_spec(std::string(kRangeNet) + "decision: {class_bias: {fence: 0}}\n",
+                                                  "/models/m.yaml");
+  EXPECT_TRUE(decision_offsets(zero).empty()) << "every offset 0: the plain argmax";
+
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {class_bias: {house: 1}}\n")
+                .find("decision.class_bias.house: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {class_bias: {unlabeled: 1}}\n")
+                .find("decision.class_bias.unlabeled: unknown key"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {class_bias: {fence: 21}}\n")
+                .find("decision.class_bias.fence: 21 is outside"),
+            std::string::npos);
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {class_bias: {fence: 1, fence: 2}}\n")
+                .find("given twice"),
             std::string::npos);
 }
 

@@ -134,15 +134,15 @@ struct OdometryConfig {
   /// is kept only if |n . z| >= 1 - tolerance (normal near vertical), one of
   /// building/fence only if |n . z| <= tolerance (normal near horizontal).
   double plane_normal_tolerance = 0.05;
-  /// With semantics: a map line (edge feature's fitted neighbours) whose unit
-  /// direction d rises less than this, |d . z| < level_line_max_rise, is a
-  /// level line and constrains the feature only across it horizontally (the
-  /// vertical plane through it), not in height. The edges that remain with
-  /// labels (ground gives none) cross the rings upright; a level line is
-  /// mostly one ring's footprint seen by several frames, whose height moves
-  /// with the sensor (z = range * tan(elevation)): fitted as a line, it pulls
-  /// the pitch, most with 16 beams (docs/odometry.md, "Level edge lines":
-  /// 0.5, lines rising less than 30 degrees). 0: off, every line a line.
+  /// A map line (edge feature's fitted neighbours) whose unit direction d
+  /// rises less than this, |d . z| < level_line_max_rise, is a level line and
+  /// constrains the feature only across it horizontally (the vertical plane
+  /// through it), not in height. A level line is mostly one ring's footprint
+  /// seen by several frames, whose height moves with the sensor
+  /// (z = range * tan(elevation)): fitted as a line, it pulls the pitch, most
+  /// with 16 beams, with or without labels (docs/odometry.md, "Level edge
+  /// lines": 0.5, lines rising less than 30 degrees). 0: off, every line a
+  /// line.
   double level_line_max_rise = 0.5;
   bool use_semantics = true;     ///< false: label-agnostic FLOAM-style baseline
   /// Match within groups of classes that networks confuse and that share a
@@ -401,7 +401,7 @@ void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature", Range{3, kMaxFitNeighbours});
   v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . z|", Range{0, 1});
   v("level_line_max_rise", c.level_line_max_rise,
-    "with semantics, map lines with |d . z| below this constrain only horizontally (0: off)", Range{0, 1});
+    "map lines with |d . z| below this constrain only horizontally (0: off)", Range{0, 1});
   v("use_semantics", c.use_semantics, "semantic assistance on/off");
   v("match_class_groups", c.match_class_groups, "match within class groups instead of single classes");
   v("deskew", c.deskew, "constant-velocity de-skewing");

@@ -22,7 +22,7 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
   s.reassociation_min_translation = config.reassociation_min_translation;
   s.reassociation_min_rotation = config.reassociation_min_rotation_deg * M_PI / 180.0;
   s.plane_normal_tolerance = config.plane_normal_tolerance;
-  s.level_line_max_rise = config.use_semantics ? config.level_line_max_rise : 0.0;
+  s.level_line_max_rise = config.level_line_max_rise;
   s.class_weight = class_weights(config);
   for (int c = 0; c < kNumClassIndices; ++c) {
     s.orientation[c] = config.use_semantics

@@ -184,6 +184,24 @@ std::string read_limited(const fs::path& file) {
   return read_file(file, kMaxSpecBytes, "segmentation model description");
 }
 
+/// `decision:` of `spec`, whose classes are read: every key optional;
+/// class_bias names classes of the model's output (unlabeled excluded).
+void read_decision(const YAML::Node& node, const fs::path& file, SegmenterSpec& spec) {
+  const MapReader d(node, "decision", file, {"dynamic_bias", "class_bias"});
+  if (d.has("dynamic_bias")) spec.dynamic_bias = d.number("dynamic_bias", 0.0, 20.0);
+  if (!d.has("class_bias")) return;
+  std::set<std::string> names;
+  for (const auto id : spec.classes) {
+    if (id != cls::kUnlabeled) names.emplace(class_name(id));
+  }
+  const YAML::Node biases = d.node("class_bias");
+  const MapReader b(biases, "decision.class_bias", file, names);
+  for (const auto& kv : biases) {
+    const auto name = kv.first.as<std::string>();
+    spec.class_bias.emplace_back(*semantic_class_id(name), b.number(name, -20.0, 20.0));
+  }
+}
+
 }  // namespace
 
 std::vector<std::uint16_t> semantickitti_learning_classes() {
@@ -215,19 +233,22 @@ SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& o
   read_projection(r.node("projection"), origin, spec);
   spec.classes = read_classes(r.node("classes"), origin);
   spec.knn = read_knn(r.node("knn"), origin);
-  if (r.has("decision")) {
-    const MapReader d(r.node("decision"), "decision", origin, {"dynamic_bias"});
-    spec.dynamic_bias = d.number("dynamic_bias", 0.0, 20.0);
-  }
+  if (r.has("decision")) read_decision(r.node("decision"), origin, spec);
   spec.network.shape.in_channels = static_cast<int>(spec.projection.channels.size());
   spec.network.shape.classes = static_cast<int>(spec.classes.size());
   return spec;
 }
 
 std::vector<float> decision_offsets(const SegmenterSpec& spec) {
-  if (spec.dynamic_bias == 0.0) return {};
   std::vector<float> offsets;
-  for (const auto id : spec.classes) offsets.push_back(is_dynamic(id) ? static_cast<float>(spec.dynamic_bias) : 0.0f);
+  bool any = false;
+  for (const auto id : spec.classes) {
+    double offset = is_dynamic(id) ? spec.dynamic_bias : 0.0;
+    for (const auto& [biased, bias] : spec.class_bias) offset += biased == id ? bias : 0.0;
+    offsets.push_back(static_cast<float>(offset));
+    any = any || offset != 0.0;
+  }
+  if (!any) offsets.clear();
   return offsets;
 }
 
@@ -273,9 +294,15 @@ std::string segmenter_spec_yaml(const SegmenterSpec& spec, const fs::path& folde
   out << YAML::Key << "k" << YAML::Value << spec.knn.k << YAML::Key << "window" << YAML::Value << spec.knn.window;
   out << YAML::Key << "cutoff" << YAML::Value << spec.knn.cutoff << YAML::Key << "sigma" << YAML::Value << spec.knn.sigma;
   out << YAML::EndMap;
-  if (spec.dynamic_bias != 0.0) {
+  if (spec.dynamic_bias != 0.0 || !spec.class_bias.empty()) {
     out << YAML::Key << "decision" << YAML::Value << YAML::Flow << YAML::BeginMap;
-    out << YAML::Key << "dynamic_bias" << YAML::Value << spec.dynamic_bias << YAML::EndMap;
+    if (spec.dynamic_bias != 0.0) out << YAML::Key << "dynamic_bias" << YAML::Value << spec.dynamic_bias;
+    if (!spec.class_bias.empty()) {
+      out << YAML::Key << "class_bias" << YAML::Value << YAML::BeginMap;
+      for (const auto& [id, bias] : spec.class_bias) out << YAML::Key << std::string(class_name(id)) << YAML::Value << bias;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndMap;
   }
   out << YAML::EndMap;
   return std::string(out.c_str()) + "\n";

@@ -19,7 +19,7 @@
 //     stds: [...]               # one per channel, > 0
 //   classes: semantickitti | [unlabeled, car, ...]   # output index -> class name
 //   knn: {k: 5, window: 5, cutoff: 1.0, sigma: 1.0}
-//   decision: {dynamic_bias: 0.0}   # optional
+//   decision: {dynamic_bias: 0.0, class_bias: {building: 0.5}}   # optional, each key too
 //
 // Every value is range-checked; an error names the file and the key.
 
@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "saloam/segmentation/knn_labels.hpp"
@@ -51,10 +52,17 @@ struct SegmenterSpec {
   /// it, while a pole called a person only loses one constraint; a bias > 0
   /// is the decision that weighs the first error more (docs/segmentation.md).
   double dynamic_bias = 0.0;
+  /// Added to the logit of single classes (raw id, offset) before the
+  /// argmax, after dynamic_bias: the same decision for other unequal costs,
+  /// e.g. a building point called vegetation costs the odometry a plane,
+  /// while vegetation called building is mostly refused by the plane's
+  /// orientation check (docs/segmentation.md, "The decision").
+  std::vector<std::pair<std::uint16_t, double>> class_bias;
 };
 
 /// One offset per output class of `spec` (the dynamic ones get
-/// spec.dynamic_bias), or none when the bias is 0: NetworkSpec::logit_offsets.
+/// spec.dynamic_bias, plus spec.class_bias's), or none when every offset is
+/// 0: NetworkSpec::logit_offsets.
 std::vector<float> decision_offsets(const SegmenterSpec& spec);
 
 /// The 20 SemanticKITTI training classes in their learning order (0 =
