@@ -155,6 +155,11 @@ TEST(SegmenterSpec, ClassBiasesOffsetTheirClassesOnTopOfTheDynamicBias) {
 
 TEST(SegmenterSpec, ErrorsNameTheFileAndTheKey) {
   EXPECT_NE(error_of("format: other 2\n").find("/models/m.yaml: format: expected 'saloam-segmenter 1'"), std::string::npos);
+  // A list where a key belongs (found by fuzzing: it ended the program).
+  EXPECT_NE(error_of(replaced(kSegNet, "stem_stride:", "[31, 64]: 1, stem_stride:"))
+                .find("/models/m.yaml: network.<key>: a key that is not a name"),
+            std::string::npos)
+      << error_of(replaced(kSegNet, "stem_stride:", "[31, 64]: 1, stem_stride:"));
   EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 1024\n  colums: 3")).find("projection.colums: unknown key"),
             std::string::npos);
   EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 1024\n  columns: 512")).find("projection.columns: given twice"),

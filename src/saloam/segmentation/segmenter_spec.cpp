@@ -30,7 +30,8 @@ class MapReader {
     if (!node.IsMap()) fail(section_, "expected a map");
     std::set<std::string> seen;
     for (const auto& kv : node) {
-      const auto key = kv.first.as<std::string>();
+      if (!kv.first.IsScalar()) fail("<key>", "a key that is not a name (a list or a map)");
+      const auto key = kv.first.Scalar();
       if (!known.contains(key)) fail(key, "unknown key");
       if (!seen.insert(key).second) fail(key, "given twice");
     }
@@ -197,7 +198,7 @@ void read_decision(const YAML::Node& node, const fs::path& file, SegmenterSpec& 
   const YAML::Node biases = d.node("class_bias");
   const MapReader b(biases, "decision.class_bias", file, names);
   for (const auto& kv : biases) {
-    const auto name = kv.first.as<std::string>();
+    const auto name = kv.first.Scalar();  // a known class name: MapReader checked every key
     spec.class_bias.emplace_back(*semantic_class_id(name), b.number(name, -20.0, 20.0));
   }
 }
