@@ -1,6 +1,10 @@
 // End-to-end: `saloam simulate --passes`, `saloam slam --save-map` and
 // `saloam localize` on two short passes of one simulated world.
 
+#include <cmath>
+#include <sstream>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -53,6 +57,22 @@ TEST(LocalizeCli, SavesAMapAndLocalisesASecondPassInIt) {
   const std::size_t placed = summary["localized"].get<std::size_t>() + summary["odometry"].get<std::size_t>();
   EXPECT_EQ(line_count(dir / "loc" / "poses.txt"), placed);
   EXPECT_EQ(line_count(dir / "loc" / "frames.csv"), summary["frames"].get<std::size_t>() + 1);
+  // frames.csv's error column measures what the summary measures (after the
+  // map's own error is aligned away): its localized rows give the same RMSE.
+  std::istringstream frames(file_text(dir / "loc" / "frames.csv"));
+  std::string row;
+  std::getline(frames, row);
+  ASSERT_EQ(row.substr(row.rfind(',') + 1), "error_m") << row;
+  double squares = 0;
+  std::size_t localized = 0;
+  while (std::getline(frames, row)) {
+    if (row.find(",localized,") == std::string::npos) continue;
+    const double e = std::stod(row.substr(row.rfind(',') + 1));
+    squares += e * e;
+    ++localized;
+  }
+  ASSERT_EQ(localized, summary["localized"].get<std::size_t>());
+  EXPECT_NEAR(std::sqrt(squares / static_cast<double>(localized)), summary["localized_rmse_in_map_m"].get<double>(), 1e-4);
 
   // A folder that is not a map is refused, naming its manifest.
   std::filesystem::create_directories(dir / "not_a_map");

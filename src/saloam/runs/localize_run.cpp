@@ -36,7 +36,15 @@ std::optional<std::vector<Pose>> reference_lidar_poses(const SourceInfo& info, s
 
 std::string number_or_empty(double v, int digits) { return v < 0 ? std::string() : fmt::format("{:.{}f}", v, digits); }
 
-void write_frames_csv(const std::filesystem::path& file, const Localizer& localizer, const std::vector<Pose>* truth) {
+/// An estimate as it is compared with the truth: moved by the map's own
+/// error (LocalizeRunOptions::map_alignment) when known. Every error this
+/// run reports (summary, frames.csv, relocalizations.csv) is measured so.
+Pose for_truth(const Pose& estimate, const LocalizeRunOptions& options) {
+  return options.map_alignment ? Pose(*options.map_alignment * estimate) : estimate;
+}
+
+void write_frames_csv(const std::filesystem::path& file, const Localizer& localizer, const std::vector<Pose>* truth,
+                      const LocalizeRunOptions& options) {
   AtomicFile out_file(file);
   std::ostream& out = out_file.stream();
   out << "frame,time,status,fitted,since_fix_m,inlier_fraction,mean_residual_m,submap_keyframes,x,y,z,yaw_deg,event";
@@ -55,7 +63,10 @@ void write_frames_csv(const std::filesystem::path& file, const Localizer& locali
       out << ",,,";
     }
     out << ",\"" << f.event << '"';
-    if (truth) out << ',' << (placed ? fmt::format("{:.4f}", (p - (*truth)[f.frame].translation()).norm()) : std::string());
+    if (truth) {
+      const Eigen::Vector3d error = for_truth(f.pose, options).translation() - (*truth)[f.frame].translation();
+      out << ',' << (placed ? fmt::format("{:.4f}", error.norm()) : std::string());
+    }
     out << '\n';
   }
   out_file.commit();
@@ -67,7 +78,7 @@ bool is_true(const Pose& estimate, const Pose& truth) {
 }
 
 void write_relocalizations_csv(const std::filesystem::path& file, const Localizer& localizer,
-                               const std::vector<Pose>* truth) {
+                               const std::vector<Pose>* truth, const LocalizeRunOptions& options) {
   AtomicFile out_file(file);
   std::ostream& out = out_file.stream();
   out << "frame,travelled_m,map_keyframe,score,descriptor_yaw_deg,guess,features,inliers,inlier_fraction,mean_residual_m,"
@@ -85,7 +96,8 @@ void write_relocalizations_csv(const std::filesystem::path& file, const Localize
                        r.pose.translation().z());
     if (truth) {
       const Pose& t = (*truth)[r.frame];
-      out << fmt::format(",{:.3f},{:d}", (r.pose.translation() - t.translation()).norm(), is_true(r.pose, t));
+      const Pose estimate = for_truth(r.pose, options);
+      out << fmt::format(",{:.3f},{:d}", (estimate.translation() - t.translation()).norm(), is_true(estimate, t));
     }
     out << '\n';
   }
@@ -121,7 +133,6 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
   const auto& frames = localizer.frames();
   result.frames = frames.size();
   std::vector<Pose> placed_estimates, placed_references;
-  const auto aligned = [&](const Pose& p) { return options.map_alignment ? Pose(*options.map_alignment * p) : p; };
   std::vector<double> placed_errors, localized_errors;
   for (const LocalizedFrame& f : frames) {
     switch (f.status) {
@@ -138,7 +149,7 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
       placed_references.push_back((*reference)[f.frame]);
     }
     if (truth) {
-      const double e = (aligned(f.pose).translation() - (*truth)[f.frame].translation()).norm();
+      const double e = (for_truth(f.pose, options).translation() - (*truth)[f.frame].translation()).norm();
       placed_errors.push_back(e);
       if (f.status == LocalizationStatus::kLocalized) localized_errors.push_back(e);
     }
@@ -152,7 +163,7 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
   if (truth) {
     std::size_t false_count = 0;
     for (const auto& r : localizer.relocalizations())
-      if (r.outcome == "confirmed" && !is_true(aligned(r.pose), (*truth)[r.frame])) ++false_count;
+      if (r.outcome == "confirmed" && !is_true(for_truth(r.pose, options), (*truth)[r.frame])) ++false_count;
     result.false_relocalizations = false_count;
     if (!placed_errors.empty()) result.placed_rmse_m = error_stats(placed_errors).rmse;
     if (!localized_errors.empty()) {
@@ -250,8 +261,8 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
   result.map_loads = map.loads();
 
   const std::vector<Pose>* truth_ptr = truth ? &*truth : nullptr;
-  write_frames_csv(folder / "frames.csv", localizer, truth_ptr);
-  write_relocalizations_csv(folder / "relocalizations.csv", localizer, truth_ptr);
+  write_frames_csv(folder / "frames.csv", localizer, truth_ptr, options);
+  write_relocalizations_csv(folder / "relocalizations.csv", localizer, truth_ptr, options);
   write_file_atomically(folder / "timing.json",
                         localize_timing_json(frames, total, frame_summary, result, map).dump(2) + '\n');
   write_run_summary(folder, localize_summary_json(info, map, result));
