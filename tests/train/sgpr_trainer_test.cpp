@@ -183,6 +183,15 @@ TEST(SgprTrainingData, RecipeErrorsNameTheFileAndTheEntry) {
   EXPECT_NE(write("train: [{simulate: poses.txt, calib: poses.txt, colour: red}]\nvalidation: [{folder: .}]\n")
                 .find("train[0]: unknown key 'colour'"),
             std::string::npos);
+  // A list where a key belongs, at each level: an InputError naming the file.
+  EXPECT_NE(write("train: [{folder: .}]\nvalidation: [{folder: .}]\n[1, 2]: 3\n")
+                .find("recipe.yaml: <root>: a key that is not a name"),
+            std::string::npos);
+  EXPECT_NE(write("defaults: {[1]: 2}\ntrain: [{folder: .}]\nvalidation: [{folder: .}]\n")
+                .find("recipe.yaml: defaults: a key that is not a name"),
+            std::string::npos);
+  EXPECT_NE(write("train: [{folder: ., [1]: 2}]\nvalidation: [{folder: .}]\n").find("recipe.yaml: train[0]: a key that is not a name"),
+            std::string::npos);
   const std::string ok = write("defaults: {calib: poses.txt, frame_step: 3}\ntrain: [{simulate: poses.txt, frames: '0:9'}]\n"
                                "validation: [{folder: ., labels: here}]\n");
   EXPECT_EQ(ok, "no error");

@@ -43,6 +43,11 @@ Pose for_truth(const Pose& estimate, const LocalizeRunOptions& options) {
   return options.map_alignment ? Pose(*options.map_alignment * estimate) : estimate;
 }
 
+/// [m] how far `estimate` (for_truth) lies from `truth`.
+double truth_error(const Pose& estimate, const Pose& truth, const LocalizeRunOptions& options) {
+  return (for_truth(estimate, options).translation() - truth.translation()).norm();
+}
+
 void write_frames_csv(const std::filesystem::path& file, const Localizer& localizer, const std::vector<Pose>* truth,
                       const LocalizeRunOptions& options) {
   AtomicFile out_file(file);
@@ -64,16 +69,16 @@ void write_frames_csv(const std::filesystem::path& file, const Localizer& locali
     }
     out << ",\"" << f.event << '"';
     if (truth) {
-      const Eigen::Vector3d error = for_truth(f.pose, options).translation() - (*truth)[f.frame].translation();
-      out << ',' << (placed ? fmt::format("{:.4f}", error.norm()) : std::string());
+      out << ',' << (placed ? fmt::format("{:.4f}", truth_error(f.pose, (*truth)[f.frame], options)) : std::string());
     }
     out << '\n';
   }
   out_file.commit();
 }
 
-bool is_true(const Pose& estimate, const Pose& truth) {
-  const Pose difference = truth.inverse() * estimate;
+/// A relocalisation within 0.5 m and 2 degrees of the truth (for_truth), as loops are judged.
+bool is_true(const Pose& estimate, const Pose& truth, const LocalizeRunOptions& options) {
+  const Pose difference = truth.inverse() * for_truth(estimate, options);
   return difference.translation().norm() <= kTrueTranslation && rotation_angle(difference) <= kTrueRotation;
 }
 
@@ -96,8 +101,7 @@ void write_relocalizations_csv(const std::filesystem::path& file, const Localize
                        r.pose.translation().z());
     if (truth) {
       const Pose& t = (*truth)[r.frame];
-      const Pose estimate = for_truth(r.pose, options);
-      out << fmt::format(",{:.3f},{:d}", (estimate.translation() - t.translation()).norm(), is_true(estimate, t));
+      out << fmt::format(",{:.3f},{:d}", truth_error(r.pose, t, options), is_true(r.pose, t, options));
     }
     out << '\n';
   }
@@ -149,7 +153,7 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
       placed_references.push_back((*reference)[f.frame]);
     }
     if (truth) {
-      const double e = (for_truth(f.pose, options).translation() - (*truth)[f.frame].translation()).norm();
+      const double e = truth_error(f.pose, (*truth)[f.frame], options);
       placed_errors.push_back(e);
       if (f.status == LocalizationStatus::kLocalized) localized_errors.push_back(e);
     }
@@ -163,7 +167,7 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
   if (truth) {
     std::size_t false_count = 0;
     for (const auto& r : localizer.relocalizations())
-      if (r.outcome == "confirmed" && !is_true(for_truth(r.pose, options), (*truth)[r.frame])) ++false_count;
+      if (r.outcome == "confirmed" && !is_true(r.pose, (*truth)[r.frame], options)) ++false_count;
     result.false_relocalizations = false_count;
     if (!placed_errors.empty()) result.placed_rmse_m = error_stats(placed_errors).rmse;
     if (!localized_errors.empty()) {

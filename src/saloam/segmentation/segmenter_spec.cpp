@@ -242,14 +242,12 @@ SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& o
 
 std::vector<float> decision_offsets(const SegmenterSpec& spec) {
   std::vector<float> offsets;
-  bool any = false;
   for (const auto id : spec.classes) {
     double offset = is_dynamic(id) ? spec.dynamic_bias : 0.0;
     for (const auto& [biased, bias] : spec.class_bias) offset += biased == id ? bias : 0.0;
     offsets.push_back(static_cast<float>(offset));
-    any = any || offset != 0.0;
   }
-  if (!any) offsets.clear();
+  if (std::ranges::all_of(offsets, [](float offset) { return offset == 0.0f; })) offsets.clear();
   return offsets;
 }
 

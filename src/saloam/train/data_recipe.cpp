@@ -42,6 +42,13 @@ int read_beams(const YAML::Node& node, const fs::path& file, const std::string& 
   return beams;
 }
 
+/// The name of a map key at `where` in `file`; a list or a map as a key is
+/// an InputError (yaml-cpp's own conversion error would not name the file).
+std::string key_name(const YAML::Node& key, const fs::path& file, const std::string& where) {
+  if (!key.IsScalar()) throw InputError(file, where + ": a key that is not a name (a list or a map)");
+  return key.Scalar();
+}
+
 fs::path resolve(const fs::path& base, const std::string& text) {
   const fs::path p(text);
   return p.is_absolute() ? p : base / p;
@@ -71,7 +78,7 @@ SourceSpec read_source(const YAML::Node& node, const SourceSpec& defaults, const
       throw InputError(file, where + ": needs `simulate: POSES.txt` or `folder: DIR`");
     }
     for (const auto& kv : node) {
-      const auto key = kv.first.as<std::string>();
+      const auto key = key_name(kv.first, file, where);
       if (key == "simulate" || key == "folder") continue;
       if (key == "calib") spec.calib = resolve(base, kv.second.as<std::string>());
       else if (key == "frames") spec.frames = kv.second.as<std::string>();
@@ -147,7 +154,7 @@ DataRecipe read_data_recipe(const fs::path& file, const SourceSpec& given_defaul
     if (!d.IsMap()) throw InputError(file, "defaults: expected a map");
     try {
       for (const auto& kv : d) {
-        const auto key = kv.first.as<std::string>();
+        const auto key = key_name(kv.first, file, "defaults");
         if (key == "calib") defaults.calib = resolve(base, kv.second.as<std::string>());
         else if (key == "frame_step") defaults.frame_step = kv.second.as<std::size_t>();
         else if (key == "seed") defaults.seed = kv.second.as<std::uint64_t>();
@@ -169,7 +176,7 @@ DataRecipe read_data_recipe(const fs::path& file, const SourceSpec& given_defaul
       out.push_back(read_source(list[i], defaults, base, file, fmt::format("{}[{}]", section, i)));
   }
   for (const auto& key : root)
-    if (const auto k = key.first.as<std::string>(); k != "train" && k != "validation" && k != "defaults")
+    if (const auto k = key_name(key.first, file, "<root>"); k != "train" && k != "validation" && k != "defaults")
       throw InputError(file, "unknown key '" + k + "'");
   return recipe;
 }
