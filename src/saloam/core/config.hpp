@@ -317,8 +317,8 @@ struct LocalizeConfig {
   int confirmations = 2;
   double confirm_interval = 1.0;  ///< [m]
   /// Uniqueness of a place found with no prior (a search of the whole map:
-  /// at the start, or after the odometry fallback ran out): the fit of the
-  /// candidate and of each confirming fix is refused when a distinct fit,
+  /// at the start, or after the odometry fallback ran out): the candidate's
+  /// fit is refused when a distinct fit,
   /// started 1.5 and 3 m along its least constrained direction, reaches this
   /// fraction of its inliers (loop.max_runner_up_ratio's test). Along a
   /// street that the map cannot tell from another, such a second solution is
@@ -491,7 +491,7 @@ void visit_fields(LocalizeConfig& c, Visitor&& v) {
   v("confirmations", c.confirmations, "agreeing tracking fixes that confirm a relocalisation", Range{0, 100});
   v("confirm_interval", c.confirm_interval, "[m] travel between confirming fixes", AtLeast{0});
   v("max_runner_up_ratio", c.max_runner_up_ratio,
-    "no prior: max inliers of a distinct fit / best, for the candidate and its confirmations (.inf: off)", Range{0, kInf});
+    "no prior: max inliers of a distinct fit / the candidate's (.inf: off)", Range{0, kInf});
   v("track_radius", c.track_radius, "[m] map keyframes this near the pose form the tracking submap", Above{0});
   v("submap_spacing", c.submap_spacing, "[m] least spacing of the tracking submap's keyframes", AtLeast{0});
   v("submap_rebuild_distance", c.submap_rebuild_distance, "[m] motion that rebuilds the tracking submap", Above{0});

@@ -114,7 +114,7 @@ bool Localizer::small_correction(const Pose& predicted, const Pose& fitted) cons
          rotation_angle(difference) <= config_.localize.track_max_correction_deg * M_PI / 180.0;
 }
 
-LoopVerification Localizer::verify_near(const Pose& predicted, const LoopVerificationSettings& settings) {
+LoopVerification Localizer::verify_near(const Pose& predicted) {
   const Submap& submap = submap_near(predicted.translation());
   LoopVerification v;
   if (submap.keyframes.empty()) {
@@ -122,7 +122,7 @@ LoopVerification Localizer::verify_near(const Pose& predicted, const LoopVerific
     return v;
   }
   const std::vector<Pose> guesses{predicted};
-  return verify_loop(odometry_.last_features(), submap.features, guesses, settings);
+  return verify_loop(odometry_.last_features(), submap.features, guesses, verification_);
 }
 
 void Localizer::track(LocalizedFrame& out) {
@@ -166,7 +166,7 @@ void Localizer::reenter(LocalizedFrame& out) {
   if (map_.near(predicted.translation(), 0.5 * lc.track_radius).empty()) return;  // still outside
   last_reentry_try_ = travelled_;
   const StageTimer timer;
-  const LoopVerification v = verify_near(predicted, verification_);
+  const LoopVerification v = verify_near(predicted);
   out.inlier_fraction = v.inlier_fraction;
   out.mean_residual = v.mean_residual;
   out.submap_keyframes = submap_ ? submap_->keyframes.size() : 0;
@@ -192,7 +192,7 @@ void Localizer::confirm(LocalizedFrame& out) {
   RelocalizationRecord record;
   record.frame = out.frame;
   record.travelled = travelled_;
-  record.verification = verify_near(predicted, h.without_prior ? unique_verification_ : verification_);
+  record.verification = verify_near(predicted);
   record.pose = record.verification.relative;
   out.inlier_fraction = record.verification.inlier_fraction;
   out.mean_residual = record.verification.mean_residual;
@@ -255,9 +255,8 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
   const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
   const std::vector<PlaceCandidate> chosen = best_places(map_, places_, query, std::move(candidates), score_threshold_, n);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
-  // With no prior (the whole map searched) a fit must also be unique.
-  const bool without_prior = state_ != State::kOdometry;
-  const LoopVerificationSettings& settings = without_prior ? unique_verification_ : verification_;
+  // With no prior (the whole map searched) the fit must also be unique.
+  const LoopVerificationSettings& settings = state_ == State::kOdometry ? verification_ : unique_verification_;
   for (const PlaceCandidate& candidate : chosen) {
     const std::size_t match = candidate.keyframe;
     const LoopSubmap submap = submap_around(map_, match, w, verification_);
@@ -280,7 +279,6 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
       h.confirmations_left = config_.localize.confirmations;
       h.last_fix = travelled_;
       h.last_pose = record.pose;
-      h.without_prior = without_prior;
       if (h.confirmations_left <= 0) {
         record.outcome = "confirmed";
         map_from_odometry_ = h.map_from_odometry;

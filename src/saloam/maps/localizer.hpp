@@ -11,9 +11,8 @@
 //    acceptance test). An accepted fit is a hypothesis, not yet a pose.
 //    With no prior at all (the run's start, or after the odometry fallback
 //    ran out; the whole map is searched) the fit must also be unique along
-//    its least constrained direction (localize.max_runner_up_ratio), it and
-//    each of its confirming fixes: a street the map cannot tell from another
-//    is not a place.
+//    its least constrained direction (localize.max_runner_up_ratio): a
+//    street the map cannot tell from another is not a place.
 //  * Hypothesis: localize.confirmations later fixes, confirm_interval metres
 //    apart, must agree: each registers the scan against the map around the
 //    pose the odometry predicts from the hypothesis and must pass the same
@@ -118,7 +117,6 @@ class Localizer {
     int confirmations_left = 0;
     double last_fix = 0;  ///< travelled at the last fix
     Pose last_pose = Pose::Identity();  ///< T_map<-sensor at the last fix
-    bool without_prior = false;  ///< found by a whole-map search: its fits must be unique
   };
   struct Submap;
 
@@ -132,7 +130,7 @@ class Localizer {
   /// The tracking submap around `position` (rebuilt when it moved far enough).
   const Submap& submap_near(const Eigen::Vector3d& position);
   /// Registration against the tracking submap from `predicted`, with the loop acceptance test.
-  LoopVerification verify_near(const Pose& predicted, const LoopVerificationSettings& settings);
+  LoopVerification verify_near(const Pose& predicted);
   [[nodiscard]] bool small_correction(const Pose& predicted, const Pose& fitted) const;
 
   SaloamConfig config_;
