@@ -316,6 +316,14 @@ struct LocalizeConfig {
   /// acceptance test.
   int confirmations = 2;
   double confirm_interval = 1.0;  ///< [m]
+  /// Uniqueness of a place found with no prior (a search of the whole map:
+  /// at the start, or after the odometry fallback ran out): the candidate's
+  /// fit is refused when a distinct fit,
+  /// started 1.5 and 3 m along its least constrained direction, reaches this
+  /// fraction of its inliers (loop.max_runner_up_ratio's test). Along a
+  /// street that the map cannot tell from another, such a second solution is
+  /// nearly as good. .inf = off.
+  double max_runner_up_ratio = 0.9;
   /// [m] map keyframes whose position lies within this of the predicted pose
   /// form the tracking submap.
   double track_radius = 40.0;
@@ -482,6 +490,8 @@ void visit_fields(LocalizeConfig& c, Visitor&& v) {
   v("relocalize_interval", c.relocalize_interval, "[m] travel between relocalisation attempts", AtLeast{0});
   v("confirmations", c.confirmations, "agreeing tracking fixes that confirm a relocalisation", Range{0, 100});
   v("confirm_interval", c.confirm_interval, "[m] travel between confirming fixes", AtLeast{0});
+  v("max_runner_up_ratio", c.max_runner_up_ratio,
+    "no prior: max inliers of a distinct fit / the candidate's (.inf: off)", Range{0, kInf});
   v("track_radius", c.track_radius, "[m] map keyframes this near the pose form the tracking submap", Above{0});
   v("submap_spacing", c.submap_spacing, "[m] least spacing of the tracking submap's keyframes", AtLeast{0});
   v("submap_rebuild_distance", c.submap_rebuild_distance, "[m] motion that rebuilds the tracking submap", Above{0});

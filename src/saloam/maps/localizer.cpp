@@ -43,6 +43,9 @@ Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optio
   tracking_.inlier_distance = config.loop.inlier_distance;
   tracking_.level_line_max_rise = 0;  // as the verification's fits (LoopVerificationSettings)
   score_threshold_ = place_score_threshold(config, places_.detector());
+  unique_verification_ = verification_;
+  unique_verification_.max_runner_up_ratio =
+      std::min(verification_.max_runner_up_ratio, config.localize.max_runner_up_ratio);
 }
 
 Localizer::~Localizer() = default;
@@ -252,6 +255,8 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
   const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
   const std::vector<PlaceCandidate> chosen = best_places(map_, places_, query, std::move(candidates), score_threshold_, n);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
+  // With no prior (the whole map searched) the fit must also be unique.
+  const LoopVerificationSettings& settings = state_ == State::kOdometry ? verification_ : unique_verification_;
   for (const PlaceCandidate& candidate : chosen) {
     const std::size_t match = candidate.keyframe;
     const LoopSubmap submap = submap_around(map_, match, w, verification_);
@@ -265,7 +270,7 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
     record.travelled = travelled_;
     record.keyframe = match;
     record.score = candidate.match;
-    record.verification = verify_loop(odometry_.last_features(), submap, guesses, verification_);
+    record.verification = verify_loop(odometry_.last_features(), submap, guesses, settings);
     record.pose = orthonormalized(map_.pose(match) * record.verification.relative);
     const bool accepted = record.verification.accepted;
     if (accepted) {

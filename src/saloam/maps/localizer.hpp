@@ -9,6 +9,10 @@
 //    loop closure verifies a candidate (semantic ICP against the keyframes
 //    around it, coarse to fine, from the descriptor's yaw; the normalized
 //    acceptance test). An accepted fit is a hypothesis, not yet a pose.
+//    With no prior at all (the run's start, or after the odometry fallback
+//    ran out; the whole map is searched) the fit must also be unique along
+//    its least constrained direction (localize.max_runner_up_ratio): a
+//    street the map cannot tell from another is not a place.
 //  * Hypothesis: localize.confirmations later fixes, confirm_interval metres
 //    apart, must agree: each registers the scan against the map around the
 //    pose the odometry predicts from the hypothesis and must pass the same
@@ -134,6 +138,7 @@ class Localizer {
   SemanticOdometry odometry_;
   PlaceRecognizer places_;
   LoopVerificationSettings verification_;
+  LoopVerificationSettings unique_verification_;  ///< verification_ with localize.max_runner_up_ratio
   RegistrationSettings tracking_;
   double score_threshold_ = 0;
 

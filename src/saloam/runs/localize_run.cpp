@@ -84,17 +84,17 @@ void write_relocalizations_csv(const std::filesystem::path& file, const Localize
   AtomicFile out_file(file);
   std::ostream& out = out_file.stream();
   out << "frame,travelled_m,map_keyframe,score,descriptor_yaw_deg,guess,features,inliers,inlier_fraction,mean_residual_m,"
-         "translation_eigenvalue,accepted,reason,outcome,x,y,z";
+         "translation_eigenvalue,runner_up_inlier_ratio,accepted,reason,outcome,x,y,z";
   if (truth) out << ",error_m,correct";
   out << '\n';
   for (const RelocalizationRecord& r : localizer.relocalizations()) {
     const auto& v = r.verification;
-    out << fmt::format("{},{:.2f},{},{},{},{},{},{},{:.4f},{:.4f},{:.4f},{:d},\"{}\",{},{:.3f},{:.3f},{:.3f}", r.frame,
+    out << fmt::format("{},{:.2f},{},{},{},{},{},{},{:.4f},{:.4f},{:.4f},{:.4f},{:d},\"{}\",{},{:.3f},{:.3f},{:.3f}", r.frame,
                        r.travelled, r.keyframe ? std::to_string(*r.keyframe) : std::string(),
                        r.keyframe ? fmt::format("{:.4f}", r.score.score) : std::string(),
                        r.score.yaw ? fmt::format("{:.1f}", *r.score.yaw * 180.0 / M_PI) : std::string(), v.guess,
                        v.features, v.registration.inliers, v.inlier_fraction, v.mean_residual, v.translation_eigenvalue,
-                       v.accepted, v.reason, r.outcome, r.pose.translation().x(), r.pose.translation().y(),
+                       v.runner_up_inlier_ratio, v.accepted, v.reason, r.outcome, r.pose.translation().x(), r.pose.translation().y(),
                        r.pose.translation().z());
     if (truth) {
       const Pose& t = (*truth)[r.frame];

@@ -163,10 +163,13 @@ LoopVerification verify_loop(const ScanFeatures& query, const LoopSubmap& submap
     candidate.guess = g;
     candidate.registration = fit_from(guesses[g], features, submap, settings);
     if (!candidate.registration.ok) continue;
-    if (std::isfinite(settings.max_runner_up_ratio)) {
-      candidate.runner_up_inlier_ratio = runner_up_ratio(candidate.registration, features, submap, settings);
-    }
     judge(candidate, settings);
+    // Uniqueness only decides a fit that passes the rest of the normalized
+    // test: its extra registrations are spent on those alone.
+    if (std::isfinite(settings.max_runner_up_ratio) && candidate.passes_normalized_test) {
+      candidate.runner_up_inlier_ratio = runner_up_ratio(candidate.registration, features, submap, settings);
+      judge(candidate, settings);
+    }
     if (!found || candidate.accepted || candidate.registration.inliers > best.registration.inliers) {
       best = std::move(candidate);
       found = true;

@@ -78,7 +78,8 @@ struct LoopVerification {
   double inlier_fraction = 0;
   double mean_residual = 0;          ///< [m] mean |residual| of the inliers
   double translation_eigenvalue = 0; ///< smallest eigenvalue of H_tt / N
-  /// Inliers of the best distinct other fit over the best fit's (0: none found).
+  /// Inliers of the best distinct other fit over the best fit's (0: none
+  /// found, the test is off, or the fit fails the rest of the normalized test).
   double runner_up_inlier_ratio = 0;
   bool passes_loss_test = false;
   bool passes_normalized_test = false;
