@@ -77,12 +77,14 @@ TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
   expected.odometry.local_map_point = "newest";
   expected.odometry.match_class_groups = false;
   expected.odometry.adaptive_class_weights = false;
+  expected.odometry.class_weight["vegetation"] = 1.0;
   expected.odometry.features.ground_edge_alpha = 0.1;
   expected.odometry.features.thin_object_axes = false;
   expected.loop.acceptance = "loss";
   expected.loop.sigma = 0.05;
   EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));
   EXPECT_EQ(loaded.odometry.local_map_frames, 20);  // N_m of Table I
+  for (const auto& [name, weight] : loaded.odometry.class_weight) EXPECT_EQ(weight, 1.0) << name;  // "defined equally"
 }
 
 TEST(Config, InfinityRoundTrips) {
