@@ -77,12 +77,14 @@ TEST(Config, ShippedPaperFileSetsThePublishedChoices) {
   expected.odometry.local_map_point = "newest";
   expected.odometry.match_class_groups = false;
   expected.odometry.adaptive_class_weights = false;
+  expected.odometry.class_weight["vegetation"] = 1.0;
   expected.odometry.features.ground_edge_alpha = 0.1;
   expected.odometry.features.thin_object_axes = false;
   expected.loop.acceptance = "loss";
   expected.loop.sigma = 0.05;
   EXPECT_EQ(config_to_yaml(loaded), config_to_yaml(expected));
   EXPECT_EQ(loaded.odometry.local_map_frames, 20);  // N_m of Table I
+  for (const auto& [name, weight] : loaded.odometry.class_weight) EXPECT_EQ(weight, 1.0) << name;  // "defined equally"
 }
 
 TEST(Config, InfinityRoundTrips) {
@@ -140,7 +142,8 @@ TEST(Config, ErrorsNameTheProblem) {
 
 // yaml-cpp keeps both entries of a repeated key; which one wins is not what
 // the user meant, so a repeated key, a repeated section and a second document
-// are errors naming the file, the key and both lines.
+// are errors naming the file, the key and both lines; so is a key that is
+// not a name.
 TEST(Config, RepeatedKeysSectionsAndDocumentsAreErrors) {
   auto yaml_error = [](const std::string& text) -> std::string {
     SaloamConfig c;
@@ -160,6 +163,12 @@ TEST(Config, RepeatedKeysSectionsAndDocumentsAreErrors) {
             "twice.yaml: 'odometry.class_weight.pole' is given twice (lines 3 and 4): give each key once");
   EXPECT_EQ(yaml_error("odometry:\n  threads: 2\n---\nodometry:\n  threads: 3\n"),
             "twice.yaml: holds 2 YAML documents (separated by '---'); a configuration is one");
+  // A list or a map where a key belongs (found by fuzz_config) names nothing.
+  EXPECT_EQ(yaml_error("odometry:\n  class_voxel_size:\n    default: 0.4\n  ? pole: 0.1\n    trunk: 0.1\n"),
+            "twice.yaml: line 4: a key in 'odometry' that is not a name (a list or a map)");
+  EXPECT_EQ(yaml_error("odometry:\n  class_weight:\n    ? [pole, trunk]\n    : 2\n"),
+            "twice.yaml: line 3: a key in 'odometry.class_weight' that is not a name (a list or a map)");
+  EXPECT_EQ(yaml_error("? {odometry: 1}\n: 2\n"), "twice.yaml: line 1: a key that is not a name (a list or a map)");
   // One document, with or without its markers, and an empty file are fine.
   EXPECT_EQ(yaml_error("---\nodometry:\n  threads: 2\n...\n"), "no error");
   EXPECT_EQ(yaml_error(""), "no error");

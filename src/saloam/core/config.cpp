@@ -103,14 +103,20 @@ void check_member(const T& member, const R& range, const std::string& key, const
   }
 }
 
-// yaml-cpp keeps both entries of a key given twice in one map (two
-// `odometry:` blocks, a key repeated): which one wins is not what the user
-// meant to say, so a repeated key is an error naming both lines.
+// Every key of a map is a name, given once. yaml-cpp accepts a list or a map
+// as a key (`? [a, b]: 1`), which names nothing here; and it keeps both
+// entries of a key given twice in one map (two `odometry:` blocks, a key
+// repeated): which one wins is not what the user meant to say, so a repeated
+// key is an error naming both lines.
 void check_unique_keys(const YAML::Node& map, const std::string& prefix, const std::string& origin) {
   std::map<std::string, int> first_line;
   for (const auto& entry : map) {
-    const std::string name = entry.first.Scalar();
     const int line = entry.first.Mark().line + 1;
+    if (!entry.first.IsScalar()) {
+      throw ConfigError(fmt::format("{}: line {}: a key {}that is not a name (a list or a map)", origin, line,
+                                    prefix.empty() ? "" : "in '" + prefix + "' "));
+    }
+    const std::string name = entry.first.Scalar();
     const auto [it, inserted] = first_line.emplace(name, line);
     if (inserted) continue;
     throw ConfigError(fmt::format("{}: '{}' is given twice (lines {} and {}): give each key once", origin,
@@ -126,7 +132,7 @@ void assign(T& member, const YAML::Node& node, const std::string& key, const std
     }
     check_unique_keys(node, key, origin);
     for (const auto& entry : node) {
-      const auto name = entry.first.as<std::string>();
+      const auto name = entry.first.Scalar();  // a name: check_unique_keys
       if (name != "default" && !semantic_class_id(name)) {
         throw ConfigError(fmt::format("{}: '{}' names unknown class '{}'", origin, key, name));
       }
@@ -211,7 +217,7 @@ void apply_node(SaloamConfig& config, const YAML::Node& node, const std::string&
   check_unique_keys(node, prefix, origin);
   const auto sections = section_names(config);
   for (const auto& entry : node) {
-    const auto name = entry.first.as<std::string>();
+    const auto name = entry.first.Scalar();  // a name: check_unique_keys
     const std::string key = prefix.empty() ? name : prefix + "." + name;
     const auto field = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.key == key; });
     if (field != fields.end()) {

@@ -11,6 +11,7 @@
 #include "saloam/core/progress.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/calibration.hpp"
+#include "saloam/runs/loop_truth.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
 #include "saloam/runs/timing_report.hpp"
@@ -19,9 +20,6 @@
 namespace saloam {
 
 namespace {
-
-constexpr double kTrueTranslation = 0.5;             // [m] a relocalisation within this of the truth is true
-constexpr double kTrueRotation = 2.0 * M_PI / 180;   // [rad]
 
 // The source's reference poses of the processed frames, LiDAR frame, frame 0 = identity.
 std::optional<std::vector<Pose>> reference_lidar_poses(const SourceInfo& info, std::size_t frames) {
@@ -76,10 +74,9 @@ void write_frames_csv(const std::filesystem::path& file, const Localizer& locali
   out_file.commit();
 }
 
-/// A relocalisation within 0.5 m and 2 degrees of the truth (for_truth), as loops are judged.
+/// A relocalisation is true when its pose, brought to the truth's frame (for_truth), agrees with the truth as loops do.
 bool is_true(const Pose& estimate, const Pose& truth, const LocalizeRunOptions& options) {
-  const Pose difference = truth.inverse() * for_truth(estimate, options);
-  return difference.translation().norm() <= kTrueTranslation && rotation_angle(difference) <= kTrueRotation;
+  return agrees_with_truth(for_truth(estimate, options), truth);
 }
 
 void write_relocalizations_csv(const std::filesystem::path& file, const Localizer& localizer,

@@ -19,6 +19,12 @@ LoopTruthOptions LoopTruthOptions::from_config(const LoopClosureConfig& config) 
   return options;
 }
 
+bool agrees_with_truth(const Pose& estimate, const Pose& truth, const LoopTruthOptions& options) {
+  const Pose error = truth.inverse() * estimate;
+  return error.translation().norm() <= options.max_translation_error &&
+         rotation_angle(error) * 180.0 / M_PI <= options.max_rotation_error_deg;
+}
+
 LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const LoopTruthOptions& options) {
   LoopTruth truth;
   const Pose& gt_match = gt.at(loop.match_frame);
@@ -30,8 +36,7 @@ LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const 
   truth.rotation_error_deg = rotation_angle(error) * 180.0 / M_PI;
   truth.gt_distance = gt_relative.translation().norm();
   truth.gt_yaw_deg = heading_deg(gt_relative);
-  truth.correct = truth.translation_error <= options.max_translation_error &&
-                  truth.rotation_error_deg <= options.max_rotation_error_deg;
+  truth.correct = agrees_with_truth(loop.verification.relative, gt_relative, options);
   return truth;
 }
 

@@ -35,6 +35,11 @@ struct LoopTruth {
   bool correct = false;
 };
 
+/// Whether an estimate agrees with the truth within the options' 0.5 m and
+/// 2 deg (the error is truth^-1 * estimate): the one rule that judges loops,
+/// cross-session edges and relocalisations against ground truth.
+bool agrees_with_truth(const Pose& estimate, const Pose& truth, const LoopTruthOptions& options = {});
+
 /// Truth of one loop; `gt` holds the LiDAR-frame ground truth per processed frame.
 LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const LoopTruthOptions& options = {});
 

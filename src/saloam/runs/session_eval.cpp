@@ -11,13 +11,11 @@
 #include "saloam/core/lie.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
+#include "saloam/runs/loop_truth.hpp"
 
 namespace saloam {
 
 namespace {
-// A loop edge is true when its relative pose is within these of the truth's (as loops are judged).
-constexpr double kTrueLoopTranslation = 0.5;            // [m]
-constexpr double kTrueLoopRotation = 2.0 * M_PI / 180;  // [rad]
 constexpr std::size_t kMaxRecordBytes = 1 << 16;
 }  // namespace
 
@@ -110,8 +108,7 @@ SessionEvaluation evaluate_sessions(const SavedMap& map, const std::vector<std::
   out.all_aligned = error_stats(all);
   for (const PoseGraphEdge& e : map.edges) {
     if (e.kind != EdgeKind::kLoop || map.keyframes[e.from].session == map.keyframes[e.to].session) continue;
-    const Pose d = (world[e.from].inverse() * world[e.to]).inverse() * e.measured;
-    const bool ok = d.translation().norm() < kTrueLoopTranslation && rotation_angle(d) < kTrueLoopRotation;
+    const bool ok = agrees_with_truth(e.measured, world[e.from].inverse() * world[e.to]);
     ++(ok ? out.true_cross_session_loops : out.false_cross_session_loops);
   }
   return out;
