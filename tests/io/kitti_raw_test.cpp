@@ -17,22 +17,22 @@ namespace {
 
 using testing::input_error_of;
 
-TEST(KittiRaw, TimestampsAreSecondsSinceTheEpoch) {
+TEST(KittiRaw, TimestampsAreNanosecondsSinceTheEpoch) {
   std::istringstream in("2011-09-26 13:02:25.964389445\n2011-09-26 13:02:26.074898283\r\n\n2011-09-27 00:00:00\n");
-  const auto t = parse_kitti_timestamps(in, "timestamps.txt");
+  const auto t = parse_kitti_timestamps_ns(in, "timestamps.txt");
   ASSERT_EQ(t.size(), 3u);
-  EXPECT_NEAR(t[0], 1317042145.964389445, 1e-6);  // date -u -d '2011-09-26 13:02:25' +%s = 1317042145
-  EXPECT_NEAR(t[1] - t[0], 0.110508838, 1e-6);
-  EXPECT_NEAR(t[2], 1317081600.0, 1e-6);
+  EXPECT_EQ(t[0], 1317042145 * kNanosPerSecond + 964389445);  // date -u -d '2011-09-26 13:02:25' +%s = 1317042145
+  EXPECT_EQ(t[1] - t[0], 110508838);
+  EXPECT_EQ(t[2], 1317081600 * kNanosPerSecond);
 }
 
 TEST(KittiRaw, TimestampsWriteAndReadBack) {
   testing::TempDir dir;
   const std::vector<double> t{1317042145.0, 1317042145.1, 1317042145.2 + 86400.0 * 400};
   write_kitti_timestamps(dir / "t.txt", t);
-  const auto back = read_kitti_timestamps(dir / "t.txt");
+  const auto back = read_kitti_timestamps_ns(dir / "t.txt");
   ASSERT_EQ(back.size(), 3u);
-  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(back[i], t[i], 1e-6);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(nanos_to_seconds(back[i]), t[i], 1e-6);
 }
 
 // Nanoseconds stay exact: times relative to a drive's first scan come back as
@@ -43,7 +43,7 @@ TEST(KittiRaw, TimestampsAreExactNanoseconds) {
   ASSERT_EQ(ns.size(), 3u);
   EXPECT_EQ(ns[0], 1317042145 * kNanosPerSecond);
   EXPECT_EQ(ns[1] - ns[0], 100000000);
-  EXPECT_EQ(ns[2] - ns[1], 1);  // a tenth digit rounds
+  EXPECT_EQ(ns[2] - ns[1], 1);  // a tenth digit rounds (a double of seconds since 1970 could not tell them apart)
   EXPECT_EQ(nanos_to_seconds(ns[1] - ns[0]), 0.1);
   testing::TempDir dir;
   write_kitti_timestamps_ns(dir / "t.txt", ns);
@@ -53,7 +53,7 @@ TEST(KittiRaw, TimestampsAreExactNanoseconds) {
 TEST(KittiRaw, BadTimestampsNameTheLine) {
   const auto error_of = [](const std::string& text) {
     std::istringstream in(text);
-    return input_error_of([&] { parse_kitti_timestamps(in, "ts.txt"); });
+    return input_error_of([&] { parse_kitti_timestamps_ns(in, "ts.txt"); });
   };
   EXPECT_NE(error_of("2011-09-26 13:02:25.9\n2011-13-26 13:02:25.9\n").find("ts.txt: line 2: '2011-13-26 13:02:25.9' is not a KITTI timestamp"), std::string::npos);
   EXPECT_NE(error_of("2011-09-26 13:02:25.9\n2011-09-26 13:02:25.8\n").find("ts.txt: line 2: timestamp"), std::string::npos);

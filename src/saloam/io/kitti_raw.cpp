@@ -212,21 +212,9 @@ std::vector<std::int64_t> parse_kitti_timestamps_ns(std::istream& in, const std:
   return times;
 }
 
-std::vector<double> parse_kitti_timestamps(std::istream& in, const std::filesystem::path& file) {
-  const auto nanos = parse_kitti_timestamps_ns(in, file);
-  std::vector<double> times(nanos.size());
-  std::transform(nanos.begin(), nanos.end(), times.begin(), nanos_to_seconds);
-  return times;
-}
-
 std::vector<std::int64_t> read_kitti_timestamps_ns(const std::filesystem::path& file) {
   auto in = open_text_file(file, "timestamps file");
   return parse_kitti_timestamps_ns(in, file);
-}
-
-std::vector<double> read_kitti_timestamps(const std::filesystem::path& file) {
-  auto in = open_text_file(file, "timestamps file");
-  return parse_kitti_timestamps(in, file);
 }
 
 void write_kitti_timestamps(const std::filesystem::path& file, const std::vector<double>& seconds) {

@@ -66,9 +66,6 @@ inline constexpr std::int64_t kNanosPerSecond = 1000000000;
 /// that does not increase. Empty lines are skipped.
 std::vector<std::int64_t> parse_kitti_timestamps_ns(std::istream& in, const std::filesystem::path& file);
 std::vector<std::int64_t> read_kitti_timestamps_ns(const std::filesystem::path& file);
-/// The same in seconds since the epoch.
-std::vector<double> parse_kitti_timestamps(std::istream& in, const std::filesystem::path& file);
-std::vector<double> read_kitti_timestamps(const std::filesystem::path& file);
 /// Writes nanoseconds (or seconds, rounded to nanoseconds) since the epoch
 /// as KITTI timestamp lines.
 void write_kitti_timestamps_ns(const std::filesystem::path& file, const std::vector<std::int64_t>& nanos);
