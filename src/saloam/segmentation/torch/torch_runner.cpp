@@ -2,6 +2,7 @@
 // TorchScript models with libtorch on the CPU, one intra-op thread per
 // calling thread. saloam loads it with dlopen only when a run segments.
 
+#include <malloc.h>
 #include <torch/script.h>
 #include <torch/torch.h>
 
@@ -30,6 +31,20 @@ void use_one_thread() {
     at::set_num_threads(1);
     done = true;
   }
+}
+
+/// libtorch allocates and frees some 15 MB per 64-beam scan (activations,
+/// logits). By default glibc's malloc hands a thread arena's free top back to
+/// the kernel, and large blocks are mmapped afresh, so every scan faulted its
+/// buffers in again: 4,000 page faults and more than half of the stage's CPU
+/// time (docs/segmentation.md, "Speed and memory"). Keeping 64 MiB of free
+/// top per arena (a thread arena's heap is at most 64 MiB) lets the next scan
+/// reuse the same pages. Process-wide, set once, when the first network opens.
+void keep_freed_memory_for_reuse() {
+#ifdef __GLIBC__
+  static const bool done = mallopt(M_TOP_PAD, 64 << 20) == 1;
+  (void)done;
+#endif
 }
 
 void check_output(const torch::Tensor& logits, int classes, int rows, int cols) {
@@ -91,6 +106,7 @@ class TorchScriptRunner final : public NetworkRunner {
 };
 
 std::unique_ptr<NetworkRunner> open(const NetworkSpec& spec) {
+  keep_freed_memory_for_reuse();
   if (spec.format == NetworkFormat::kTorchScript) return std::make_unique<TorchScriptRunner>(spec);
   return std::make_unique<SegNetRunner>(spec);
 }
