@@ -149,7 +149,7 @@ TEST(SegmenterSpec, ClassBiasesOffsetTheirClassesOnTopOfTheDynamicBias) {
                 .find("decision.class_bias.fence: 21 is outside"),
             std::string::npos);
   EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {class_bias: {fence: 1, fence: 2}}\n")
-                .find("given twice"),
+                .find("'decision.class_bias.fence' is given twice (lines 13 and 13)"),
             std::string::npos);
 }
 
@@ -157,12 +157,12 @@ TEST(SegmenterSpec, ErrorsNameTheFileAndTheKey) {
   EXPECT_NE(error_of("format: other 2\n").find("/models/m.yaml: format: expected 'saloam-segmenter 1'"), std::string::npos);
   // A list where a key belongs (found by fuzzing: it ended the program).
   EXPECT_NE(error_of(replaced(kSegNet, "stem_stride:", "[31, 64]: 1, stem_stride:"))
-                .find("/models/m.yaml: network.<key>: a key that is not a name"),
+                .find("/models/m.yaml: line 2: a key in 'network' that is not a name (a list or a map)"),
             std::string::npos)
       << error_of(replaced(kSegNet, "stem_stride:", "[31, 64]: 1, stem_stride:"));
   EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 1024\n  colums: 3")).find("projection.colums: unknown key"),
             std::string::npos);
-  EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 1024\n  columns: 512")).find("projection.columns: given twice"),
+  EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 1024\n  columns: 512")).find("'projection.columns' is given twice (lines 6 and 7)"),
             std::string::npos);
   EXPECT_NE(error_of(replaced(kSegNet, "columns: 1024", "columns: 5")).find("projection.columns: 5 is outside [16, 16384]"),
             std::string::npos);

@@ -185,12 +185,16 @@ TEST(SgprTrainingData, RecipeErrorsNameTheFileAndTheEntry) {
             std::string::npos);
   // A list where a key belongs, at each level: an InputError naming the file.
   EXPECT_NE(write("train: [{folder: .}]\nvalidation: [{folder: .}]\n[1, 2]: 3\n")
-                .find("recipe.yaml: <root>: a key that is not a name"),
+                .find("recipe.yaml: line 3: a key that is not a name"),
             std::string::npos);
   EXPECT_NE(write("defaults: {[1]: 2}\ntrain: [{folder: .}]\nvalidation: [{folder: .}]\n")
-                .find("recipe.yaml: defaults: a key that is not a name"),
+                .find("recipe.yaml: line 1: a key in 'defaults' that is not a name"),
             std::string::npos);
-  EXPECT_NE(write("train: [{folder: ., [1]: 2}]\nvalidation: [{folder: .}]\n").find("recipe.yaml: train[0]: a key that is not a name"),
+  EXPECT_NE(write("train: [{folder: ., [1]: 2}]\nvalidation: [{folder: .}]\n").find("recipe.yaml: line 1: a key in 'train[0]' that is not a name"),
+            std::string::npos);
+  // A key given twice (yaml-cpp keeps both; which one a lookup finds is not what was meant).
+  EXPECT_NE(write("train: [{folder: ., seed: 1, seed: 2}]\nvalidation: [{folder: .}]\n")
+                .find("recipe.yaml: 'train[0].seed' is given twice (lines 1 and 1)"),
             std::string::npos);
   const std::string ok = write("defaults: {calib: poses.txt, frame_step: 3}\ntrain: [{simulate: poses.txt, frames: '0:9'}]\n"
                                "validation: [{folder: ., labels: here}]\n");

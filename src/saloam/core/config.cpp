@@ -103,24 +103,11 @@ void check_member(const T& member, const R& range, const std::string& key, const
   }
 }
 
-// Every key of a map is a name, given once. yaml-cpp accepts a list or a map
-// as a key (`? [a, b]: 1`), which names nothing here; and it keeps both
-// entries of a key given twice in one map (two `odometry:` blocks, a key
-// repeated): which one wins is not what the user meant to say, so a repeated
-// key is an error naming both lines.
-void check_unique_keys(const YAML::Node& map, const std::string& prefix, const std::string& origin) {
-  std::map<std::string, int> first_line;
-  for (const auto& entry : map) {
-    const int line = entry.first.Mark().line + 1;
-    if (!entry.first.IsScalar()) {
-      throw ConfigError(fmt::format("{}: line {}: a key {}that is not a name (a list or a map)", origin, line,
-                                    prefix.empty() ? "" : "in '" + prefix + "' "));
-    }
-    const std::string name = entry.first.Scalar();
-    const auto [it, inserted] = first_line.emplace(name, line);
-    if (inserted) continue;
-    throw ConfigError(fmt::format("{}: '{}' is given twice (lines {} and {}): give each key once", origin,
-                                  prefix.empty() ? name : prefix + "." + name, it->second, line));
+/// ConfigError when a key of the map `node` is not a name or is given twice
+/// (key_problem).
+void check_keys(const YAML::Node& node, const std::string& section, const std::string& origin) {
+  if (const auto problem = key_problem(node, section); !problem.empty()) {
+    throw ConfigError(fmt::format("{}: {}", origin, problem));
   }
 }
 
@@ -130,9 +117,9 @@ void assign(T& member, const YAML::Node& node, const std::string& key, const std
     if (!node.IsMap()) {
       throw ConfigError(fmt::format("{}: '{}' must be a map of class name to number", origin, key));
     }
-    check_unique_keys(node, key, origin);
+    check_keys(node, key, origin);
     for (const auto& entry : node) {
-      const auto name = entry.first.Scalar();  // a name: check_unique_keys
+      const auto name = entry.first.Scalar();  // a name: check_keys
       if (name != "default" && !semantic_class_id(name)) {
         throw ConfigError(fmt::format("{}: '{}' names unknown class '{}'", origin, key, name));
       }
@@ -214,10 +201,10 @@ void apply_node(SaloamConfig& config, const YAML::Node& node, const std::string&
   if (!node.IsMap()) {
     throw ConfigError(fmt::format("{}: '{}' must be a map", origin, prefix.empty() ? "<root>" : prefix));
   }
-  check_unique_keys(node, prefix, origin);
+  check_keys(node, prefix, origin);
   const auto sections = section_names(config);
   for (const auto& entry : node) {
-    const auto name = entry.first.Scalar();  // a name: check_unique_keys
+    const auto name = entry.first.Scalar();  // a name: check_keys
     const std::string key = prefix.empty() ? name : prefix + "." + name;
     const auto field = std::find_if(fields.begin(), fields.end(), [&](const Field& f) { return f.key == key; });
     if (field != fields.end()) {

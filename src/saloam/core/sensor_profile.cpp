@@ -30,19 +30,9 @@ T value(const YAML::Node& map, const std::string& key, const std::filesystem::pa
 // A profile of 1024 lasers is about 10 kB.
 constexpr std::size_t kMaxProfileBytes = std::size_t{1} << 20;
 
-/// InputError when a key of the map `node` is given twice (yaml-cpp keeps
-/// either silently).
-void keys_once(const YAML::Node& node, const std::string& prefix, const std::filesystem::path& file) {
-  if (!node.IsMap()) return;
-  std::vector<std::string> keys;
-  for (const auto& entry : node) {
-    if (!entry.first.IsScalar()) throw InputError(file, "a key that is not a name");
-    const std::string key = entry.first.Scalar();
-    if (std::find(keys.begin(), keys.end(), key) != keys.end()) {
-      throw InputError(file, fmt::format("'{}{}' is given twice: give each key once", prefix, key));
-    }
-    keys.push_back(key);
-  }
+/// InputError when a key of the map `node` is not a name or is given twice.
+void check_keys(const YAML::Node& node, const std::string& section, const std::filesystem::path& file) {
+  if (const auto problem = key_problem(node, section); !problem.empty()) throw InputError(file, problem);
 }
 
 void check(const SensorProfile& p, const std::filesystem::path& file) {
@@ -90,8 +80,8 @@ SensorProfile parse_sensor_profile(std::string_view yaml, const std::filesystem:
                                        documents.size()));
   }
   const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
-  keys_once(root, "", file);
-  if (root.IsMap() && root["simulation"]) keys_once(root["simulation"], "simulation.", file);
+  check_keys(root, "", file);
+  if (root.IsMap() && root["simulation"]) check_keys(root["simulation"], "simulation", file);
   SensorProfile p;
   p.name = value<std::string>(root, "name", file);
   p.model = value<std::string>(root, "model", file);

@@ -1,7 +1,10 @@
 #include "saloam/core/yaml_documents.hpp"
 
+#include <map>
 #include <sstream>
 #include <string>
+
+#include <fmt/format.h>
 
 #include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/parser.h>
@@ -41,6 +44,24 @@ std::vector<YAML::Node> load_yaml_documents(std::string_view text) {
   std::vector<YAML::Node> documents = YAML::LoadAll(copy);
   std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
   return documents;
+}
+
+std::string key_problem(const YAML::Node& node, const std::string& section) {
+  if (!node.IsMap()) return {};
+  std::map<std::string, int> first_line;
+  for (const auto& entry : node) {
+    const int line = entry.first.Mark().line + 1;
+    if (!entry.first.IsScalar()) {
+      return fmt::format("line {}: a key {}that is not a name (a list or a map)", line,
+                         section.empty() ? "" : "in '" + section + "' ");
+    }
+    const std::string& name = entry.first.Scalar();
+    if (const auto [it, inserted] = first_line.emplace(name, line); !inserted) {
+      return fmt::format("'{}' is given twice (lines {} and {}): give each key once",
+                         section.empty() ? name : section + "." + name, it->second, line);
+    }
+  }
+  return {};
 }
 
 }  // namespace saloam

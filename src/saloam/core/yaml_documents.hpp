@@ -1,11 +1,10 @@
 #pragma once
-// The documents of a YAML text, for the readers of YAML files (the
-// configuration, sensor profiles). yaml-cpp 0.7's LoadAll never ends on some
-// malformed texts (e.g. "&a," alone: the parser hands out the same empty
-// document again and again, and LoadAll keeps them until memory runs out),
-// so the documents are counted first, at most kMaxYamlDocuments.
+// What every reader of a YAML file (the configuration, sensor profiles,
+// segmenter descriptions, data recipes) needs beyond yaml-cpp: its documents
+// read with a bound, and maps whose keys are names given once.
 
 #include <cstddef>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -17,7 +16,20 @@ inline constexpr std::size_t kMaxYamlDocuments = 64;
 
 /// The documents of `text` that are not empty (null), in order. Throws
 /// YAML::Exception for invalid YAML and for more than kMaxYamlDocuments
-/// documents.
+/// documents. (yaml-cpp 0.7's LoadAll never ends on some malformed texts,
+/// e.g. "&a," alone: the parser hands out the same empty document again and
+/// again, and LoadAll keeps them until memory runs out; so the documents are
+/// counted first.)
 std::vector<YAML::Node> load_yaml_documents(std::string_view text);
+
+/// What is wrong with the keys of the map `node`, as a phrase for an error
+/// message: "'odometry.k' is given twice (lines 3 and 9): give each key
+/// once" or "line 4: a key in 'odometry' that is not a name (a list or a
+/// map)" (`section` is the map's dotted name, empty at the top). Empty when
+/// every key is a name given once, and for a node that is not a map.
+/// yaml-cpp accepts a list or a map as a key, which names nothing here, and
+/// keeps both entries of a repeated key: which one a lookup finds is not what
+/// the user meant to say.
+std::string key_problem(const YAML::Node& node, const std::string& section = "");
 
 }  // namespace saloam

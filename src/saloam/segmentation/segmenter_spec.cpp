@@ -22,18 +22,17 @@ namespace fs = std::filesystem;
 constexpr std::size_t kMaxSpecBytes = std::size_t{1} << 20;
 constexpr int kMaxRows = 1024, kMaxColumns = 16384, kMaxClasses = 256, kMaxWidth = 1024;
 
-/// Reads one YAML map, refusing keys it does not know and keys given twice.
+/// Reads one YAML map, refusing keys that are not names, are given twice or
+/// are not known.
 class MapReader {
  public:
   MapReader(const YAML::Node& node, std::string section, const fs::path& file, std::set<std::string> known)
       : node_(node), section_(std::move(section)), file_(file) {
     if (!node.IsMap()) fail(section_, "expected a map");
-    std::set<std::string> seen;
+    if (const auto problem = key_problem(node, section_); !problem.empty()) throw InputError(file_, problem);
     for (const auto& kv : node) {
-      if (!kv.first.IsScalar()) fail("<key>", "a key that is not a name (a list or a map)");
-      const auto key = kv.first.Scalar();
+      const std::string key = kv.first.Scalar();  // a name: key_problem
       if (!known.contains(key)) fail(key, "unknown key");
-      if (!seen.insert(key).second) fail(key, "given twice");
     }
   }
 

@@ -10,6 +10,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/frame_range.hpp"
+#include "saloam/core/yaml_documents.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
 #include "saloam/sim/trajectories.hpp"
@@ -42,11 +43,11 @@ int read_beams(const YAML::Node& node, const fs::path& file, const std::string& 
   return beams;
 }
 
-/// The name of a map key at `where` in `file`; a list or a map as a key is
-/// an InputError (yaml-cpp's own conversion error would not name the file).
-std::string key_name(const YAML::Node& key, const fs::path& file, const std::string& where) {
-  if (!key.IsScalar()) throw InputError(file, where + ": a key that is not a name (a list or a map)");
-  return key.Scalar();
+/// InputError when a key of the map `node` at `where` (empty: the top) is not
+/// a name or is given twice (key_problem; yaml-cpp's own conversion error
+/// would not name the file).
+void check_keys(const YAML::Node& node, const fs::path& file, const std::string& where) {
+  if (const auto problem = key_problem(node, where); !problem.empty()) throw InputError(file, problem);
 }
 
 fs::path resolve(const fs::path& base, const std::string& text) {
@@ -77,8 +78,9 @@ SourceSpec read_source(const YAML::Node& node, const SourceSpec& defaults, const
     } else {
       throw InputError(file, where + ": needs `simulate: POSES.txt` or `folder: DIR`");
     }
+    check_keys(node, file, where);
     for (const auto& kv : node) {
-      const auto key = key_name(kv.first, file, where);
+      const std::string key = kv.first.Scalar();  // a name: check_keys
       if (key == "simulate" || key == "folder") continue;
       if (key == "calib") spec.calib = resolve(base, kv.second.as<std::string>());
       else if (key == "frames") spec.frames = kv.second.as<std::string>();
@@ -148,13 +150,15 @@ DataRecipe read_data_recipe(const fs::path& file, const SourceSpec& given_defaul
     throw InputError(file, std::string("not valid YAML: ") + e.what());
   }
   if (!root.IsMap()) throw InputError(file, "expected a map with `train:` and `validation:` lists");
+  check_keys(root, file, "");
   const fs::path base = file.parent_path();
   SourceSpec defaults = given_defaults;
   if (const auto d = root["defaults"]) {
     if (!d.IsMap()) throw InputError(file, "defaults: expected a map");
+    check_keys(d, file, "defaults");
     try {
       for (const auto& kv : d) {
-        const auto key = key_name(kv.first, file, "defaults");
+        const std::string key = kv.first.Scalar();  // a name: check_keys
         if (key == "calib") defaults.calib = resolve(base, kv.second.as<std::string>());
         else if (key == "frame_step") defaults.frame_step = kv.second.as<std::size_t>();
         else if (key == "seed") defaults.seed = kv.second.as<std::uint64_t>();
@@ -175,8 +179,8 @@ DataRecipe read_data_recipe(const fs::path& file, const SourceSpec& given_defaul
     for (std::size_t i = 0; i < list.size(); ++i)
       out.push_back(read_source(list[i], defaults, base, file, fmt::format("{}[{}]", section, i)));
   }
-  for (const auto& key : root)
-    if (const auto k = key_name(key.first, file, "<root>"); k != "train" && k != "validation" && k != "defaults")
+  for (const auto& kv : root)
+    if (const std::string k = kv.first.Scalar(); k != "train" && k != "validation" && k != "defaults")
       throw InputError(file, "unknown key '" + k + "'");
   return recipe;
 }
