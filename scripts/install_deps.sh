@@ -32,3 +32,5 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
 $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# The downloaded packages (1.5 GB with libtorch) are not needed once installed.
+$SUDO apt-get clean
