@@ -19,10 +19,16 @@ LoopTruthOptions LoopTruthOptions::from_config(const LoopClosureConfig& config) 
   return options;
 }
 
-bool agrees_with_truth(const Pose& estimate, const Pose& truth, const LoopTruthOptions& options) {
-  const Pose error = truth.inverse() * estimate;
+namespace {
+/// The rule on the error truth^-1 * estimate.
+bool within_truth_bounds(const Pose& error, const LoopTruthOptions& options) {
   return error.translation().norm() <= options.max_translation_error &&
          rotation_angle(error) * 180.0 / M_PI <= options.max_rotation_error_deg;
+}
+}  // namespace
+
+bool agrees_with_truth(const Pose& estimate, const Pose& truth, const LoopTruthOptions& options) {
+  return within_truth_bounds(truth.inverse() * estimate, options);
 }
 
 LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const LoopTruthOptions& options) {
@@ -36,7 +42,7 @@ LoopTruth loop_truth(const LoopRecord& loop, const std::vector<Pose>& gt, const 
   truth.rotation_error_deg = rotation_angle(error) * 180.0 / M_PI;
   truth.gt_distance = gt_relative.translation().norm();
   truth.gt_yaw_deg = heading_deg(gt_relative);
-  truth.correct = agrees_with_truth(loop.verification.relative, gt_relative, options);
+  truth.correct = within_truth_bounds(error, options);
   return truth;
 }
 
