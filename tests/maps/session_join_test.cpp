@@ -73,12 +73,13 @@ PriorMap prior_of(const Session& s) {
   return PriorMap(s.map, [&s](std::size_t k) { return s.features[k]; }, 100);
 }
 
-JoinedMaps join(const PriorMap& base, const PriorMap& joining) {
-  const SaloamConfig& config = base.saved().config;
+JoinedMaps join(const PriorMap& base, const PriorMap& joining, const SaloamConfig& config) {
   const PlaceRecognizer places(parse_place_detector(config.loop.detector), std::nullopt, GraphBuilderConfig{},
                                ScanContextConfig{}, config.loop.ssc);
   return join_maps(base, joining, config, places);
 }
+
+JoinedMaps join(const PriorMap& base, const PriorMap& joining) { return join(base, joining, base.saved().config); }
 
 bool agrees(const Pose& estimate, const Pose& truth) {
   const Pose d = truth.inverse() * estimate;
@@ -170,6 +171,25 @@ TEST(SessionJoin, SecondPassLandsInTheFirstPassFrame) {
   EXPECT_LT(aligned[1].rmse, 0.3);
   EXPECT_LT(aligned[1].max, 0.6);
   EXPECT_LT(aligned[0].rmse, 0.3);
+}
+
+// A place found with no prior (the search of the whole base map before the
+// link) must be unique, as in localisation (localize.max_runner_up_ratio):
+// at a ratio no fit can stay below, every such fit that passes the rest of
+// the acceptance test is refused as ambiguous and the sessions are not linked.
+// Fits near a prediction do not take the test (the default join above links).
+TEST(SessionJoin, APlaceFoundWithNoPriorMustBeUnique) {
+  const PriorMap base = prior_of(pass_session(0)), joining = prior_of(pass_session(1));
+  SaloamConfig config = base.saved().config;
+  config.localize.max_runner_up_ratio = 0;
+  const JoinedMaps joined = join(base, joining, config);
+  EXPECT_FALSE(joined.linked_at.has_value());
+  std::size_t ambiguous = 0;
+  for (const CrossSessionRecord& r : joined.records) {
+    EXPECT_EQ(r.outcome, "rejected");
+    ambiguous += r.verification.reason.starts_with("ambiguous");
+  }
+  EXPECT_GT(ambiguous, 0u) << joined.records.size() << " fits verified";
 }
 
 void write_session(const std::filesystem::path& folder, const Session& s) {

@@ -38,14 +38,12 @@ Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optio
       odometry_(config.odometry),
       places_(PlaceRecognizer::from_config(config.loop, std::move(network))),
       verification_(LoopVerificationSettings::from_config(config)),
+      unique_verification_(whole_map_verification(config)),
       tracking_(RegistrationSettings::from_config(config.odometry)) {
   tracking_.parallel = false;
   tracking_.inlier_distance = config.loop.inlier_distance;
   tracking_.level_line_max_rise = 0;  // as the verification's fits (LoopVerificationSettings)
   score_threshold_ = place_score_threshold(config, places_.detector());
-  unique_verification_ = verification_;
-  unique_verification_.max_runner_up_ratio =
-      std::min(verification_.max_runner_up_ratio, config.localize.max_runner_up_ratio);
 }
 
 Localizer::~Localizer() = default;

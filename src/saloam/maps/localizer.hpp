@@ -138,7 +138,7 @@ class Localizer {
   SemanticOdometry odometry_;
   PlaceRecognizer places_;
   LoopVerificationSettings verification_;
-  LoopVerificationSettings unique_verification_;  ///< verification_ with localize.max_runner_up_ratio
+  LoopVerificationSettings unique_verification_;  ///< whole_map_verification: a place found with no prior
   RegistrationSettings tracking_;
   double score_threshold_ = 0;
 

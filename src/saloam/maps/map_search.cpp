@@ -38,6 +38,12 @@ bool in_map_frame(const PriorMap& map, std::size_t k) {
 }
 }  // namespace
 
+LoopVerificationSettings whole_map_verification(const SaloamConfig& config) {
+  LoopVerificationSettings settings = LoopVerificationSettings::from_config(config);
+  settings.max_runner_up_ratio = std::min(settings.max_runner_up_ratio, config.localize.max_runner_up_ratio);
+  return settings;
+}
+
 double place_score_threshold(const SaloamConfig& config, PlaceDetector detector) {
   switch (detector) {
     case PlaceDetector::kSgpr: return config.loop.zeta;

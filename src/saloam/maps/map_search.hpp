@@ -22,6 +22,15 @@ struct PlaceCandidate {
   PlaceMatch match;
 };
 
+/// Verification of a place found with no prior (a search of the whole map,
+/// by localisation or by the joining of sessions): the loop verification's
+/// settings (LoopVerificationSettings::from_config) with the uniqueness test
+/// of localize.max_runner_up_ratio, the stricter of the two ratios. Along a
+/// street that the map cannot tell from another, a distinct fit nearly as
+/// good as the candidate's exists, and with no prior nothing else tells
+/// the two apart.
+LoopVerificationSettings whole_map_verification(const SaloamConfig& config);
+
 /// The detector's score threshold (loop.zeta, loop.ssc_zeta or
 /// loop.scancontext_zeta).
 double place_score_threshold(const SaloamConfig& config, PlaceDetector detector);

@@ -38,6 +38,7 @@ class SessionJoiner {
   SessionJoiner(const PriorMap& base, const PriorMap& joining, const SaloamConfig& config, const PlaceRecognizer& places)
       : base_(base), joining_(joining), config_(config), places_(places),
         verification_(LoopVerificationSettings::from_config(config)),
+        whole_map_verification_(whole_map_verification(config)),
         gate_(CandidateGate::from_config(config.loop)),
         threshold_(place_score_threshold(config, places.detector())) {}
 
@@ -59,7 +60,9 @@ class SessionJoiner {
   /// (T_base<-q); accepted only when the base map measures the motion since
   /// `last_fix` (T_base<-keyframe of the hypothesis' last fix; require_measured_motion).
   CrossSessionRecord fit_near(std::size_t q, const Pose& predicted, const Pose& last_fix) const;
-  CrossSessionRecord verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses) const;
+  /// Registers joining keyframe q against the base keyframes around `candidate`.
+  CrossSessionRecord verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses,
+                            const LoopVerificationSettings& settings) const;
   [[nodiscard]] CrossEdge edge_of(const CrossSessionRecord& r) const {
     return {r.match, r.query, r.verification.relative,
             registration_information(r.verification.registration, 1.0, config_.slam.information_scale)};
@@ -80,6 +83,7 @@ class SessionJoiner {
   const SaloamConfig& config_;
   const PlaceRecognizer& places_;
   LoopVerificationSettings verification_;
+  LoopVerificationSettings whole_map_verification_;  ///< a place found with no prior must be unique
   CandidateGate gate_;
   double threshold_;
 
@@ -118,7 +122,8 @@ JoinedMaps SessionJoiner::run() {
   return out;
 }
 
-CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses) const {
+CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses,
+                                         const LoopVerificationSettings& settings) const {
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
   const LoopSubmap submap = submap_around(base_, candidate.keyframe, w, verification_);
   add_distinct_guess(guesses, place_match_guess(candidate.match));
@@ -127,7 +132,7 @@ CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceCandidate& ca
   r.match = candidate.keyframe;
   r.travelled = path_[q];
   r.score = candidate.match;
-  r.verification = verify_loop(joining_.features(q)->expand(), submap, guesses, verification_);
+  r.verification = verify_loop(joining_.features(q)->expand(), submap, guesses, settings);
   r.pose = orthonormalized(base_.pose(candidate.keyframe) * r.verification.relative);
   return r;
 }
@@ -138,7 +143,7 @@ void SessionJoiner::relocalize(std::size_t q) {
   for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
   const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
   for (const PlaceCandidate& c : best_places(base_, places_, joining_.place(q), std::move(all), threshold_, n)) {
-    CrossSessionRecord r = verify(q, c, {});
+    CrossSessionRecord r = verify(q, c, {}, whole_map_verification_);
     if (!r.verification.accepted) {
       r.outcome = "rejected";
       records_.push_back(std::move(r));
@@ -251,7 +256,7 @@ void SessionJoiner::search_loop(std::size_t q) {
   const std::vector<PlaceCandidate> candidates =
       best_places(base_, places_, joining_.place(q), base_.near(predicted.translation(), radius), threshold_, n);
   for (const PlaceCandidate& c : candidates) {
-    CrossSessionRecord r = verify(q, c, {orthonormalized(base_.pose(c.keyframe).inverse() * predicted)});
+    CrossSessionRecord r = verify(q, c, {orthonormalized(base_.pose(c.keyframe).inverse() * predicted)}, verification_);
     require_link_agrees(r, predicted, path_[q] - last_loop_);
     const bool accepted = r.verification.accepted;
     r.outcome = accepted ? "loop" : "rejected loop";

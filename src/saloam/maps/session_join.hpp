@@ -11,7 +11,10 @@
 //    best loop.num_loop above the detector's threshold are verified as loop
 //    closure verifies a candidate (semantic ICP against the keyframes
 //    loop.submap_half_width either side, from the descriptor's yaw; the loop
-//    acceptance test). An accepted fit is a hypothesis of T_base<-joining.
+//    acceptance test). Found with no prior, the fit must also be unique
+//    along its least constrained direction (localize.max_runner_up_ratio,
+//    map_search.hpp's whole_map_verification), as in localisation. An
+//    accepted fit is a hypothesis of T_base<-joining.
 //  * Hypothesis: as localisation confirms a relocalisation (localizer.hpp),
 //    localize.confirmations later keyframes, localize.confirm_interval
 //    metres apart, must register against the base keyframes near the pose
