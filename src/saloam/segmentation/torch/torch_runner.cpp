@@ -33,13 +33,13 @@ void use_one_thread() {
   }
 }
 
-/// libtorch allocates and frees some 15 MB per 64-beam scan (activations,
-/// logits). By default glibc's malloc hands a thread arena's free top back to
-/// the kernel, and large blocks are mmapped afresh, so every scan faulted its
-/// buffers in again: 4,000 page faults and more than half of the stage's CPU
-/// time (docs/segmentation.md, "Speed and memory"). Keeping 64 MiB of free
-/// top per arena (a thread arena's heap is at most 64 MiB) lets the next scan
-/// reuse the same pages. Process-wide, set once, when the first network opens.
+/// libtorch allocates and frees its activations and logits (megabytes) for
+/// every scan. By default glibc's malloc hands a thread arena's free top back
+/// to the kernel and maps large blocks afresh, so each scan would fault its
+/// buffers in again, which costs more than the network itself
+/// (docs/segmentation.md, "Speed and memory"). Keeping 64 MiB of free top per
+/// arena (a thread arena's heap is at most 64 MiB) lets the next scan reuse
+/// the same pages. Process-wide, set once, when the first network opens.
 void keep_freed_memory_for_reuse() {
 #ifdef __GLIBC__
   static const bool done = mallopt(M_TOP_PAD, 64 << 20) == 1;
