@@ -59,7 +59,7 @@ TEST(SensorProfiles, BadFilesNameTheProblem) {
   std::string body = good;
   body.replace(body.find("ego_body: none"), 14, "ego_body: bus");
   EXPECT_EQ(error_of(body), "bad.yaml: simulation.ego_body 'bus': kitti or none");
-  EXPECT_NE(error_of("[").find("bad.yaml: invalid YAML"), std::string::npos);
+  EXPECT_NE(error_of("[").find("bad.yaml: not valid YAML"), std::string::npos);
   EXPECT_EQ(error_of(good + "max_range: 80\n"), "bad.yaml: 'max_range' is given twice (lines 5 and 10): give each key once");
   EXPECT_EQ(error_of(good + "---\n" + good), "bad.yaml: holds 2 YAML documents (separated by '---'); a sensor profile is one");
 }

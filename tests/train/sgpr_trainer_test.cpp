@@ -196,6 +196,14 @@ TEST(SgprTrainingData, RecipeErrorsNameTheFileAndTheEntry) {
   EXPECT_NE(write("train: [{folder: ., seed: 1, seed: 2}]\nvalidation: [{folder: .}]\n")
                 .find("recipe.yaml: 'train[0].seed' is given twice (lines 1 and 1)"),
             std::string::npos);
+  // Read as every other YAML file: one document, invalid YAML named, a folder in its place refused.
+  EXPECT_NE(write("train: [{folder: .}]\nvalidation: [{folder: .}]\n---\ntrain: [{folder: .}]\n")
+                .find("recipe.yaml: holds 2 YAML documents (separated by '---'); a data recipe is one"),
+            std::string::npos);
+  EXPECT_NE(write("train: [{folder: .\n").find("recipe.yaml: not valid YAML (line"), std::string::npos);
+  std::filesystem::create_directory(dir / "folder.yaml");
+  EXPECT_NE(testing::input_error_of([&] { (void)read_data_recipe(dir / "folder.yaml"); }).find("folder.yaml"),
+            std::string::npos);
   const std::string ok = write("defaults: {calib: poses.txt, frame_step: 3}\ntrain: [{simulate: poses.txt, frames: '0:9'}]\n"
                                "validation: [{folder: ., labels: here}]\n");
   EXPECT_EQ(ok, "no error");

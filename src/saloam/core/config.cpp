@@ -294,17 +294,9 @@ void validate_config(const SaloamConfig& config_in, std::string_view origin_in) 
 }
 
 void apply_config_yaml(SaloamConfig& config, std::string_view yaml_text, std::string_view origin) {
-  std::vector<YAML::Node> documents;
-  try {
-    documents = load_yaml_documents(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(fmt::format("{}: invalid YAML: {}", origin, e.what()));
-  }
-  if (documents.size() > 1) {
-    throw ConfigError(fmt::format("{}: holds {} YAML documents (separated by '---'); a configuration is one", origin,
-                                  documents.size()));
-  }
-  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+  const YamlDocument document = load_yaml_document(yaml_text, "a configuration");
+  if (!document.problem.empty()) throw ConfigError(fmt::format("{}: {}", origin, document.problem));
+  const YAML::Node& root = document.root;
   SaloamConfig updated = config;  // `config` stays as it was when anything is wrong
   if (!root.IsNull()) apply_node(updated, root, "", std::string(origin), collect_fields(updated));  // null: empty file
   validate_config(updated, origin);

@@ -69,17 +69,9 @@ void check(const SensorProfile& p, const std::filesystem::path& file) {
 }  // namespace
 
 SensorProfile parse_sensor_profile(std::string_view yaml, const std::filesystem::path& file) {
-  std::vector<YAML::Node> documents;
-  try {
-    documents = load_yaml_documents(yaml);
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, fmt::format("invalid YAML: {}", e.what()));
-  }
-  if (documents.size() > 1) {
-    throw InputError(file, fmt::format("holds {} YAML documents (separated by '---'); a sensor profile is one",
-                                       documents.size()));
-  }
-  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+  const YamlDocument document = load_yaml_document(yaml, "a sensor profile");
+  if (!document.problem.empty()) throw InputError(file, document.problem);
+  const YAML::Node& root = document.root;
   check_keys(root, "", file);
   if (root.IsMap() && root["simulation"]) check_keys(root["simulation"], "simulation", file);
   SensorProfile p;

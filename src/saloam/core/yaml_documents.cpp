@@ -46,6 +46,25 @@ std::vector<YAML::Node> load_yaml_documents(std::string_view text) {
   return documents;
 }
 
+YamlDocument load_yaml_document(std::string_view text, std::string_view what) {
+  YamlDocument document;
+  std::vector<YAML::Node> documents;
+  try {
+    documents = load_yaml_documents(text);
+  } catch (const YAML::Exception& e) {
+    const std::string line = e.mark.is_null() ? "" : fmt::format(" (line {})", e.mark.line + 1);
+    document.problem = fmt::format("not valid YAML{}: {}", line, e.msg.substr(0, 200));
+    return document;
+  }
+  if (documents.size() > 1) {
+    document.problem =
+        fmt::format("holds {} YAML documents (separated by '---'); {} is one", documents.size(), what);
+  } else if (!documents.empty()) {
+    document.root = documents.front();
+  }
+  return document;
+}
+
 std::string key_problem(const YAML::Node& node, const std::string& section) {
   if (!node.IsMap()) return {};
   std::map<std::string, int> first_line;

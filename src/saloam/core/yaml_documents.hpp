@@ -22,6 +22,17 @@ inline constexpr std::size_t kMaxYamlDocuments = 64;
 /// counted first.)
 std::vector<YAML::Node> load_yaml_documents(std::string_view text);
 
+/// A file that holds one YAML document (a configuration, a sensor profile, a
+/// segmenter description, a data recipe).
+struct YamlDocument {
+  YAML::Node root;      ///< the document; null for a text with none (an empty file)
+  std::string problem;  ///< why there is no document, for an error message; empty: `root` is it
+};
+/// The one document of `text` (load_yaml_documents), or the problem:
+/// "not valid YAML (line 3): ..." or "holds 2 YAML documents (separated by
+/// '---'); a configuration is one" (`what`: "a configuration").
+YamlDocument load_yaml_document(std::string_view text, std::string_view what);
+
 /// What is wrong with the keys of the map `node`, as a phrase for an error
 /// message: "'odometry.k' is given twice (lines 3 and 9): give each key
 /// once" or "line 4: a key in 'odometry' that is not a name (a list or a

@@ -211,19 +211,9 @@ std::vector<std::uint16_t> semantickitti_learning_classes() {
 }
 
 SegmenterSpec parse_segmenter_spec(std::string_view yaml_text, const fs::path& origin) {
-  std::vector<YAML::Node> documents;
-  try {
-    // Documents counted before LoadAll, which never ends (and runs out of
-    // memory) on some malformed inputs (load_yaml_documents).
-    documents = load_yaml_documents(yaml_text);
-  } catch (const YAML::Exception& e) {
-    throw InputError(origin, fmt::format("not valid YAML (line {}): {}", e.mark.line + 1, e.msg.substr(0, 200)));
-  }
-  if (documents.size() > 1) {
-    throw InputError(origin, fmt::format("holds {} YAML documents (separated by '---'); a description is one",
-                                         documents.size()));
-  }
-  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+  const YamlDocument document = load_yaml_document(yaml_text, "a description");
+  if (!document.problem.empty()) throw InputError(origin, document.problem);
+  const YAML::Node& root = document.root;
   const MapReader r(root, "", origin, {"format", "network", "projection", "classes", "knn", "decision"});
   if (r.text("format") != kSegmenterFormat)
     r.fail("format", fmt::format("expected '{}'", kSegmenterFormat));

@@ -20,6 +20,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+/// A recipe lists a few dozen sequences; a larger file is not one.
+constexpr std::size_t kMaxRecipeBytes = std::size_t{1} << 20;
+
 /// Tr from a calib.txt (`Tr:` line) or, failing that, from a per-sequence
 /// list (`NN: ...`) picked by the pose file's name (00.txt), as `saloam simulate` does.
 Pose velo_to_cam_for(const fs::path& calib, const fs::path& trajectory) {
@@ -142,13 +145,9 @@ nlohmann::json SourceSpec::to_json() const {
 }
 
 DataRecipe read_data_recipe(const fs::path& file, const SourceSpec& given_defaults) {
-  require_file(file, "data recipe");
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(file.string());
-  } catch (const YAML::Exception& e) {
-    throw InputError(file, std::string("not valid YAML: ") + e.what());
-  }
+  const YamlDocument document = load_yaml_document(read_file(file, kMaxRecipeBytes, "data recipe"), "a data recipe");
+  if (!document.problem.empty()) throw InputError(file, document.problem);
+  const YAML::Node& root = document.root;
   if (!root.IsMap()) throw InputError(file, "expected a map with `train:` and `validation:` lists");
   check_keys(root, file, "");
   const fs::path base = file.parent_path();
