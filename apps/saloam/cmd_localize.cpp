@@ -15,9 +15,6 @@
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/core/profiling.hpp"
-#include "saloam/eval/trajectory_metrics.hpp"
-#include "saloam/io/calibration.hpp"
-#include "saloam/io/trajectory_io.hpp"
 #include "saloam/maps/prior_map.hpp"
 #include "saloam/runs/localize_run.hpp"
 #include "saloam/runs/session_eval.hpp"
@@ -45,32 +42,6 @@ std::optional<Pose> simulated_truth(const PriorMap& map, const SourceInfo& info)
   return orthonormalized(map_pass->origin.inverse() * run_pass->origin);
 }
 
-/// The SE(3) alignment of the map's keyframes to their truth (the map
-/// source's poses), when that source can be read.
-std::optional<Pose> map_alignment(const PriorMap& map) {
-  try {
-    const std::filesystem::path source = map.saved().manifest.source;
-    std::vector<Pose> truth = read_kitti_poses(source / "poses.txt");
-    if (std::filesystem::exists(source / "poses_sensor.txt")) truth = read_kitti_poses(source / "poses_sensor.txt");
-    if (std::filesystem::exists(source / "calib.txt")) truth = camera_to_lidar_poses(truth, read_velo_to_cam(source / "calib.txt"));
-    const Pose rebase = truth.front().inverse();
-    std::vector<Eigen::Vector3d> estimated, reference;
-    for (const auto& k : map.saved().keyframes) {
-      if (k.frame >= truth.size()) return std::nullopt;
-      estimated.push_back(k.pose.translation());
-      reference.push_back((rebase * truth[k.frame]).translation());
-    }
-    if (estimated.size() < 3) return std::nullopt;
-    const SimilarityTransform s = umeyama_alignment(estimated, reference, false);
-    Pose T = Pose::Identity();
-    T.linear() = s.rotation;
-    T.translation() = s.translation;
-    return T;
-  } catch (const InputError&) {
-    return std::nullopt;
-  }
-}
-
 int run_localize_command(const LocalizeOptions& options) {
   const StageTimer load_timer;
   // The map's own configuration (its detector made the descriptors), a
@@ -91,7 +62,7 @@ int run_localize_command(const LocalizeOptions& options) {
   const std::unique_ptr<FrameSource> source = options.source.open(!labels, config);
   LocalizeRunOptions run_options;
   run_options.truth_map_from_source = simulated_truth(map, source->info());
-  if (run_options.truth_map_from_source) run_options.map_alignment = map_alignment(map);
+  if (run_options.truth_map_from_source) run_options.map_error = map_error_against_source(map);
   if (run_options.truth_map_from_source) {
     std::cout << "the map and the scans are passes of one simulated world: relocalisations are judged against the truth\n";
   }
@@ -115,6 +86,10 @@ int run_localize_command(const LocalizeOptions& options) {
                              *r.false_relocalizations, r.localized_rmse_m ? fmt::format("{:.3f}", *r.localized_rmse_m) : "-",
                              r.localized_max_m ? fmt::format("{:.3f}", *r.localized_max_m) : "-",
                              r.placed_rmse_m ? fmt::format("{:.3f}", *r.placed_rmse_m) : "-");
+  }
+  if (r.map_error_where_localized_m) {
+    std::cout << fmt::format("the map's own error where the frames were localized: RMSE {:.3f} m (the localized frames "
+                             "inherit it)\n", *r.map_error_where_localized_m);
   }
   if (r.aligned_ate_m) std::cout << fmt::format("placed frames against the reference: ATE {:.3f} m (SE(3)-aligned)\n", *r.aligned_ate_m);
   std::cout << fmt::format("wrote {} ({})\n", options.out, fmt::join(r.files, ", "));

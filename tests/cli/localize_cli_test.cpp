@@ -50,6 +50,13 @@ TEST(LocalizeCli, SavesAMapAndLocalisesASecondPassInIt) {
   EXPECT_LT(summary["first_placed_after_m"].get<double>(), 20.0);
   EXPECT_EQ(summary["false_relocalizations"].get<int>(), 0);
   EXPECT_LT(summary["localized_rmse_in_map_m"].get<double>(), 0.3);
+  // Beside it the map's own error where those frames are (their nearest
+  // keyframes'), which they inherit: the localisation adds a few cm at most.
+  ASSERT_TRUE(summary.contains("map_error_where_localized_m")) << summary.dump(1);
+  const double map_error = summary["map_error_where_localized_m"].get<double>();
+  EXPECT_GT(map_error, 0.0);
+  EXPECT_LT(summary["localized_rmse_in_map_m"].get<double>() - map_error, 0.1) << summary.dump(1);
+  EXPECT_NE(output.find("the map's own error where the frames were localized"), std::string::npos) << output;
   // Pass 1 drives 80 poses beyond the mapped stretch: it leaves the map and says so.
   EXPECT_GE(summary["left_mapped_area"].get<int>(), 1);
   EXPECT_GT(summary["odometry"].get<int>(), 0);

@@ -1,16 +1,20 @@
 #include "saloam/runs/localize_run.hpp"
 
+#include <limits>
+
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "saloam/core/cancellation.hpp"
+#include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/core/output_file.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/calibration.hpp"
+#include "saloam/io/trajectory_io.hpp"
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
@@ -35,10 +39,10 @@ std::optional<std::vector<Pose>> reference_lidar_poses(const SourceInfo& info, s
 std::string number_or_empty(double v, int digits) { return v < 0 ? std::string() : fmt::format("{:.{}f}", v, digits); }
 
 /// An estimate as it is compared with the truth: moved by the map's own
-/// error (LocalizeRunOptions::map_alignment) when known. Every error this
+/// error (LocalizeRunOptions::map_error) when known. Every error this
 /// run reports (summary, frames.csv, relocalizations.csv) is measured so.
 Pose for_truth(const Pose& estimate, const LocalizeRunOptions& options) {
-  return options.map_alignment ? Pose(*options.map_alignment * estimate) : estimate;
+  return options.map_error ? Pose(options.map_error->alignment * estimate) : estimate;
 }
 
 /// [m] how far `estimate` (for_truth) lies from `truth`.
@@ -128,13 +132,24 @@ double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWrit
 
 // Counts of the frames and relocalisations, and their errors against the
 // source's reference poses (`truth`: the same in the map's frame) when known.
-void evaluate_frames(const Localizer& localizer, const std::optional<std::vector<Pose>>& reference,
+// [m] the map's own error at `position` (map frame): that of the nearest keyframe.
+double map_error_at(const PriorMap& map, const MapError& error, const Eigen::Vector3d& position) {
+  std::size_t nearest = 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 0; k < map.size(); ++k) {
+    const double d = (map.pose(k).translation() - position).squaredNorm();
+    if (d < best) best = d, nearest = k;
+  }
+  return error.keyframe_errors[nearest];
+}
+
+void evaluate_frames(const Localizer& localizer, const PriorMap& map, const std::optional<std::vector<Pose>>& reference,
                      const std::optional<std::vector<Pose>>& truth, const LocalizeRunOptions& options,
                      LocalizeRunResult& result) {
   const auto& frames = localizer.frames();
   result.frames = frames.size();
   std::vector<Pose> placed_estimates, placed_references;
-  std::vector<double> placed_errors, localized_errors;
+  std::vector<double> placed_errors, localized_errors, map_errors;
   for (const LocalizedFrame& f : frames) {
     switch (f.status) {
       case LocalizationStatus::kLocalized: ++result.localized; break;
@@ -152,7 +167,10 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
     if (truth) {
       const double e = truth_error(f.pose, (*truth)[f.frame], options);
       placed_errors.push_back(e);
-      if (f.status == LocalizationStatus::kLocalized) localized_errors.push_back(e);
+      if (f.status == LocalizationStatus::kLocalized) {
+        localized_errors.push_back(e);
+        if (options.map_error) map_errors.push_back(map_error_at(map, *options.map_error, f.pose.translation()));
+      }
     }
   }
   result.first_placed_m = localizer.first_placed_at();
@@ -172,6 +190,7 @@ void evaluate_frames(const Localizer& localizer, const std::optional<std::vector
       result.localized_rmse_m = s.rmse;
       result.localized_max_m = s.max;
     }
+    if (!map_errors.empty()) result.map_error_where_localized_m = error_stats(map_errors).rmse;
   }
   if (placed_estimates.size() >= 3) {
     result.aligned_ate_m = compute_ate(placed_references, placed_estimates, Alignment::kSE3).aligned.rmse;
@@ -222,12 +241,40 @@ nlohmann::json localize_summary_json(const SourceInfo& info, const PriorMap& map
   if (result.aligned_ate_m) summary["placed_ate_se3_m"] = *result.aligned_ate_m;
   if (result.false_relocalizations) summary["false_relocalizations"] = *result.false_relocalizations;
   if (result.localized_rmse_m) summary["localized_rmse_in_map_m"] = *result.localized_rmse_m;
+  if (result.map_error_where_localized_m) summary["map_error_where_localized_m"] = *result.map_error_where_localized_m;
   if (result.placed_rmse_m) summary["placed_rmse_in_map_m"] = *result.placed_rmse_m;
   if (info.folder) summary["sequence"] = std::filesystem::absolute(*info.folder).lexically_normal().string();
   return summary;
 }
 
 }  // namespace
+
+std::optional<MapError> map_error_against_source(const PriorMap& map) {
+  try {
+    const std::filesystem::path source = map.saved().manifest.source;
+    std::vector<Pose> truth = read_kitti_poses(source / "poses.txt");
+    if (std::filesystem::exists(source / "poses_sensor.txt")) truth = read_kitti_poses(source / "poses_sensor.txt");
+    if (std::filesystem::exists(source / "calib.txt")) truth = camera_to_lidar_poses(truth, read_velo_to_cam(source / "calib.txt"));
+    const Pose rebase = truth.front().inverse();
+    std::vector<Eigen::Vector3d> estimated, reference;
+    for (const auto& k : map.saved().keyframes) {
+      if (k.frame >= truth.size()) return std::nullopt;
+      estimated.push_back(k.pose.translation());
+      reference.push_back((rebase * truth[k.frame]).translation());
+    }
+    if (estimated.size() < 3) return std::nullopt;
+    const SimilarityTransform s = umeyama_alignment(estimated, reference, false);
+    MapError error;
+    error.alignment.linear() = s.rotation;
+    error.alignment.translation() = s.translation;
+    for (std::size_t k = 0; k < estimated.size(); ++k) {
+      error.keyframe_errors.push_back((error.alignment * estimated[k] - reference[k]).norm());
+    }
+    return error;
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
 
 LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, const PriorMap& map,
                                std::optional<SgprNetwork> network, const std::filesystem::path& out_dir,
@@ -252,7 +299,7 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
     truth.emplace();
     for (const Pose& p : *reference) truth->push_back(orthonormalized(*options.truth_map_from_source * p));
   }
-  evaluate_frames(localizer, reference, truth, options, result);
+  evaluate_frames(localizer, map, reference, truth, options, result);
   std::vector<double> total;
   for (const auto& f : frames) total.push_back(f.timing.total_ms());
   const Summary frame_summary = summarize(total);

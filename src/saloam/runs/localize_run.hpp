@@ -28,6 +28,21 @@
 
 namespace saloam {
 
+/// A map's own error against the truth of the run that made it.
+struct MapError {
+  /// The rigid transform that best aligns the map's keyframes with their
+  /// truth (as the mapping run's ATE aligns).
+  Pose alignment = Pose::Identity();
+  /// [m] each keyframe's position error after the alignment.
+  std::vector<double> keyframe_errors;
+};
+
+/// The map's error when the source it was made from (its manifest's
+/// `source`) holds reference poses (poses_sensor.txt or poses.txt, with
+/// calib.txt's Tr); none when it cannot be read or its poses do not cover
+/// the keyframes.
+std::optional<MapError> map_error_against_source(const PriorMap& map);
+
 struct LocalizeRunOptions {
   bool show_progress = true;
   /// T_map<-L0: the map frame from the source's first frame (LiDAR), when
@@ -35,11 +50,10 @@ struct LocalizeRunOptions {
   /// the source's reference poses in the map frame, and each relocalisation
   /// judged true or false (0.5 m, 2 degrees, as loops).
   std::optional<Pose> truth_map_from_source;
-  /// The map's own error: the rigid transform that best aligns the map's
-  /// keyframes with their truth (as the mapping run's ATE aligns). Estimates
-  /// are moved by it before they are compared with the truth, so that the
+  /// The map's own error (map_error_against_source). Estimates are moved by
+  /// its alignment before they are compared with the truth, so that the
   /// localisation error and the mapping ATE measure the same thing.
-  std::optional<Pose> map_alignment;
+  std::optional<MapError> map_error;
 };
 
 struct LocalizeRunResult {
@@ -53,6 +67,10 @@ struct LocalizeRunResult {
   /// from it, and the position errors of the placed frames in the map frame.
   std::optional<std::size_t> false_relocalizations;
   std::optional<double> localized_rmse_m, localized_max_m, placed_rmse_m;
+  /// [m] RMSE over the localized frames of the map's own error where each is
+  /// (its nearest map keyframe's, LocalizeRunOptions::map_error): what the
+  /// localized error inherits from the map; the rest is the localisation's.
+  std::optional<double> map_error_where_localized_m;
   /// With reference poses: ATE of the placed frames after an SE(3) alignment.
   std::optional<double> aligned_ate_m;
   double seconds = 0;
