@@ -101,6 +101,20 @@ TEST(MergeCli, JoinsASecondPassAndMergesTwoMaps) {
                         &output),
             2)
       << output;
+
+  // Localised in the merged map, each frame is set beside the map's own
+  // error where it is: every session's keyframes against their own pass's
+  // truth (pass 1 drives on beyond pass 0, where only session 1 has keyframes).
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("localize {} --map {} --out {}", quoted(dir / "pass1"),
+                                               quoted(dir / "merged"), quoted(dir / "loc"))),
+                        &output),
+            0)
+      << output;
+  const auto located = nlohmann::json::parse(file_text(dir / "loc" / "summary.json"));
+  EXPECT_EQ(located["false_relocalizations"].get<int>(), 0) << located.dump(1);
+  ASSERT_TRUE(located.contains("map_error_where_localized_m")) << located.dump(1);
+  EXPECT_LT(located["map_error_where_localized_m"].get<double>(), 0.2) << located.dump(1);
+  EXPECT_LT(located["localized_rmse_in_map_m"].get<double>(), 0.3) << located.dump(1);
 }
 
 }  // namespace

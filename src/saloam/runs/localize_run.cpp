@@ -1,6 +1,8 @@
 #include "saloam/runs/localize_run.hpp"
 
+#include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -14,10 +16,10 @@
 #include "saloam/core/progress.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/calibration.hpp"
-#include "saloam/io/trajectory_io.hpp"
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
+#include "saloam/runs/session_eval.hpp"
 #include "saloam/runs/timing_report.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 
@@ -132,15 +134,16 @@ double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWrit
 
 // Counts of the frames and relocalisations, and their errors against the
 // source's reference poses (`truth`: the same in the map's frame) when known.
-// [m] the map's own error at `position` (map frame): that of the nearest keyframe.
+// [m] the map's own error at `position` (map frame): that of the nearest
+// keyframe in the map frame (a session not linked has none).
 double map_error_at(const PriorMap& map, const MapError& error, const Eigen::Vector3d& position) {
-  std::size_t nearest = 0;
+  double nearest_error = NAN;
   double best = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < map.size(); ++k) {
     const double d = (map.pose(k).translation() - position).squaredNorm();
-    if (d < best) best = d, nearest = k;
+    if (std::isfinite(error.keyframe_errors[k]) && d < best) best = d, nearest_error = error.keyframe_errors[k];
   }
-  return error.keyframe_errors[nearest];
+  return nearest_error;
 }
 
 void evaluate_frames(const Localizer& localizer, const PriorMap& map, const std::optional<std::vector<Pose>>& reference,
@@ -251,27 +254,13 @@ nlohmann::json localize_summary_json(const SourceInfo& info, const PriorMap& map
 
 std::optional<MapError> map_error_against_source(const PriorMap& map) {
   try {
-    const std::filesystem::path source = map.saved().manifest.source;
-    std::vector<Pose> truth = read_kitti_poses(source / "poses.txt");
-    if (std::filesystem::exists(source / "poses_sensor.txt")) truth = read_kitti_poses(source / "poses_sensor.txt");
-    if (std::filesystem::exists(source / "calib.txt")) truth = camera_to_lidar_poses(truth, read_velo_to_cam(source / "calib.txt"));
-    const Pose rebase = truth.front().inverse();
-    std::vector<Eigen::Vector3d> estimated, reference;
-    for (const auto& k : map.saved().keyframes) {
-      if (k.frame >= truth.size()) return std::nullopt;
-      estimated.push_back(k.pose.translation());
-      reference.push_back((rebase * truth[k.frame]).translation());
-    }
-    if (estimated.size() < 3) return std::nullopt;
-    const SimilarityTransform s = umeyama_alignment(estimated, reference, false);
-    MapError error;
-    error.alignment.linear() = s.rotation;
-    error.alignment.translation() = s.translation;
-    for (std::size_t k = 0; k < estimated.size(); ++k) {
-      error.keyframe_errors.push_back((error.alignment * estimated[k] - reference[k]).norm());
-    }
-    return error;
+    std::vector<std::vector<Pose>> truth;
+    for (const MapSession& session : map_sessions(map.saved())) truth.push_back(read_sequence_truth(session.source));
+    KeyframeAlignment alignment = align_keyframes(map.saved(), truth);
+    return MapError{alignment.alignment, std::move(alignment.aligned)};
   } catch (const InputError&) {
+    return std::nullopt;
+  } catch (const std::invalid_argument&) {
     return std::nullopt;
   }
 }

@@ -33,14 +33,15 @@ struct MapError {
   /// The rigid transform that best aligns the map's keyframes with their
   /// truth (as the mapping run's ATE aligns).
   Pose alignment = Pose::Identity();
-  /// [m] each keyframe's position error after the alignment.
+  /// [m] each keyframe's position error after the alignment (NaN: its
+  /// session is not linked to the map frame).
   std::vector<double> keyframe_errors;
 };
 
-/// The map's error when the source it was made from (its manifest's
-/// `source`) holds reference poses (poses_sensor.txt or poses.txt, with
-/// calib.txt's Tr); none when it cannot be read or its poses do not cover
-/// the keyframes.
+/// The map's error when the sources its sessions were made from hold
+/// reference poses (read_sequence_truth: poses_sensor.txt or poses.txt,
+/// calib.txt's Tr, a simulated pass's origin); none when one cannot be read
+/// or its poses do not cover the keyframes.
 std::optional<MapError> map_error_against_source(const PriorMap& map);
 
 struct LocalizeRunOptions {

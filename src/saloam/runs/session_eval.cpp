@@ -78,34 +78,53 @@ std::vector<Pose> keyframe_truth(const SavedMap& map, const std::vector<MapSessi
 
 }  // namespace
 
-SessionEvaluation evaluate_sessions(const SavedMap& map, const std::vector<std::vector<Pose>>& truth) {
+KeyframeAlignment align_keyframes(const SavedMap& map, const std::vector<std::vector<Pose>>& truth) {
   const std::vector<MapSession> sessions = map_sessions(map);
-  const std::vector<Pose> world = keyframe_truth(map, sessions, truth);
+  KeyframeAlignment out;
+  out.world = keyframe_truth(map, sessions, truth);
   // The map frame: the LiDAR frame of session 0's first keyframe.
-  const Pose map_from_world = world.front().inverse();
+  const Pose map_from_world = out.world.front().inverse();
   std::vector<Eigen::Vector3d> estimated, reference;
-  std::vector<std::size_t> index;
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    estimated.push_back(map.keyframes[k].pose.translation());
+    reference.push_back((map_from_world * out.world[k]).translation());
+  }
+  std::vector<Eigen::Vector3d> linked_estimated, linked_reference;
   for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
     if (!sessions[map.keyframes[k].session].linked) continue;
-    estimated.push_back(map.keyframes[k].pose.translation());
-    reference.push_back((map_from_world * world[k]).translation());
-    index.push_back(k);
+    linked_estimated.push_back(estimated[k]);
+    linked_reference.push_back(reference[k]);
   }
-  if (estimated.size() < 3) throw std::invalid_argument("fewer than 3 linked keyframes: nothing to align");
-  const SimilarityTransform s = umeyama_alignment(estimated, reference, false);
+  if (linked_estimated.size() < 3) throw std::invalid_argument("fewer than 3 linked keyframes: nothing to align");
+  const SimilarityTransform s = umeyama_alignment(linked_estimated, linked_reference, false);
+  out.alignment.linear() = s.rotation;
+  out.alignment.translation() = s.translation;
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    const bool linked = sessions[map.keyframes[k].session].linked;
+    out.aligned.push_back(linked ? (out.alignment * estimated[k] - reference[k]).norm() : NAN);
+    out.unaligned.push_back(linked ? (estimated[k] - reference[k]).norm() : NAN);
+  }
+  return out;
+}
+
+SessionEvaluation evaluate_sessions(const SavedMap& map, const std::vector<std::vector<Pose>>& truth) {
+  const std::vector<MapSession> sessions = map_sessions(map);
+  const KeyframeAlignment alignment = align_keyframes(map, truth);
   std::vector<std::vector<double>> aligned(sessions.size()), unaligned(sessions.size());
   std::vector<double> all;
-  for (std::size_t i = 0; i < estimated.size(); ++i) {
-    const std::uint32_t session = map.keyframes[index[i]].session;
-    aligned[session].push_back((s.rotation * estimated[i] + s.translation - reference[i]).norm());
-    unaligned[session].push_back((estimated[i] - reference[i]).norm());
-    all.push_back(aligned[session].back());
+  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
+    const std::uint32_t session = map.keyframes[k].session;
+    if (!sessions[session].linked) continue;
+    aligned[session].push_back(alignment.aligned[k]);
+    unaligned[session].push_back(alignment.unaligned[k]);
+    all.push_back(alignment.aligned[k]);
   }
   SessionEvaluation out;
   for (std::size_t i = 0; i < sessions.size(); ++i) {
     out.sessions.push_back({sessions[i].keyframes, sessions[i].linked, error_stats(aligned[i]), error_stats(unaligned[i])});
   }
   out.all_aligned = error_stats(all);
+  const std::vector<Pose>& world = alignment.world;
   for (const PoseGraphEdge& e : map.edges) {
     if (e.kind != EdgeKind::kLoop || map.keyframes[e.from].session == map.keyframes[e.to].session) continue;
     const bool ok = agrees_with_truth(e.measured, world[e.from].inverse() * world[e.to]);

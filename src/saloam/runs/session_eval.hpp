@@ -57,10 +57,25 @@ struct SessionEvaluation {
   std::size_t false_cross_session_loops = 0;
 };
 
+/// The one SE(3) alignment of every linked keyframe's position to its truth
+/// in the map frame (the LiDAR frame of session 0's first keyframe, as the
+/// truth's when rebased there), and each keyframe's error.
+struct KeyframeAlignment {
+  Pose alignment = Pose::Identity();  ///< applied to the map's poses
+  std::vector<double> aligned;        ///< [m] per keyframe, after it (NaN: session not linked)
+  std::vector<double> unaligned;      ///< [m] per keyframe, in the map frame (NaN: session not linked)
+  std::vector<Pose> world;            ///< each keyframe's truth in the world frame
+};
+
 /// `truth[s]`: session s's LiDAR poses in the common world frame, indexed by
-/// source frame (MapSession::first_frame + the keyframe's frame).
-/// std::invalid_argument when the counts do not fit (a session without a
-/// truth, a keyframe beyond its truth, fewer than 3 linked keyframes).
+/// source frame (MapSession::first_frame + the keyframe's frame), as
+/// read_sequence_truth gives them. std::invalid_argument when the counts do
+/// not fit (a session without a truth, a keyframe beyond its truth, fewer
+/// than 3 linked keyframes).
+KeyframeAlignment align_keyframes(const SavedMap& map, const std::vector<std::vector<Pose>>& truth);
+
+/// align_keyframes' errors per session, and the cross-session loop edges
+/// judged against the truth; the same exceptions.
 SessionEvaluation evaluate_sessions(const SavedMap& map, const std::vector<std::vector<Pose>>& truth);
 
 void print_session_evaluation(std::ostream& out, const SessionEvaluation& evaluation,
