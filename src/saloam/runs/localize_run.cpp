@@ -132,8 +132,6 @@ double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWrit
   return timer.elapsed_s();
 }
 
-// Counts of the frames and relocalisations, and their errors against the
-// source's reference poses (`truth`: the same in the map's frame) when known.
 // [m] the map's own error at `position` (map frame): that of the nearest
 // keyframe in the map frame (a session not linked has none).
 double map_error_at(const PriorMap& map, const MapError& error, const Eigen::Vector3d& position) {
@@ -146,6 +144,8 @@ double map_error_at(const PriorMap& map, const MapError& error, const Eigen::Vec
   return nearest_error;
 }
 
+// Counts of the frames and relocalisations, and their errors against the
+// source's reference poses (`truth`: the same in the map's frame) when known.
 void evaluate_frames(const Localizer& localizer, const PriorMap& map, const std::optional<std::vector<Pose>>& reference,
                      const std::optional<std::vector<Pose>>& truth, const LocalizeRunOptions& options,
                      LocalizeRunResult& result) {
