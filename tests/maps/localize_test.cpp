@@ -170,6 +170,20 @@ TEST(Localize, RelocalisesDrivingTheOppositeWay) {
   EXPECT_GT(localized, s.frames.size() / 2);
 }
 
+TEST(Localize, QueriesFromTheSidePlaceTheOppositeLaneSooner) {
+  // Scan Context compares scans taken from one spot; the reverse pass drives
+  // 3.2 m beside the mapped lane. Described also from a lane width to either
+  // side (localize.lateral_query_offset), the scan finds its place sooner.
+  const TestMap& map = test_map(5);
+  const Session from_sensor = localize(map, 2, 5, 60, [](LocalizeConfig& c) { c.lateral_query_offset = 0; });
+  const Session from_sides = localize(map, 2, 5, 60);
+  ASSERT_TRUE(from_sides.first_placed);
+  EXPECT_EQ(false_confirmations(map, from_sides), 0u);
+  EXPECT_LT(*from_sides.first_placed, from_sensor.first_placed.value_or(1e9));
+  std::printf("seed 5 reverse: placed after %.1f m from the sensor's query only, %.1f m with queries from the side\n",
+              from_sensor.first_placed.value_or(-1.0), *from_sides.first_placed);
+}
+
 TEST(Localize, RefusesTheReversePassTurnedAlongTheStreet) {
   // World seed 6, the reverse pass over 60 route poses (30 frames, about 65 m): its first
   // descriptor match fits it turned by 180 degrees in the mapped lane, metres
@@ -178,9 +192,13 @@ TEST(Localize, RefusesTheReversePassTurnedAlongTheStreet) {
   // pass the acceptance test; started from the last fix's pose they land
   // elsewhere, which refutes it. The run is placed later, where it is.
   // (The uniqueness test of a place found with no prior, which refuses that
-  // hypothesis before any confirmation, is off here: this tests the other.)
+  // hypothesis before any confirmation, is off here: this tests the other.
+  // So are the queries from the side, which find the right place first.)
   const TestMap& map = test_map(6);
-  const Session s = localize(map, 2, 6, 60, [](LocalizeConfig& c) { c.max_runner_up_ratio = kInf; });
+  const Session s = localize(map, 2, 6, 60, [](LocalizeConfig& c) {
+    c.max_runner_up_ratio = kInf;
+    c.lateral_query_offset = 0;
+  });
   std::size_t wrong_hypotheses = 0, refuted_by_motion = 0;
   for (const auto& r : s.relocalizations) {
     if (r.outcome == "hypothesis" && !agrees(map.alignment * r.pose, s.truth[r.frame])) ++wrong_hypotheses;
@@ -209,11 +227,14 @@ TEST(Localize, RefusesAPlaceItCannotTellAlongTheStreet) {
   // street passes the acceptance test and is believed (the set-up this test
   // needs); with it, every such fit has a distinct solution along the street
   // nearly as good and is refused, and the run is placed where it is.
+  // (Queries from the sensor only: those from the side find the right place
+  // before the wrong one arises.)
   const TestMap& map = test_map(6);
   const auto no_confirmations = [](double ratio) {
     return [ratio](LocalizeConfig& c) {
       c.confirmations = 0;
       c.max_runner_up_ratio = ratio;
+      c.lateral_query_offset = 0;
     };
   };
   const Session without = localize(map, 2, 6, 60, no_confirmations(kInf));

@@ -331,6 +331,12 @@ struct LocalizeConfig {
   /// nearly as good. It decides under the normalized acceptance test (the
   /// default loop.acceptance), not under the loss test. .inf = off.
   double max_runner_up_ratio = 0.9;
+  /// [m] Place recognition describes the scan also as seen from this far
+  /// to either side of the sensor (0: only from the sensor). Scan Context
+  /// compares scans taken from one spot; a run in the opposite lane, or in
+  /// the lane beside the mapped one, is about a lane width from where the
+  /// map's scans were taken.
+  double lateral_query_offset = 3.2;
   /// [m] map keyframes whose position lies within this of the predicted pose
   /// form the tracking submap.
   double track_radius = 40.0;
@@ -499,6 +505,8 @@ void visit_fields(LocalizeConfig& c, Visitor&& v) {
   v("confirm_interval", c.confirm_interval, "[m] travel between confirming fixes", AtLeast{0});
   v("max_runner_up_ratio", c.max_runner_up_ratio,
     "no prior: max inliers of a distinct fit / the candidate's (.inf: off)", Range{0, kInf});
+  v("lateral_query_offset", c.lateral_query_offset,
+    "[m] place recognition also from this far to either side (another lane; 0: off)", Range{0, 20});
   v("track_radius", c.track_radius, "[m] map keyframes this near the pose form the tracking submap", Above{0});
   v("submap_spacing", c.submap_spacing, "[m] least spacing of the tracking submap's keyframes", AtLeast{0});
   v("submap_rebuild_distance", c.submap_rebuild_distance, "[m] motion that rebuilds the tracking submap", Above{0});

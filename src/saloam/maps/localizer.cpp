@@ -245,21 +245,51 @@ std::vector<std::size_t> Localizer::relocalization_candidates(const LocalizedFra
   return candidates;
 }
 
+std::vector<Localizer::ProposedPlace> Localizer::propose_places(const LabelledCloud& scan,
+                                                               std::vector<std::size_t> candidates) const {
+  const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
+  const double offset = config_.localize.lateral_query_offset;
+  std::vector<double> sideways{0.0};
+  if (offset > 0) sideways.insert(sideways.end(), {offset, -offset});
+  // Each query's best places, its guess made the sensor's.
+  std::vector<ProposedPlace> proposed;
+  for (const double y : sideways) {
+    LabelledCloud seen_from = scan;  // the points in a frame `y` to the left of the sensor
+    for (Eigen::Vector3f& p : seen_from.points) p.y() -= static_cast<float>(y);
+    Pose query_from_sensor = Pose::Identity();
+    query_from_sensor.translation().y() = -y;
+    for (const PlaceCandidate& c : best_places(map_, places_, places_.describe(seen_from), candidates, score_threshold_, n)) {
+      proposed.push_back({c, orthonormalized(place_match_guess(c.match) * query_from_sensor)});
+    }
+  }
+  // The best n over all queries (the sensor's first among equals), one per place.
+  std::stable_sort(proposed.begin(), proposed.end(), [](const ProposedPlace& a, const ProposedPlace& b) {
+    return a.candidate.match.score > b.candidate.match.score;
+  });
+  std::vector<ProposedPlace> chosen;
+  for (const ProposedPlace& p : proposed) {
+    if (chosen.size() >= n) break;
+    const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](const ProposedPlace& o) {
+      return (map_.pose(o.candidate.keyframe).translation() - map_.pose(p.candidate.keyframe).translation()).norm() <
+             kSamePlaceDistance;
+    });
+    if (!same_place) chosen.push_back(p);
+  }
+  return chosen;
+}
+
 void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
   last_relocalization_ = travelled_;
   const StageTimer timer;
-  const PlaceDescriptor query = places_.describe(scan);
-  std::vector<std::size_t> candidates = relocalization_candidates(out);
-  const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
-  const std::vector<PlaceCandidate> chosen = best_places(map_, places_, query, std::move(candidates), score_threshold_, n);
+  const std::vector<ProposedPlace> chosen = propose_places(scan, relocalization_candidates(out));
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
   // With no prior (the whole map searched) the fit must also be unique.
   const LoopVerificationSettings& settings = state_ == State::kOdometry ? verification_ : unique_verification_;
-  for (const PlaceCandidate& candidate : chosen) {
+  for (const auto& [candidate, guess] : chosen) {
     const std::size_t match = candidate.keyframe;
     const LoopSubmap submap = submap_around(map_, match, w, verification_);
-    // Guesses: the descriptor's yaw (and SSC's offset); on the odometry also where it says we are.
-    std::vector<Pose> guesses{place_match_guess(candidate.match)};
+    // Guesses: the descriptor's (its yaw, SSC's offset, the query's side); on the odometry also where it says we are.
+    std::vector<Pose> guesses{guess};
     if (state_ == State::kOdometry) {
       add_distinct_guess(guesses, orthonormalized(map_.pose(match).inverse() * map_from_odometry_ * out.odometry_pose));
     }

@@ -3,8 +3,10 @@
 // frame the semantic odometry registers the scan as in any run; on top:
 //
 //  * Not placed (the start, or after the odometry fallback ran out):
-//    every localize.relocalize_interval metres the scan is described and
-//    scored against every map keyframe (the map's detector), the best
+//    every localize.relocalize_interval metres the scan is described (from
+//    the sensor and from a lane width to either side: Scan Context compares
+//    scans taken from one spot) and scored against every map keyframe (the
+//    map's detector), the best
 //    loop.num_loop above the detector's threshold are verified exactly as
 //    loop closure verifies a candidate (semantic ICP against the keyframes
 //    around it, coarse to fine, from the descriptor's yaw; the normalized
@@ -44,6 +46,7 @@
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
+#include "saloam/maps/map_search.hpp"
 #include "saloam/maps/prior_map.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
 #include "saloam/place/place_recognizer.hpp"
@@ -124,6 +127,15 @@ class Localizer {
   /// The map keyframes a relocalisation attempt scores: all of them, or on
   /// the odometry those within Eq. 3's radius of the prediction.
   [[nodiscard]] std::vector<std::size_t> relocalization_candidates(const LocalizedFrame& out) const;
+  /// A place to verify and the guess of T_keyframe<-sensor its query gives.
+  struct ProposedPlace {
+    PlaceCandidate candidate;
+    Pose guess;
+  };
+  /// The best loop.num_loop places among `candidates` for the scan described
+  /// from the sensor and from localize.lateral_query_offset to either side.
+  [[nodiscard]] std::vector<ProposedPlace> propose_places(const LabelledCloud& scan,
+                                                          std::vector<std::size_t> candidates) const;
   void confirm(LocalizedFrame& out);
   void track(LocalizedFrame& out);
   void reenter(LocalizedFrame& out);

@@ -13,8 +13,6 @@ namespace {
 // Map keyframes whose Scan Context is scored exactly per query, picked by
 // their ring keys (as Scan Context's own retrieval).
 constexpr std::size_t kRingKeyCandidates = 100;
-// Proposals closer than this to a better one are the same place.
-constexpr double kSamePlace = 5.0;  // [m]
 
 // The kRingKeyCandidates candidates with the nearest ring keys, ascending.
 std::vector<std::size_t> nearest_ring_keys(const PriorMap& map, const PlaceDescriptor& query,
@@ -74,7 +72,7 @@ std::vector<PlaceCandidate> best_places(const PriorMap& map, const PlaceRecogniz
   for (const PlaceCandidate& c : above) {
     if (chosen.size() >= count) break;
     const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](const PlaceCandidate& o) {
-      return (map.pose(o.keyframe).translation() - map.pose(c.keyframe).translation()).norm() < kSamePlace;
+      return (map.pose(o.keyframe).translation() - map.pose(c.keyframe).translation()).norm() < kSamePlaceDistance;
     });
     if (!same_place) chosen.push_back(c);
   }

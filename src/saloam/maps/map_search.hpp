@@ -16,6 +16,10 @@
 
 namespace saloam {
 
+/// [m] map keyframes nearer than this to each other are one place: a search
+/// proposes at most one of them.
+inline constexpr double kSamePlaceDistance = 5.0;
+
 /// A map keyframe proposed for verification and its descriptor's score.
 struct PlaceCandidate {
   std::size_t keyframe = 0;
@@ -37,8 +41,8 @@ double place_score_threshold(const SaloamConfig& config, PlaceDetector detector)
 
 /// Among `candidates` (map keyframes), those whose descriptor scores above
 /// `threshold` against `query`, best first (ties: the lower index), at most
-/// `count`, and at most one within 5 m of another (neighbouring keyframes are
-/// the same place). With a Scan Context detector only the 100 candidates
+/// `count`, and at most one within kSamePlaceDistance of another
+/// (neighbouring keyframes are the same place). With a Scan Context detector only the 100 candidates
 /// with the nearest ring keys (rotation invariant) are scored exactly, as
 /// Scan Context's own retrieval does.
 std::vector<PlaceCandidate> best_places(const PriorMap& map, const PlaceRecognizer& places,
