@@ -62,8 +62,8 @@ int run_localize_command(const LocalizeOptions& options) {
   const std::unique_ptr<FrameSource> source = options.source.open(!labels, config);
   LocalizeRunOptions run_options;
   run_options.truth_map_from_source = simulated_truth(map, source->info());
-  if (run_options.truth_map_from_source) run_options.map_error = map_error_against_source(map);
   if (run_options.truth_map_from_source) {
+    run_options.map_error = map_error_against_source(map);
     std::cout << "the map and the scans are passes of one simulated world: relocalisations are judged against the truth\n";
   }
   const LocalizeRunResult r = run_localize(*source, config, map, load_loop_network(config), options.out, run_options);

@@ -194,7 +194,7 @@ TEST(SegmenterSpec, ErrorsNameTheFileAndTheKey) {
 TEST(SegmenterSpec, MalformedYamlEndsWithAnErrorNotOutOfMemory) {
   // Found by the segmenter_spec fuzzer (fuzz/regressions/segmenter_spec/):
   // yaml-cpp's LoadAll on a flow sequence cut at its start took 5 GB and
-  // more without end; the documents are counted first (load_yaml_documents).
+  // more without end; the documents are counted first (load_yaml_document).
   const std::string yaml = ", remission], means:6\n  channels: [range, x]\nclasses: [unlabeled, car]\n";
   EXPECT_NE(error_of(yaml).find("/models/m.yaml: not valid YAML"), std::string::npos) << error_of(yaml);
 }

@@ -1,8 +1,10 @@
 #include "saloam/core/yaml_documents.hpp"
 
+#include <cstddef>
 #include <map>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -26,8 +28,11 @@ class Discard : public YAML::EventHandler {
   void OnMapEnd() override {}
 };
 
-}  // namespace
+constexpr std::size_t kMaxYamlDocuments = 64;
 
+// The documents of `text` that are not empty (null), in order; YAML::Exception
+// for invalid YAML and for more than kMaxYamlDocuments documents, counted
+// before LoadAll (load_yaml_document says why).
 std::vector<YAML::Node> load_yaml_documents(std::string_view text) {
   const std::string copy(text);
   {
@@ -45,6 +50,8 @@ std::vector<YAML::Node> load_yaml_documents(std::string_view text) {
   std::erase_if(documents, [](const YAML::Node& document) { return document.IsNull(); });
   return documents;
 }
+
+}  // namespace
 
 YamlDocument load_yaml_document(std::string_view text, std::string_view what) {
   YamlDocument document;

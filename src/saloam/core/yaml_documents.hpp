@@ -3,24 +3,12 @@
 // segmenter descriptions, data recipes) needs beyond yaml-cpp: its documents
 // read with a bound, and maps whose keys are names given once.
 
-#include <cstddef>
 #include <string>
 #include <string_view>
-#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
 namespace saloam {
-
-inline constexpr std::size_t kMaxYamlDocuments = 64;
-
-/// The documents of `text` that are not empty (null), in order. Throws
-/// YAML::Exception for invalid YAML and for more than kMaxYamlDocuments
-/// documents. (yaml-cpp 0.7's LoadAll never ends on some malformed texts,
-/// e.g. "&a," alone: the parser hands out the same empty document again and
-/// again, and LoadAll keeps them until memory runs out; so the documents are
-/// counted first.)
-std::vector<YAML::Node> load_yaml_documents(std::string_view text);
 
 /// A file that holds one YAML document (a configuration, a sensor profile, a
 /// segmenter description, a data recipe).
@@ -28,9 +16,13 @@ struct YamlDocument {
   YAML::Node root;      ///< the document; null for a text with none (an empty file)
   std::string problem;  ///< why there is no document, for an error message; empty: `root` is it
 };
-/// The one document of `text` (load_yaml_documents), or the problem:
-/// "not valid YAML (line 3): ..." or "holds 2 YAML documents (separated by
-/// '---'); a configuration is one" (`what`: "a configuration").
+/// The one document of `text`, or the problem: "not valid YAML (line 3):
+/// ..." or "holds 2 YAML documents (separated by '---'); a configuration is
+/// one" (`what`: "a configuration"). Empty documents are not counted. The
+/// documents are counted before they are loaded, and more than 64 are
+/// invalid: yaml-cpp 0.7's LoadAll never ends on some malformed texts (e.g.
+/// "&a," alone: the parser hands out the same empty document again and
+/// again, and LoadAll keeps them until memory runs out).
 YamlDocument load_yaml_document(std::string_view text, std::string_view what);
 
 /// What is wrong with the keys of the map `node`, as a phrase for an error

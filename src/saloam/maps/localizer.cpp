@@ -266,16 +266,7 @@ std::vector<Localizer::ProposedPlace> Localizer::propose_places(const LabelledCl
   std::stable_sort(proposed.begin(), proposed.end(), [](const ProposedPlace& a, const ProposedPlace& b) {
     return a.candidate.match.score > b.candidate.match.score;
   });
-  std::vector<ProposedPlace> chosen;
-  for (const ProposedPlace& p : proposed) {
-    if (chosen.size() >= n) break;
-    const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](const ProposedPlace& o) {
-      return (map_.pose(o.candidate.keyframe).translation() - map_.pose(p.candidate.keyframe).translation()).norm() <
-             kSamePlaceDistance;
-    });
-    if (!same_place) chosen.push_back(p);
-  }
-  return chosen;
+  return one_per_place(map_, proposed, n, [](const ProposedPlace& p) { return p.candidate.keyframe; });
 }
 
 void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {

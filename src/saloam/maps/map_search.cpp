@@ -68,15 +68,7 @@ std::vector<PlaceCandidate> best_places(const PriorMap& map, const PlaceRecogniz
   std::sort(above.begin(), above.end(), [](const PlaceCandidate& a, const PlaceCandidate& b) {
     return a.match.score != b.match.score ? a.match.score > b.match.score : a.keyframe < b.keyframe;
   });
-  std::vector<PlaceCandidate> chosen;
-  for (const PlaceCandidate& c : above) {
-    if (chosen.size() >= count) break;
-    const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](const PlaceCandidate& o) {
-      return (map.pose(o.keyframe).translation() - map.pose(c.keyframe).translation()).norm() < kSamePlaceDistance;
-    });
-    if (!same_place) chosen.push_back(c);
-  }
-  return chosen;
+  return one_per_place(map, above, count, [](const PlaceCandidate& c) { return c.keyframe; });
 }
 
 LoopSubmap submap_around(const PriorMap& map, std::size_t match, std::size_t half_width,

@@ -4,6 +4,7 @@
 // place descriptors score best against a query, the verification submap
 // around one of them, and the map keyframes near a position.
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -25,6 +26,23 @@ struct PlaceCandidate {
   std::size_t keyframe = 0;
   PlaceMatch match;
 };
+
+/// The first `count` of `ranked` (best first; `keyframe_of(item)` its map
+/// keyframe), skipping any within kSamePlaceDistance of one already taken.
+template <class Item, class KeyframeOf>
+std::vector<Item> one_per_place(const PriorMap& map, const std::vector<Item>& ranked, std::size_t count,
+                                KeyframeOf keyframe_of) {
+  std::vector<Item> chosen;
+  for (const Item& item : ranked) {
+    if (chosen.size() >= count) break;
+    const Eigen::Vector3d position = map.pose(keyframe_of(item)).translation();
+    const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](const Item& other) {
+      return (map.pose(keyframe_of(other)).translation() - position).norm() < kSamePlaceDistance;
+    });
+    if (!same_place) chosen.push_back(item);
+  }
+  return chosen;
+}
 
 /// Verification of a place found with no prior (a search of the whole map,
 /// by localisation or by the joining of sessions): the loop verification's

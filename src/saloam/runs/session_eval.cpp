@@ -84,16 +84,13 @@ KeyframeAlignment align_keyframes(const SavedMap& map, const std::vector<std::ve
   out.world = keyframe_truth(map, sessions, truth);
   // The map frame: the LiDAR frame of session 0's first keyframe.
   const Pose map_from_world = out.world.front().inverse();
-  std::vector<Eigen::Vector3d> estimated, reference;
+  std::vector<Eigen::Vector3d> estimated, reference, linked_estimated, linked_reference;
   for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
     estimated.push_back(map.keyframes[k].pose.translation());
     reference.push_back((map_from_world * out.world[k]).translation());
-  }
-  std::vector<Eigen::Vector3d> linked_estimated, linked_reference;
-  for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
     if (!sessions[map.keyframes[k].session].linked) continue;
-    linked_estimated.push_back(estimated[k]);
-    linked_reference.push_back(reference[k]);
+    linked_estimated.push_back(estimated.back());
+    linked_reference.push_back(reference.back());
   }
   if (linked_estimated.size() < 3) throw std::invalid_argument("fewer than 3 linked keyframes: nothing to align");
   const SimilarityTransform s = umeyama_alignment(linked_estimated, linked_reference, false);
