@@ -65,7 +65,10 @@ int run_segment(SegmentArgs args) {
   std::cout << fmt::format("{} scans, {} points; segmentation stage per scan: median {:.1f} ms CPU, {:.1f} ms wall ({} "
                            "worker(s))\n",
                            result.frames, result.points, cpu.median, wall.median, config.segmentation.workers);
-  if (result.score) print_score(*result.score, *options.truth);
+  if (result.score) {
+    print_score(*result.score, *options.truth);
+    std::cout << fmt::format("score with its confusion matrix: {}\n", result.score_file.string());
+  }
   std::cout << fmt::format("wrote {} .label files to {}; picture {}\n", result.frames, args.out, result.picture.string());
   if (result.interrupted) {
     spdlog::warn("interrupted: {} scans labelled", result.frames);

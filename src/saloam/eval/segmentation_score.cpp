@@ -1,6 +1,8 @@
 #include "saloam/eval/segmentation_score.hpp"
 
+#include <cmath>
 #include <limits>
+#include <string>
 
 #include "saloam/core/error.hpp"
 
@@ -52,6 +54,23 @@ double SegmentationScore::accuracy() const {
     ok += confusion_[c][c];
   }
   return all == 0 ? 0.0 : static_cast<double>(ok) / static_cast<double>(all);
+}
+
+nlohmann::json SegmentationScore::to_json() const {
+  nlohmann::json iou = nlohmann::json::object(), points = nlohmann::json::object();
+  for (int c = 1; c < kNumLearningClasses; ++c) {
+    const double value = this->iou(c);
+    if (std::isnan(value)) continue;
+    const std::string name(learning_class_name(static_cast<std::uint8_t>(c)));
+    iou[name] = value;
+    points[name] = truth_count(c);
+  }
+  const double mean = miou();
+  return {{"miou", std::isnan(mean) ? nlohmann::json() : nlohmann::json(mean)},
+          {"accuracy", accuracy()},
+          {"iou", iou},
+          {"points", points},
+          {"confusion", confusion_}};
 }
 
 }  // namespace saloam

@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "saloam/core/semantic_classes.hpp"
 
 namespace saloam {
@@ -25,6 +27,11 @@ class SegmentationScore {
   /// Fraction of (non-ignored) points labelled correctly.
   [[nodiscard]] double accuracy() const;
   [[nodiscard]] std::uint64_t truth_count(int learning_class) const;
+  /// mIoU, accuracy, per-class IoU and points (classes present in either
+  /// labelling, by name) and the confusion matrix (rows: truth, columns:
+  /// prediction, learning classes 0..19), from which scores over several
+  /// runs are pooled.
+  [[nodiscard]] nlohmann::json to_json() const;
 
  private:
   std::array<std::array<std::uint64_t, kNumLearningClasses>, kNumLearningClasses> confusion_{};

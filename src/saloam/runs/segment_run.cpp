@@ -7,6 +7,7 @@
 #include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
@@ -72,6 +73,14 @@ SegmentRunResult run_segmentation(FrameSource& source, const fs::path& out_dir, 
   }
   progress.finish();
   result.segment_times = segmentation_times(source);
+  if (result.score) {
+    nlohmann::json score = result.score->to_json();
+    score["truth"] = fs::absolute(*options.truth).lexically_normal().string();
+    score["frames"] = result.frames;
+    score["interrupted"] = result.interrupted;
+    result.score_file = out_dir / "score.json";
+    write_file_atomically(result.score_file, score.dump(1) + '\n');
+  }
   return result;
 }
 

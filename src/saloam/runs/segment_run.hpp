@@ -33,12 +33,15 @@ struct SegmentRunResult {
   std::size_t points = 0;
   std::vector<StageTime> segment_times;  ///< per frame: the segmentation stage's time
   std::optional<SegmentationScore> score;
+  std::filesystem::path score_file;  ///< score.json beside the labels (when scored)
   std::filesystem::path picture;
   bool interrupted = false;
 };
 
 /// Writes the labels of every frame of `source` (which has labels) into
-/// `out_dir` (created; never the source folder's own labels/ or labels_gt/).
+/// `out_dir` (created; never the source folder's own labels/ or labels_gt/),
+/// and, when scored, `out_dir/score.json` (SegmentationScore::to_json with
+/// the truth folder, the frames scored and whether the run was interrupted).
 SegmentRunResult run_segmentation(FrameSource& source, const std::filesystem::path& out_dir,
                                   const SegmentRunOptions& options);
 
