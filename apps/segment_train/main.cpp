@@ -34,6 +34,7 @@ namespace fs = std::filesystem;
 struct SegmentTrainArgs {
   std::string data, out, resume, widths = "16,32,64";
   std::vector<std::string> class_weights;  ///< NAME=FACTOR
+  std::vector<std::string> augments;       ///< NAME=VALUE
   bool no_cache = false;
   SegmentTrainOptions options;
 };
@@ -101,6 +102,11 @@ SegmentTrainOptions run_options(const SegmentTrainArgs& args, const CLI::App& ap
                                     args.out, args.out));
     options.shape.widths = parse_widths(args.widths);
     options.class_weight_factors = parse_class_weights(args.class_weights);
+    for (const std::string& item : args.augments) {
+      const auto eq = item.find('=');
+      if (eq == std::string::npos) throw ConfigError(fmt::format("--augment: expected NAME=VALUE, not '{}'", item));
+      set_augment_option(options.augment, item.substr(0, eq), item.substr(eq + 1));
+    }
     return options;
   }
   for (const auto* option : app.get_options())
@@ -172,6 +178,9 @@ std::function<int()> add_segment_train_options(CLI::App& app) {
   app.add_option("--class-weight", args->class_weights,
                  "CLASS=FACTOR: multiply a class's loss weight (1 / sqrt of its frequency) by FACTOR, e.g. pole=2 to "
                  "favour its recall (repeatable; weights are then scaled to mean 1)");
+  app.add_option("--augment", args->augments,
+                 "NAME=VALUE: set one augmentation (repeatable), e.g. remission_constant=0; names and defaults in "
+                 "docs/segmentation.md (training.json lists those used)");
   app.add_option("--seed", o.seed, "Seed of the initialisation, samples and augmentations")->capture_default_str();
   app.add_option("--threads", o.threads, "libtorch threads (results are reproducible for a fixed count)")
       ->check(CLI::Range(1, 256))

@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
+
+#include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/segmentation/segmenter_spec.hpp"
@@ -166,6 +169,69 @@ TEST(SegmentTrainer, RecipesNameBeamCountsAndSegmentationRefusesNoisyLabels) {
   std::ofstream(dir / "bad.yaml") << "train: [{simulate: 'preset:urban-loop', beams: 20}]\nvalidation: [{simulate: 'preset:urban-loop'}]\n";
   EXPECT_NE(testing::input_error_of([&] { (void)read_data_recipe(dir / "bad.yaml"); }).find("beams must be 64, 32 or 16"),
             std::string::npos);
+}
+
+TEST(SegmentTrainer, RecipeWeightsDrawSourcesAndCountTheirClassesAsOftenAsSaid) {
+  testing::TempDir dir;
+  std::ofstream(dir / "recipe.yaml") << "train: [{simulate: 'preset:urban-loop', weight: 4}, {simulate: 'preset:urban-loop'}]\n"
+                                        "validation: [{simulate: 'preset:urban-loop'}]\n";
+  const DataRecipe recipe = read_data_recipe(dir / "recipe.yaml");
+  EXPECT_EQ(recipe.train[0].weight, 4.0);
+  EXPECT_EQ(recipe.train[1].weight, 1.0);
+  EXPECT_EQ(recipe.train[0].to_json(), recipe.train[1].to_json()) << "the weight is not the data's identity (cache)";
+  EXPECT_EQ(recipe_to_json(recipe)["train"][0]["weight"], 4.0);
+  EXPECT_FALSE(recipe_to_json(recipe)["train"][1].contains("weight"));
+  for (const char* bad : {"0", "-1", "1001", ".nan"}) {
+    std::ofstream(dir / "bad.yaml") << "train: [{simulate: 'preset:urban-loop', weight: " << bad
+                                    << "}]\nvalidation: [{simulate: 'preset:urban-loop'}]\n";
+    EXPECT_NE(testing::input_error_of([&] { (void)read_data_recipe(dir / "bad.yaml"); }).find("weight must lie in (0, 1000]"),
+              std::string::npos)
+        << bad;
+  }
+  TrainingScanSet heavy = street();
+  heavy.weight = 3.0;
+  const auto once = class_counts({street()});
+  const auto mixed = class_counts({street(), heavy});
+  for (int c = 0; c < kNumLearningClasses; ++c) EXPECT_EQ(mixed[c], 4 * once[c]) << c;
+}
+
+/// The first `count` scans of sequence 00 of the real labelled scans
+/// (../shared/data/semantickitti_mini), unpacked into `dir`/00.
+fs::path real_sequence(const testing::TempDir& dir, int count) {
+  const fs::path archive = testing::shared_file("data/semantickitti_mini/semantickitti_mini.tar.xz");
+  std::string members;
+  for (int k = 0; k < count; ++k)
+    members += fmt::format(" semantickitti_mini/sequences/00/velodyne/{0:06d}.bin semantickitti_mini/sequences/00/labels/{0:06d}.label", k);
+  const std::string command = "tar -xJf " + testing::quoted(archive) + " -C " + testing::quoted(dir.path()) + members;
+  EXPECT_EQ(std::system(command.c_str()), 0) << command;
+  return dir / "semantickitti_mini/sequences/00";
+}
+
+TEST(SegmentTrainer, TrainingOnRealAndSimulatedScansLowersTheLoss) {
+  SALOAM_REQUIRE_SHARED_DATA();
+  testing::TempDir dir;
+  SourceSpec real;
+  real.kind = SourceSpec::Kind::kFolder;
+  real.path = real_sequence(dir, 2);
+  real.frame_step = 1;
+  real.weight = 2.0;
+  TrainingScanSet real_scans = build_training_scans(real, FeatureConfig{}, std::nullopt, false);
+  ASSERT_EQ(real_scans.scans.size(), 2U);
+  EXPECT_EQ(real_scans.scans[0].beams, 64);
+  EXPECT_GT(real_scans.scans[0].size(), 100000U);
+  EXPECT_EQ(real_scans.weight, 2.0);
+  std::size_t road = 0;
+  for (const auto t : real_scans.scans[0].target) road += t == 9;
+  EXPECT_GT(road, 10000U) << "SemanticKITTI's labels read as learning classes";
+
+  SegmentTrainOptions options = tiny_options(dir / "run");
+  options.epochs = 4;
+  options.samples_per_epoch = 8;
+  options.learning_rate = 1e-2;
+  set_training_threads(1);
+  const auto result = train_segmenter({real_scans, street()}, {real_scans}, options);
+  ASSERT_EQ(result.history.size(), 4U);
+  EXPECT_LT(result.history.back().loss, 0.8 * result.history.front().loss);
 }
 
 }  // namespace

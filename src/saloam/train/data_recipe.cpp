@@ -46,6 +46,13 @@ int read_beams(const YAML::Node& node, const fs::path& file, const std::string& 
   return beams;
 }
 
+double read_weight(const YAML::Node& node, const fs::path& file, const std::string& where) {
+  const double weight = node.as<double>();
+  if (!(weight > 0.0 && weight <= 1000.0))
+    throw InputError(file, fmt::format("{}: weight must lie in (0, 1000], not {}", where, node.Scalar()));
+  return weight;
+}
+
 /// InputError when a key of the map `node` at `where` (empty: the top) is not
 /// a name or is given twice (key_problem; yaml-cpp's own conversion error
 /// would not name the file).
@@ -89,6 +96,7 @@ SourceSpec read_source(const YAML::Node& node, const SourceSpec& defaults, const
       else if (key == "frames") spec.frames = kv.second.as<std::string>();
       else if (key == "frame_step") spec.frame_step = kv.second.as<std::size_t>();
       else if (key == "seed") spec.seed = kv.second.as<std::uint64_t>();
+      else if (key == "weight") spec.weight = read_weight(kv.second, file, where);
       else if (key == "beams" && spec.kind == SourceSpec::Kind::kSimulated) spec.beams = read_beams(kv.second, file, where);
       else if (key == "labels" && spec.kind == SourceSpec::Kind::kSimulated) {
         const auto v = kv.second.as<std::string>();
@@ -188,8 +196,12 @@ nlohmann::json recipe_to_json(const DataRecipe& recipe) {
   nlohmann::json j;
   j["train"] = nlohmann::json::array();
   j["validation"] = nlohmann::json::array();
-  for (const auto& s : recipe.train) j["train"].push_back(s.to_json());
-  for (const auto& s : recipe.validation) j["validation"].push_back(s.to_json());
+  for (const char* section : {"train", "validation"})
+    for (const auto& s : std::string(section) == "train" ? recipe.train : recipe.validation) {
+      nlohmann::json entry = s.to_json();
+      if (s.weight != 1.0) entry["weight"] = s.weight;
+      j[section].push_back(std::move(entry));
+    }
   return j;
 }
 

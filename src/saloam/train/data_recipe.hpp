@@ -6,7 +6,7 @@
 //
 //   defaults: {calib: FILE, frame_step: 5, seed: 1, labels: noisy, beams: 64}   (optional)
 //   train:      [{simulate: POSES.txt, frames: "0:4541"} | {simulate: "preset:urban-loop"} |
-//                {folder: DIR, labels: DIR}, ...]
+//                {folder: DIR, labels: DIR, weight: W}, ...]
 //   validation: [...]
 // Relative paths are relative to the recipe file.
 
@@ -35,6 +35,11 @@ struct SourceSpec {
   bool noisy_labels = true;     ///< simulated: emulated network labels (else ground truth)
   int beams = 64;               ///< simulated: 64, 32 or 16 beams
   std::filesystem::path labels; ///< folder: .label folder instead of labels/ (e.g. predictions)
+  /// Training draws each scan of this source `weight` times as often as a
+  /// scan of a weight-1 source: a few real scans beside thousands of
+  /// simulated ones get a share of the batches of their own. Not part of the
+  /// data's identity (name(), to_json(), the scan cache).
+  double weight = 1.0;
 
   /// A short name for messages and cache files: "sim-00-s1-k5-noisy", "sim-05-s3-k10-gt-b16", "folder-<dir>-k5".
   [[nodiscard]] std::string name() const;

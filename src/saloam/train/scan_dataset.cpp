@@ -5,8 +5,12 @@
 #include <fstream>
 #include <mutex>
 #include <random>
+#include <string>
+#include <type_traits>
+#include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
@@ -281,7 +285,7 @@ TrainingScanSet build_training_scans(const SourceSpec& spec, const FeatureConfig
                                  const std::optional<fs::path>& cache_dir, bool show_progress) {
   if (spec.kind == SourceSpec::Kind::kSimulated && spec.noisy_labels)
     throw InputError(spec.path, "segmentation trains on ground truth: set `labels: gt` (" + spec.name() + ")");
-  TrainingScanSet sequence{spec.name(), {}};
+  TrainingScanSet sequence{spec.name(), {}, spec.weight};
   const std::string key = cache_key(spec, rings);
   const fs::path cache = cache_dir ? *cache_dir / (spec.name() + ".scans") : fs::path();
   if (cache_dir)
@@ -297,9 +301,13 @@ TrainingScanSet build_training_scans(const SourceSpec& spec, const FeatureConfig
 
 std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<TrainingScanSet>& sequences) {
   std::array<std::uint64_t, kNumLearningClasses> counts{};
-  for (const auto& s : sequences)
+  for (const auto& s : sequences) {
+    std::array<std::uint64_t, kNumLearningClasses> set_counts{};
     for (const auto& scan : s.scans)
-      for (const auto t : scan.target) ++counts[t < kNumLearningClasses ? t : 0];
+      for (const auto t : scan.target) ++set_counts[t < kNumLearningClasses ? t : 0];
+    for (int c = 0; c < kNumLearningClasses; ++c)
+      counts[c] += static_cast<std::uint64_t>(std::llround(static_cast<double>(set_counts[c]) * s.weight));
+  }
   return counts;
 }
 
@@ -378,6 +386,39 @@ TrainingSample make_training_sample(const TrainingScan& scan, const ProjectionSp
       if (image.shown[src] >= 0) sample.target[dst] = a.target[static_cast<std::size_t>(image.shown[src])];
     }
   return sample;
+}
+
+void set_augment_option(ScanAugmentOptions& augment, std::string_view name, std::string_view value) {
+  bool found = false;
+  const std::string text(value);
+  visit_fields(augment, [&](std::string_view field, auto& member, std::string_view, auto... range) {
+    if (field != name) return;
+    found = true;
+    using T = std::decay_t<decltype(member)>;
+    if constexpr (std::is_same_v<T, bool>) {
+      if (text != "true" && text != "false")
+        throw ConfigError(fmt::format("--augment {}: expected true or false, not '{}'", name, text));
+      member = text == "true";
+    } else {
+      static_assert(sizeof...(range) == 1);
+      const Range r = (range, ...);
+      std::size_t used = 0;
+      double x = 0;
+      try {
+        x = std::stod(text, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != text.size() || !(x >= r.lo && x <= r.hi))
+        throw ConfigError(fmt::format("--augment {}: expected a number in [{:g}, {:g}], not '{}'", name, r.lo, r.hi, text));
+      member = x;
+    }
+  });
+  if (!found) {
+    std::vector<std::string> names;
+    visit_fields(augment, [&](std::string_view field, auto&&...) { names.emplace_back(field); });
+    throw ConfigError(fmt::format("--augment: unknown augmentation '{}' ({})", name, fmt::join(names, ", ")));
+  }
 }
 
 }  // namespace saloam

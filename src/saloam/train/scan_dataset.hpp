@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "saloam/core/config.hpp"
@@ -40,6 +41,7 @@ TrainingScan compact_scan(const LabelledCloud& cloud, const std::vector<std::int
 struct TrainingScanSet {
   std::string name;
   std::vector<TrainingScan> scans;
+  double weight = 1.0;  ///< how often training draws each scan, relative to a weight-1 set's (SourceSpec::weight)
 };
 
 /// The scans of one source, every k-th frame: simulated ones rendered in
@@ -51,7 +53,9 @@ struct TrainingScanSet {
 TrainingScanSet build_training_scans(const SourceSpec& spec, const FeatureConfig& rings,
                                  const std::optional<std::filesystem::path>& cache_dir, bool show_progress);
 
-/// Points per learning class over all scans (class frequencies of the loss weights).
+/// Points per learning class over all scans, each set's counted `weight`
+/// times (rounded): the class frequencies that training sees, which the loss
+/// weights balance.
 std::array<std::uint64_t, kNumLearningClasses> class_counts(const std::vector<TrainingScanSet>& sequences);
 
 /// Mean and standard deviation of each channel over the pixels with a point
@@ -76,6 +80,31 @@ struct ScanAugmentOptions {
   double remission_offset = 0.1;       ///< b uniform in [-x, x]
   double remission_noise = 0.05;       ///< per-point Gaussian sigma uniform in [0, max]
 };
+
+/// Calls v(name, member, description, range) for every augmentation (bool:
+/// v(name, member, description)): the one list that training.json, the
+/// checkpoint and `segment-train --augment NAME=VALUE` share.
+template <class Visitor>
+void visit_fields(ScanAugmentOptions& a, Visitor&& v) {
+  v("rotate", a.rotate, "yaw uniform in [0, 2 pi)");
+  v("flip", a.flip, "probability of mirroring y", Range{0, 1});
+  v("max_tilt_deg", a.max_tilt_deg, "[deg] pitch and roll uniform in [-max, max]", Range{0, 30});
+  v("max_height_shift", a.max_height_shift, "[m] z shift uniform in [-max, max]", Range{0, 5});
+  v("max_range_noise", a.max_range_noise, "[m] sigma of range noise uniform in [0, max]", Range{0, 1});
+  v("max_point_dropout", a.max_point_dropout, "fraction of points lost, uniform in [0, max]", Range{0, 0.95});
+  v("max_ring_dropout", a.max_ring_dropout, "fraction of rings lost, uniform in [0, max]", Range{0, 0.95});
+  v("occlusion", a.occlusion, "probability of occluded azimuth sectors", Range{0, 1});
+  v("remission_constant", a.remission_constant, "probability that remission is replaced by a constant", Range{0, 1});
+  v("remission_gamma", a.remission_gamma, "remission gamma in [1/max, max] (1: none)", Range{1, 10});
+  v("remission_gain", a.remission_gain, "remission gain in [1 - x, 1 + x]", Range{0, 1});
+  v("remission_offset", a.remission_offset, "remission offset in [-x, x]", Range{0, 1});
+  v("remission_noise", a.remission_noise, "per-point remission noise sigma in [0, max]", Range{0, 1});
+}
+
+/// Sets the augmentation `name` from text ("0.1"; "true"/"false" for rotate):
+/// the one check of a value from the command line. ConfigError naming the
+/// augmentation for an unknown name, unreadable text or a value out of range.
+void set_augment_option(ScanAugmentOptions& augment, std::string_view name, std::string_view value);
 
 /// One training sample: the normalised image (C x rows x cols) and the target
 /// class of every pixel (the class of the point it shows; 0 = no point or

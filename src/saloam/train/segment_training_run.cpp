@@ -10,6 +10,8 @@
 #include <fstream>
 #include <future>
 #include <map>
+#include <string_view>
+#include <type_traits>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -45,8 +47,21 @@ std::array<double, kNumLearningClasses> class_factors_from_json(const nlohmann::
   return factors;
 }
 
+nlohmann::json augment_json(ScanAugmentOptions augment) {
+  nlohmann::json j = nlohmann::json::object();
+  visit_fields(augment, [&](std::string_view name, const auto& member, auto&&...) { j[std::string(name)] = member; });
+  return j;
+}
+
+ScanAugmentOptions augment_from_json(const nlohmann::json& j) {
+  ScanAugmentOptions augment;
+  visit_fields(augment, [&](std::string_view name, auto& member, auto&&...) {
+    member = j.at(std::string(name)).get<std::decay_t<decltype(member)>>();
+  });
+  return augment;
+}
+
 nlohmann::json options_json(const SegmentTrainOptions& o) {
-  const auto& a = o.augment;
   return {{"samples_per_epoch", o.samples_per_epoch},
           {"batch", o.batch},
           {"pixels_per_sample", o.pixels_per_sample},
@@ -62,20 +77,7 @@ nlohmann::json options_json(const SegmentTrainOptions& o) {
           {"context_blocks", o.shape.context_blocks},
           {"validation_scans", o.validation_scans},
           {"init", o.init.empty() ? std::string("scratch") : fs::absolute(o.init).lexically_normal().string()},
-          {"augment",
-           {{"rotate", a.rotate},
-            {"flip", a.flip},
-            {"max_tilt_deg", a.max_tilt_deg},
-            {"max_height_shift", a.max_height_shift},
-            {"max_range_noise", a.max_range_noise},
-            {"max_point_dropout", a.max_point_dropout},
-            {"max_ring_dropout", a.max_ring_dropout},
-            {"occlusion", a.occlusion},
-            {"remission_constant", a.remission_constant},
-            {"remission_gamma", a.remission_gamma},
-            {"remission_gain", a.remission_gain},
-            {"remission_offset", a.remission_offset},
-            {"remission_noise", a.remission_noise}}}};
+          {"augment", augment_json(o.augment)}};
 }
 
 SegmentTrainOptions options_from_json(const nlohmann::json& j, SegmentTrainOptions o) {
@@ -94,21 +96,7 @@ SegmentTrainOptions options_from_json(const nlohmann::json& j, SegmentTrainOptio
   o.shape.context_blocks = j.at("context_blocks").get<int>();
   o.validation_scans = j.at("validation_scans").get<std::size_t>();
   if (const auto init = j.value("init", std::string("scratch")); init != "scratch") o.init = init;
-  const auto& a = j.at("augment");
-  auto& t = o.augment;
-  t.rotate = a.at("rotate").get<bool>();
-  t.flip = a.at("flip").get<double>();
-  t.max_tilt_deg = a.at("max_tilt_deg").get<double>();
-  t.max_height_shift = a.at("max_height_shift").get<double>();
-  t.max_range_noise = a.at("max_range_noise").get<double>();
-  t.max_point_dropout = a.at("max_point_dropout").get<double>();
-  t.max_ring_dropout = a.at("max_ring_dropout").get<double>();
-  t.occlusion = a.at("occlusion").get<double>();
-  t.remission_constant = a.at("remission_constant").get<double>();
-  t.remission_gamma = a.at("remission_gamma").get<double>();
-  t.remission_gain = a.at("remission_gain").get<double>();
-  t.remission_offset = a.at("remission_offset").get<double>();
-  t.remission_noise = a.at("remission_noise").get<double>();
+  o.augment = augment_from_json(j.at("augment"));
   return o;
 }
 
@@ -155,17 +143,25 @@ struct PlannedSample {
 };
 using Batch = std::vector<PlannedSample>;
 
-/// The batches of one epoch: scans drawn uniformly, grouped by beam count
-/// into batches, in random order.
+/// The batches of one epoch: scans drawn with their set's weight (uniformly
+/// when every set weighs the same), grouped by beam count into batches, in
+/// random order.
 std::vector<Batch> plan_epoch(const std::vector<TrainingScanSet>& train, const SegmentTrainOptions& options, int epoch) {
   std::vector<PlannedSample> all;
+  std::vector<double> weights;
   for (std::uint32_t s = 0; s < train.size(); ++s)
-    for (std::uint32_t k = 0; k < train[s].scans.size(); ++k) all.push_back({s, k, 0});
+    for (std::uint32_t k = 0; k < train[s].scans.size(); ++k) {
+      all.push_back({s, k, 0});
+      weights.push_back(train[s].weight);
+    }
+  const bool uniform = std::all_of(train.begin(), train.end(), [&](const auto& s) { return s.weight == train[0].weight; });
   std::mt19937_64 rng = epoch_generator(options.seed, epoch);
-  std::uniform_int_distribution<std::size_t> pick(0, all.size() - 1);
+  std::uniform_int_distribution<std::size_t> pick_uniform(0, all.size() - 1);
+  std::discrete_distribution<std::size_t> pick_weighted(weights.begin(), weights.end());
+  const auto pick = [&] { return uniform ? pick_uniform(rng) : pick_weighted(rng); };
   std::map<int, Batch> by_beams;
   for (std::size_t j = 0; j < options.samples_per_epoch; ++j) {
-    PlannedSample sample = all[pick(rng)];
+    PlannedSample sample = all[pick()];
     sample.seed = rng();
     by_beams[train[sample.sequence].scans[sample.scan].beams].push_back(sample);
   }
