@@ -44,6 +44,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         SALOAM_FUZZ_CHECK(session_keyframes == m.keyframes);
         check_pose(m.velo_to_cam);
         (void)parse_place_detector(m.detector);
+        if (m.version >= 3) SALOAM_FUZZ_CHECK(m.id.size() == 32 && m.digests.size() == std::size(kMapDigestedFiles));
         break;
       }
       case 1: {

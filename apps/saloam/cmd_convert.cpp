@@ -55,6 +55,8 @@ SequenceWriteOptions write_options(const ConvertArgs& args) {
 }
 
 int run_convert(const ConvertArgs& args) {
+  PathRules rules;
+  args.source.add_inputs(rules).output("--out", args.out, OutputUse::kFolder).check();
   const SequenceWriteOptions options = write_options(args);  // before anything is read
   SaloamConfig config = args.config.resolve();
   const auto source = args.source.open(args.no_labels, config);

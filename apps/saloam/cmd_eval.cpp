@@ -75,24 +75,12 @@ void warn_if_scans_were_taken_elsewhere(const std::filesystem::path& gt_file) {
                gt_file.string(), sensor.filename().string(), sensor.string());
 }
 
-/// eval's outputs never replace its inputs, nor each other.
-void check_outputs(const EvalOptions& options) {
-  const std::pair<const char*, const std::string*> inputs[] = {
-      {"--gt", &options.gt_file}, {"--est", &options.est_file}, {"--calib", &options.calib_file}};
-  const std::pair<const char*, const std::string*> outputs[] = {{"--json", &options.json_file},
-                                                                {"--plot", &options.plot_file}};
-  for (const auto& [option, output] : outputs) {
-    for (const auto& [input_option, input] : inputs) {
-      std::error_code error;
-      if (output->empty() || input->empty() || !std::filesystem::equivalent(*output, *input, error)) continue;
-      throw ConfigError(fmt::format("{} {} is the {} file: eval never overwrites its inputs", option, *output,
-                                    input_option));
-    }
-  }
-  if (!options.json_file.empty() && std::filesystem::path(options.json_file).lexically_normal() ==
-                                        std::filesystem::path(options.plot_file).lexically_normal()) {
-    throw ConfigError(fmt::format("--json and --plot name the same file {}", options.json_file));
-  }
+/// eval's outputs never equal, hold or lie inside its inputs (core/path_rules.hpp), nor each other.
+void check_paths(const EvalOptions& options) {
+  PathRules rules;
+  for (const std::string& gt : options.gt_files) rules.input("--gt", gt);
+  rules.input("--est", options.est_file).input("--calib", options.calib_file).input("--map", options.map);
+  rules.output("--json", options.json_file).output("--plot", options.plot_file).check();
 }
 
 /// `trajectory` from its `skip`-th pose on, re-based on that pose (world =
@@ -133,12 +121,6 @@ int run_map_eval(const EvalOptions& options) {
     throw ConfigError("--map evaluates a map's sessions against their sequences (one SE(3) alignment): --est, "
                       "--plot, --calib and --align do not apply");
   }
-  for (const std::string& gt : options.gt_files) {
-    std::error_code error;
-    if (!options.json_file.empty() && std::filesystem::equivalent(options.json_file, gt, error)) {
-      throw ConfigError(fmt::format("--json {} is a --gt input: eval never overwrites its inputs", options.json_file));
-    }
-  }
   const SavedMap map = read_map(options.map);
   std::vector<std::vector<Pose>> truth;
   for (const std::string& gt : options.gt_files) truth.push_back(read_sequence_truth(gt));
@@ -159,12 +141,12 @@ int run_map_eval(const EvalOptions& options) {
 }
 
 int run_eval(EvalOptions options) {
+  check_paths(options);
   if (!options.map.empty()) return run_map_eval(options);
   if (options.gt_files.size() != 1 || options.est_file.empty()) {
     throw ConfigError("eval compares one --gt with one --est (several --gt only with --map)");
   }
   options.gt_file = options.gt_files.front();
-  check_outputs(options);
   warn_if_scans_were_taken_elsewhere(options.gt_file);
   TrajectoryFormat gt_format{}, est_format{};
   Trajectory gt = read_trajectory(options.gt_file, &gt_format);

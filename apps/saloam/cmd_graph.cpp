@@ -24,6 +24,7 @@ struct GraphArgs {
 };
 
 int run_graph(const GraphArgs& args) {
+  PathRules().input("sequence", args.sequence).input("--labels", args.labels).output("--out", args.out).check();
   SequenceOptions options;
   if (!args.labels.empty()) options.labels_dir = args.labels;
   const SequenceReader reader(args.sequence, options);

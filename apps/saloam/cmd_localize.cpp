@@ -43,6 +43,8 @@ std::optional<Pose> simulated_truth(const PriorMap& map, const SourceInfo& info)
 }
 
 int run_localize_command(const LocalizeOptions& options) {
+  PathRules rules;
+  options.source.add_inputs(rules).input("--map", options.map).output("--out", options.out, OutputUse::kFolder).check();
   const StageTimer load_timer;
   // The map's own configuration (its detector made the descriptors), a
   // --config instead, then --set on top.

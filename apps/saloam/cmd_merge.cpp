@@ -9,6 +9,7 @@
 
 #include "command.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/path_rules.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/maps/map_format.hpp"
 #include "saloam/maps/prior_map.hpp"
@@ -25,13 +26,11 @@ struct MergeOptions {
 };
 
 int run_merge_command(const MergeOptions& options) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  for (const std::string& input : {options.map_a, options.map_b}) {
-    if (fs::weakly_canonical(input, ec) == fs::weakly_canonical(options.out, ec)) {
-      throw InputError(options.out, "is one of the maps merged: inputs are never overwritten (choose another --out)");
-    }
-  }
+  PathRules()
+      .input("MAP_A", options.map_a)
+      .input("MAP_B", options.map_b)
+      .output("--out", options.out, OutputUse::kReplacedFolder)
+      .check();
   const StageTimer timer;
   SavedMap a = read_map(options.map_a);
   SaloamConfig config = options.config.resolve_for_map(a.config);

@@ -25,6 +25,8 @@ struct OdomOptions {
 };
 
 int run_odom(const OdomOptions& options) {
+  PathRules rules;
+  options.source.add_inputs(rules).output("--out", options.out, OutputUse::kFolder).check();
   SaloamConfig config = options.config.resolve();
   if (options.no_semantics) config.odometry.use_semantics = false;
   const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics, config);

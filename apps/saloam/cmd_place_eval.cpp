@@ -48,6 +48,9 @@ void print_result(const PlaceEvalArgs& args, const PlaceEvalResult& r, const std
 }
 
 int run_place_eval_command(PlaceEvalArgs args) {
+  PathRules rules;
+  args.source.add_inputs(rules).input("--graphs", args.graphs).output("--out", args.out.empty() ? "place_eval_" + args.run.method : args.out, OutputUse::kFolder)
+      .check();
   PlaceEvalOptions& run = args.run;
   if (!args.graphs.empty()) run.graphs = args.graphs;
   run.graph.use_instances = !args.no_instances;

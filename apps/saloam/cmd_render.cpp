@@ -26,6 +26,7 @@ struct RenderArgs {
 };
 
 int run_render(const RenderArgs& args) {
+  PathRules().input("sequence", args.sequence).output("--out", args.out, OutputUse::kFolder).check();
   const std::filesystem::path out(args.out);
   create_folder(out);
   SequenceOptions seq_options;

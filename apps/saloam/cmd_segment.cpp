@@ -49,6 +49,8 @@ void print_score(const SegmentationScore& score, const fs::path& truth) {
 }
 
 int run_segment(SegmentArgs args) {
+  PathRules rules;
+  args.source.add_inputs(rules).input("--truth", args.truth).output("--out", args.out, OutputUse::kFolder).check();
   SaloamConfig config = args.config.resolve();
   args.source.segment.segment = true;
   args.source.no_calib = true;  // labels need no calibration

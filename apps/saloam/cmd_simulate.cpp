@@ -102,6 +102,11 @@ int write_in_layout(const SimulationOptions& options, const SimulateArgs& args) 
 }
 
 int run_simulate(const SimulateArgs& args) {
+  PathRules()
+      .input("--trajectory", args.trajectory)
+      .input("--calib", args.calib)
+      .output("--out", args.out, OutputUse::kReplacedFolder)
+      .check();
   const SimulationOptions options = simulation_options(args);
   const std::string source = args.trajectory.empty() ? "preset " + options.preset : args.trajectory;
   if (args.out.empty()) {

@@ -36,10 +36,6 @@ struct SlamOptions {
 /// --save-map is missing or names the map itself (inputs are never replaced).
 std::unique_ptr<PriorMap> open_join_map(const SlamOptions& options, SaloamConfig& config) {
   if (options.save_map.empty()) throw InputError(options.map, "--map needs --save-map: the joined map is a new map");
-  std::error_code ec;
-  if (std::filesystem::weakly_canonical(options.map, ec) == std::filesystem::weakly_canonical(options.save_map, ec)) {
-    throw InputError(options.save_map, "is the map given with --map: inputs are never overwritten (choose another --save-map)");
-  }
   SavedMap saved = read_map(options.map);
   if (!options.detector.empty()) throw InputError(options.map, "--detector with --map: the map's detector is used");
   config = options.config.resolve_for_map(saved.config);
@@ -88,6 +84,12 @@ void write_view_page(OutputFolder& folder) {
 }
 
 int run_slam_command(const SlamOptions& options) {
+  PathRules rules;
+  options.source.add_inputs(rules)
+      .input("--map", options.map)
+      .output("--out", options.out, OutputUse::kFolder)
+      .output("--save-map", options.save_map, OutputUse::kReplacedFolder)
+      .check();
   SaloamConfig config = options.config.resolve();
   if (!options.detector.empty()) apply_config_option(config, "--detector", "loop.detector", options.detector);
   std::unique_ptr<PriorMap> join_map;

@@ -51,6 +51,12 @@ void print_saved_map(const std::filesystem::path& map) {
 int write_page(const ViewOptions& options) {
   const std::filesystem::path page =
       options.page.empty() ? default_viewer_page(options.run_dir) : std::filesystem::path(options.page);
+  // A run's folder takes its page (the folder is joined); a saved map and a sequence are inputs only.
+  PathRules()
+      .input("--sequence", options.sequence)
+      .input("MAP", is_map_folder(options.run_dir) ? std::filesystem::path(options.run_dir) : std::filesystem::path())
+      .output("--out", page)
+      .check();
   std::error_code error;
   std::unique_ptr<OutputFolder> lock;
   if (std::filesystem::is_directory(options.run_dir, error) && !is_map_folder(options.run_dir)) {

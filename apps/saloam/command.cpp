@@ -221,6 +221,10 @@ SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
 }
 }  // namespace
 
+PathRules& SourceArgs::add_inputs(PathRules& rules) const {
+  return rules.input("SEQ_DIR", path).input("--labels", labels);
+}
+
 std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& config, SensorChoice* chosen) const {
   if (segment.enabled() && ignore_labels)
     throw ConfigError("--segment labels the scans, but this run does not use labels (--no-semantics, or a label-free "

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "saloam/core/config.hpp"
+#include "saloam/core/path_rules.hpp"
 #include "saloam/core/sensor_profile.hpp"
 #include "saloam/segmentation/segmented_source.hpp"
 #include "saloam/io/frame_source.hpp"
@@ -111,6 +112,8 @@ struct SourceArgs {
   /// before `config` sets up the segmentation stage; `chosen` receives it.
   [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, SaloamConfig& config,
                                                   SensorChoice* chosen = nullptr) const;
+  /// The paths it reads (SEQ_DIR, --labels) as inputs of `rules`.
+  PathRules& add_inputs(PathRules& rules) const;
 };
 
 /// The folder of the running program (from /proc/self/exe); none when it

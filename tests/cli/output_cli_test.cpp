@@ -191,8 +191,8 @@ TEST(InputsCli, EvalAndViewNeverOverwriteAnInput) {
       << output;
   const std::string gt = file_text(seq / "poses.txt"), est = file_text(tmp / "run/poses.txt");
   const std::string eval = fmt::format("eval --gt {} --est {}", quoted(seq / "poses.txt"), quoted(tmp / "run/poses.txt"));
-  expect_has(failure_of(eval + " --json " + quoted(seq / "poses.txt")), "is the --gt file: eval never overwrites");
-  expect_has(failure_of(eval + " --plot " + quoted(tmp / "run/../run/poses.txt")), "is the --est file");
+  expect_has(failure_of(eval + " --json " + quoted(seq / "poses.txt")), "is the input --gt");
+  expect_has(failure_of(eval + " --plot " + quoted(tmp / "run/../run/poses.txt")), "is the input --est");
   EXPECT_EQ(file_text(seq / "poses.txt"), gt);
   EXPECT_EQ(file_text(tmp / "run/poses.txt"), est);
 
@@ -202,9 +202,9 @@ TEST(InputsCli, EvalAndViewNeverOverwriteAnInput) {
   ASSERT_EQ(run_command(saloam_cmd(fmt::format("view {}", quoted(tmp / "run"))), &output), 0) << output;  // its own page
 
   // An output folder is never the sequence, nor any folder holding one.
-  expect_has(failure_of(fmt::format("odom {} --out {}", quoted(seq), quoted(seq))), "is the sequence folder");
+  expect_has(failure_of(fmt::format("odom {} --out {}", quoted(seq), quoted(seq))), "is the input SEQ_DIR");
   expect_has(failure_of(fmt::format("slam {} --out {}", quoted(seq), quoted(tmp / "run/.." / "seq"))),
-             "is the sequence folder");
+             "is the input SEQ_DIR");
 }
 
 TEST(InputsCli, SimulateReplacesAllOfAnEarlierSimulationAndNothingElse) {

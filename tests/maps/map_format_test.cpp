@@ -1,7 +1,12 @@
 // The saved map's format (docs/map_format.md): what is written reads back
 // the same, and the reader refuses broken maps, naming the file.
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstring>
 #include <fstream>
 #include <random>
@@ -10,6 +15,8 @@
 #include <nlohmann/json.hpp>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/folder_replace.hpp"
+#include "saloam/core/digest.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/maps/map_format.hpp"
 #include "saloam/maps/prior_map.hpp"
@@ -187,6 +194,54 @@ TEST(MapFormat, ReplacesAnEarlierMapButNothingElse) {
   EXPECT_TRUE(std::filesystem::exists(dir / "other" / "notes.txt"));
 }
 
+// A writer killed at any step of a replacement (each file of the new map,
+// the exchange or the renames, the removal of the old one) leaves a whole
+// map that the next reader finds: the old one before the step that puts the
+// new one in place, the new one from it on. The next writer tidies what the
+// killed one left, and nothing else stays beside the map.
+TEST(MapFormat, AWriterKilledAtAnyStepLeavesAWholeMap) {
+  const TestMap old_map = make_map(4);
+  const TestMap new_map = make_map(7);
+  for (const bool exchange : {true, false}) {
+    SCOPED_TRACE(exchange ? "renameat2 RENAME_EXCHANGE" : "two renames");
+    std::vector<std::string> steps;
+    {
+      testing::TempDir dir("saloam_map_steps");
+      write_test_map(dir / "map", old_map);
+      set_folder_replace_test_hooks([&](std::string_view step) { steps.emplace_back(step); }, exchange);
+      write_test_map(dir / "map", new_map);
+      set_folder_replace_test_hooks(nullptr);
+    }
+    const auto commit = std::find_if(steps.begin(), steps.end(),
+                                     [](const std::string& s) { return s == "exchanged" || s == "renamed"; });
+    ASSERT_NE(commit, steps.end());
+    ASSERT_EQ(steps.back(), "removed");
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      SCOPED_TRACE("killed at " + steps[k]);
+      testing::TempDir dir("saloam_map_kill");
+      write_test_map(dir / "map", old_map);
+      const pid_t child = ::fork();
+      ASSERT_GE(child, 0);
+      if (child == 0) {
+        std::size_t seen = 0;
+        set_folder_replace_test_hooks([&](std::string_view) { if (seen++ == k) ::kill(::getpid(), SIGKILL); }, exchange);
+        write_test_map(dir / "map", new_map);
+        ::_exit(0);
+      }
+      int status = 0;
+      ASSERT_EQ(::waitpid(child, &status, 0), child);
+      ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+      const std::size_t expected = k < static_cast<std::size_t>(commit - steps.begin()) ? 4u : 7u;
+      EXPECT_EQ(read_map(dir / "map").keyframes.size(), expected);
+      write_test_map(dir / "map", make_map(5));
+      EXPECT_EQ(read_map(dir / "map").keyframes.size(), 5u);
+      for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+        EXPECT_EQ(entry.path().filename(), "map") << "left behind: " << entry.path();
+      }
+    }
+  }
+}
+
 TEST(MapFormat, SessionsRoundTrip) {
   testing::TempDir dir("saloam_map_sessions");
   TestMap t = make_map(7);
@@ -245,6 +300,60 @@ void downgrade_to_version_1(const std::filesystem::path& folder) {
   });
 }
 
+// map.json's digests made those of the files as they are now (a test that
+// damages a file within what the digest sees, to reach the parser's checks).
+void refresh_digests(const std::filesystem::path& folder) {
+  edit_file(folder / "map.json", [&](std::string& b) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(b);
+    for (const std::string_view file : kMapDigestedFiles) {
+      std::ifstream in(folder / file, std::ios::binary);
+      const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+      j["digests"][std::string(file)] = digest_text(fnv1a64(bytes));
+    }
+    b = j.dump(2);
+  });
+}
+
+// A map knows itself (version 3): an id drawn at each save, the digest of
+// every file, and a configuration that holds every key.
+TEST(MapFormat, AMapKnowsItself) {
+  testing::TempDir dir("saloam_map_digests");
+  const TestMap t = make_map(4);
+  write_test_map(dir / "map", t);
+  const SavedMap read = read_map(dir / "map");
+  EXPECT_EQ(read.manifest.id.size(), 32u);
+  EXPECT_EQ(read.feature_digests.size(), 4u);
+  write_test_map(dir / "again", t);
+  EXPECT_NE(read_map(dir / "again").manifest.id, read.manifest.id);
+
+  // A keyframe's frame changed within bounds: its table no longer has its digest.
+  write_test_map(dir / "changed", t);
+  edit_file(dir / "changed/keyframes.bin", [](std::string& b) { b[24] = 9; });
+  std::string error = testing::input_error_of([&] { (void)read_map(dir / "changed"); });
+  EXPECT_NE(error.find((dir / "changed/keyframes.bin").string() + ": its digest"), std::string::npos) << error;
+
+  // config.yaml cut at a line: refused by its digest, and with the digest made to fit, by its missing keys.
+  write_test_map(dir / "cut", t);
+  edit_file(dir / "cut/config.yaml", [](std::string& b) { b.resize(b.find('\n', b.size() / 2) + 1); });
+  error = testing::input_error_of([&] { (void)read_map(dir / "cut"); });
+  EXPECT_NE(error.find("config.yaml: its digest"), std::string::npos) << error;
+  refresh_digests(dir / "cut");
+  error = testing::input_error_of([&] { (void)read_map(dir / "cut"); });
+  EXPECT_NE(error.find("config.yaml: holds no "), std::string::npos) << error;
+  EXPECT_NE(error.find("is the file cut?"), std::string::npos) << error;
+
+  // A map replaced while a run reads its features lazily: the run stops.
+  write_test_map(dir / "live", t);
+  const PriorMap live = PriorMap::open(dir / "live", 1);
+  EXPECT_EQ(live.features(0)->planar_points, t.features[0].planar_points);
+  TestMap other = make_map(4);
+  other.features[1].planar_points[0].x() += 1.0F;
+  write_test_map(dir / "live", other);
+  error = testing::input_error_of([&] { (void)live.features(1); });
+  EXPECT_NE(error.find("map replaced or changed under this run"), std::string::npos) << error;
+  EXPECT_NE(error.find((dir / "live/features/000001.bin").string()), std::string::npos) << error;
+}
+
 TEST(MapFormat, ReadsVersion1Maps) {
   testing::TempDir dir("saloam_map_v1");
   const TestMap t = make_map(5);
@@ -265,7 +374,7 @@ TEST(MapFormat, ReadsVersion1Maps) {
   }
   EXPECT_EQ(read.edges.size(), t.map.edges.size());
   EXPECT_EQ(read_map_features(dir / "map", 4).planar_points, t.features[4].planar_points);
-  // Written again, it is a version 2 map.
+  // Written again, it is a map of the current version.
   write_map(dir / "again", read, [&](std::size_t k) -> const StoredFeatures& { return t.features[k]; });
   EXPECT_EQ(read_map(dir / "again").manifest.version, kMapFormatVersion);
 }
@@ -278,6 +387,7 @@ TEST(MapFormat, ReaderNamesTheFileAndTheProblem) {
     const std::filesystem::path folder = dir / name;
     write_test_map(folder, t);
     edit_file(folder / file, edit);
+    if (file != "map.json") refresh_digests(folder);  // past the digests, to the parser's own checks
     std::string error = testing::input_error_of([&] {
       (void)read_map(folder);
       if (file.starts_with("features")) (void)read_map_features(folder, 0);
@@ -286,7 +396,7 @@ TEST(MapFormat, ReaderNamesTheFileAndTheProblem) {
     return error;
   };
   const auto put_double = [](std::string& bytes, std::size_t at, double v) { std::memcpy(bytes.data() + at, &v, 8); };
-  EXPECT_NE(broken("version", "keyframes.bin", [](std::string& b) { b[8] = 3; }).find("format version 3"),
+  EXPECT_NE(broken("version", "keyframes.bin", [](std::string& b) { b[8] = 4; }).find("format version 4"),
             std::string::npos);
   EXPECT_NE(broken("magic", "edges.bin", [](std::string& b) { b[0] = 'X'; }).find("magic"), std::string::npos);
   EXPECT_NE(broken("truncated", "places.bin", [](std::string& b) { b.resize(b.size() - 3); }).find("truncated"),

@@ -1,19 +1,18 @@
 // A saved map's folder (docs/map_format.md): written whole into a temporary
-// folder beside it and renamed into place, read back table by table with
-// every count and reference checked; the tables' bytes are map_format.cpp's.
-#include <sys/types.h>
-#include <unistd.h>
-
+// folder beside it and put in place in one atomic step
+// (core/folder_replace.hpp), read back table by table with every count and
+// reference checked; the tables' bytes are map_format.cpp's.
 #include <algorithm>
-#include <atomic>
-#include <cerrno>
-#include <csignal>
 #include <cstring>
+#include <random>
 
 #include <fmt/format.h>
+#include <yaml-cpp/yaml.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/folder_replace.hpp"
+#include "saloam/core/digest.hpp"
 #include "saloam/core/output_file.hpp"
 #include "saloam/maps/map_format.hpp"
 
@@ -30,11 +29,77 @@ namespace {
 constexpr std::size_t kMaxManifestBytes = std::size_t{1} << 20;
 constexpr std::size_t kMaxTableBytes = std::size_t{16} << 30;
 
-std::vector<std::byte> read_table(const fs::path& file) {
-  const std::string text = read_file(file, kMaxTableBytes, "map file");
+std::vector<std::byte> to_bytes(const std::string& text) {
   std::vector<std::byte> bytes(text.size());
   if (!text.empty()) std::memcpy(bytes.data(), text.data(), text.size());
   return bytes;
+}
+
+std::string_view as_text(const std::vector<std::byte>& bytes) {
+  return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+}
+
+// The bytes of one of the map's files, checked against the digest the
+// manifest holds for it (a map before version 3 has none).
+std::string read_checked(const fs::path& folder, const MapManifest& manifest, const std::string& name,
+                         std::size_t max_bytes) {
+  const fs::path file = folder / name;
+  std::string text = read_file(file, max_bytes, "map file");
+  const auto it = manifest.digests.find(name);
+  if (it != manifest.digests.end() && fnv1a64(text) != it->second) {
+    throw InputError(file, fmt::format("its digest {} is not the {} map.json lists: the file was cut or changed "
+                                       "after the map was saved",
+                                       digest_text(fnv1a64(text)), digest_text(it->second)));
+  }
+  return text;
+}
+
+std::vector<std::byte> read_table(const fs::path& folder, const MapManifest& manifest, const std::string& name) {
+  return to_bytes(read_checked(folder, manifest, name, kMaxTableBytes));
+}
+
+void collect_keys(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys) {
+  if (!node.IsMap()) {
+    keys.push_back(prefix);
+    return;
+  }
+  for (const auto& entry : node) {
+    const std::string key = entry.first.as<std::string>();
+    collect_keys(entry.second, prefix.empty() ? key : prefix + "." + key, keys);
+  }
+}
+
+bool holds_key(const YAML::Node& node, std::string_view key) {
+  if (!node.IsMap()) return false;
+  const std::size_t dot = key.find('.');
+  const YAML::Node next = node[std::string(key.substr(0, dot))];  // a const node: nothing is inserted
+  if (!next.IsDefined()) return false;
+  return dot == std::string_view::npos || holds_key(next, key.substr(dot + 1));
+}
+
+// The keys (dotted, e.g. "odometry.alpha") that config_to_yaml(`config`)
+// writes and `yaml_text` lacks.
+std::vector<std::string> missing_config_keys(std::string_view yaml_text, const SaloamConfig& config) {
+  std::vector<std::string> expected, missing;
+  collect_keys(YAML::Load(config_to_yaml(config)), "", expected);
+  YAML::Node given;
+  try {
+    given = YAML::Load(std::string(yaml_text));
+  } catch (const YAML::Exception&) {
+    return expected;
+  }
+  for (const std::string& key : expected) {
+    if (!holds_key(given, key)) missing.push_back(key);
+  }
+  return missing;
+}
+
+// A fresh map identity: 128 random bits as 32 hexadecimal digits.
+std::string new_map_id() {
+  std::random_device random;
+  std::string id;
+  for (int i = 0; i < 4; ++i) id += fmt::format("{:08x}", static_cast<std::uint32_t>(random()));
+  return id;
 }
 
 bool is_saloam_map(const fs::path& folder) {
@@ -45,21 +110,6 @@ bool is_saloam_map(const fs::path& folder) {
     return true;
   } catch (const InputError&) {
     return false;
-  }
-}
-
-// Temporary folders of killed writers of `target` ("NAME.partial-PID.N"
-// whose process is gone) are removed.
-void remove_stale_partials(const fs::path& target) {
-  std::error_code ec;
-  const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  const std::string prefix = target.filename().string() + ".partial-";
-  for (fs::directory_iterator it(parent, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (!name.starts_with(prefix) || !is_partial_output_name(name) || !it->is_directory(ec)) continue;
-    const std::string pid_text = name.substr(prefix.size(), name.find('.', prefix.size()) - prefix.size());
-    const long pid = std::strtol(pid_text.c_str(), nullptr, 10);
-    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(it->path(), ec);
   }
 }
 
@@ -97,12 +147,6 @@ void check_sessions(const SavedMap& map, const fs::path& keyframes_file) {
   }
 }
 
-// A fresh name for a temporary folder beside `target` ("NAME.partial-PID.N").
-fs::path partial_folder_name(const fs::path& target) {
-  static std::atomic<unsigned> counter{0};
-  return target.string() + fmt::format(".partial-{}.{}", static_cast<long>(::getpid()), counter.fetch_add(1));
-}
-
 // Removes a folder when it goes out of scope still armed.
 struct RemoveOnFailure {
   const fs::path& path;
@@ -134,37 +178,24 @@ MapManifest manifest_to_write(const SavedMap& map) {
 void write_map_tables(const fs::path& folder, const SavedMap& map,
                       const std::function<const StoredFeatures&(std::size_t)>& features) {
   create_folder(folder / "features");
-  const MapManifest manifest = manifest_to_write(map);
-  write_file_atomically(folder / "config.yaml", config_to_yaml(map.config));
-  const auto put = [&](const fs::path& file, const std::vector<std::byte>& bytes) {
-    write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  MapManifest manifest = manifest_to_write(map);
+  manifest.id = new_map_id();
+  const auto put = [&](const fs::path& file, std::string_view bytes) {
+    write_file_atomically(file, bytes);
+    folder_replace_step(file.filename().string());
+    return fnv1a64(bytes);
   };
-  put(folder / "keyframes.bin", encode_map_keyframes(map.keyframes));
-  put(folder / "edges.bin", encode_map_edges(map.edges));
-  put(folder / "places.bin", encode_map_places(map.places));
+  manifest.digests["config.yaml"] = put(folder / "config.yaml", config_to_yaml(map.config));
+  manifest.digests["keyframes.bin"] = put(folder / "keyframes.bin", as_text(encode_map_keyframes(map.keyframes)));
+  manifest.digests["edges.bin"] = put(folder / "edges.bin", as_text(encode_map_edges(map.edges)));
+  manifest.digests["places.bin"] = put(folder / "places.bin", as_text(encode_map_places(map.places)));
+  std::vector<std::uint64_t> feature_digests(map.keyframes.size());
   for (std::size_t k = 0; k < map.keyframes.size(); ++k) {
-    put(map_features_path(folder, k), encode_map_features(features(k)));
+    feature_digests[k] = put(map_features_path(folder, k), as_text(encode_map_features(features(k))));
   }
+  manifest.digests["digests.bin"] = put(folder / "digests.bin", as_text(encode_map_digests(feature_digests)));
   write_file_atomically(folder / "map.json", encode_map_manifest(manifest));
-}
-
-// Renames the finished `temporary` to `folder`. An earlier map of this name
-// goes aside first, and away once the new one is in place (back, when that fails).
-void replace_folder(const fs::path& folder, const fs::path& temporary) {
-  std::error_code ec;
-  fs::path previous;
-  if (path_taken(folder)) {
-    previous = partial_folder_name(folder);
-    fs::rename(folder, previous, ec);
-    if (ec) throw InputError(folder, fmt::format("cannot move the earlier map aside: {}", ec.message()));
-  }
-  fs::rename(temporary, folder, ec);
-  if (ec) {
-    std::error_code ignored;
-    if (!previous.empty()) fs::rename(previous, folder, ignored);
-    throw InputError(folder, fmt::format("cannot put the map in place: {}", ec.message()));
-  }
-  if (!previous.empty()) fs::remove_all(previous, ec);
+  folder_replace_step("map.json");
 }
 
 }  // namespace
@@ -181,7 +212,7 @@ void write_map(const fs::path& folder, const SavedMap& map,
   if (map.keyframes.empty()) throw InputError(folder, "no keyframe to save: the map would be empty");
   if (map.places.size() != map.keyframes.size()) throw InputError(folder, "one place descriptor per keyframe is needed");
   if (!folder.parent_path().empty()) create_folder(folder.parent_path());
-  remove_stale_partials(folder);
+  recover_folder(folder, is_saloam_map);
   const fs::path temporary = partial_folder_name(folder);
   RemoveOnFailure cleanup{temporary};
   write_map_tables(temporary, map, features);
@@ -191,39 +222,56 @@ void write_map(const fs::path& folder, const SavedMap& map,
 
 SavedMap read_map(const fs::path& folder) {
   std::error_code ec;
+  if (!path_taken(folder)) recover_folder(folder, is_saloam_map);  // a replacement killed between its renames
   if (!fs::is_directory(folder, ec)) {
+    std::string leftovers;
+    for (const fs::path& l : folder_leftovers(folder)) leftovers += (leftovers.empty() ? "" : ", ") + l.string();
     throw InputError(folder, path_taken(folder) ? "is not a folder: a saved map is a folder (map.json, ...)"
-                                                : "not found");
+                     : leftovers.empty()        ? "not found"
+                                                : "not found; a killed writer left " + leftovers);
   }
   SavedMap map;
   map.folder = folder;
   const fs::path manifest_file = folder / "map.json";
   map.manifest = parse_map_manifest(read_file(manifest_file, kMaxManifestBytes, "map manifest"), manifest_file);
   const fs::path config_file = folder / "config.yaml";
+  const std::string config_text = read_checked(folder, map.manifest, "config.yaml", kMaxConfigBytes);
   try {
-    map.config = load_config(config_file);
+    apply_config_yaml(map.config, config_text, config_file.string());
   } catch (const ConfigError& e) {
     throw InputError(config_file, e.what());
+  }
+  if (map.manifest.version >= 3) {  // written whole by saloam: a missing key is a cut file, never a default
+    const std::vector<std::string> missing = missing_config_keys(config_text, map.config);
+    if (!missing.empty()) {
+      throw InputError(config_file, fmt::format("holds no {} ({} keys missing): a map's configuration holds every key "
+                                                "(is the file cut?)",
+                                                missing.front(), missing.size()));
+    }
   }
   if (map.config.loop.detector != map.manifest.detector) {
     throw InputError(manifest_file, fmt::format("detector \"{}\", but config.yaml says loop.detector \"{}\"",
                                                 map.manifest.detector, map.config.loop.detector));
   }
   const fs::path keyframes_file = folder / "keyframes.bin";
-  map.keyframes = parse_map_keyframes(read_table(keyframes_file), keyframes_file);
+  map.keyframes = parse_map_keyframes(read_table(folder, map.manifest, "keyframes.bin"), keyframes_file);
   if (map.keyframes.size() != map.manifest.keyframes) {
     throw InputError(keyframes_file, fmt::format("{} keyframes, map.json says {}", map.keyframes.size(), map.manifest.keyframes));
   }
   check_sessions(map, keyframes_file);
   const fs::path edges_file = folder / "edges.bin";
-  map.edges = parse_map_edges(read_table(edges_file), map.keyframes.size(), edges_file);
+  map.edges = parse_map_edges(read_table(folder, map.manifest, "edges.bin"), map.keyframes.size(), edges_file);
   if (map.edges.size() != map.manifest.edges) {
     throw InputError(edges_file, fmt::format("{} edges, map.json says {}", map.edges.size(), map.manifest.edges));
   }
   const fs::path places_file = folder / "places.bin";
-  map.places = parse_map_places(read_table(places_file), map.config, places_file);
+  map.places = parse_map_places(read_table(folder, map.manifest, "places.bin"), map.config, places_file);
   if (map.places.size() != map.keyframes.size()) {
     throw InputError(places_file, fmt::format("{} descriptors for {} keyframes", map.places.size(), map.keyframes.size()));
+  }
+  if (map.manifest.version >= 3) {
+    map.feature_digests = parse_map_digests(read_table(folder, map.manifest, "digests.bin"), map.keyframes.size(),
+                                            folder / "digests.bin");
   }
   const PlaceDetector detector = parse_place_detector(map.manifest.detector);
   for (std::size_t k = 0; k < map.places.size(); ++k) {
@@ -240,7 +288,25 @@ SavedMap read_map(const fs::path& folder) {
 
 StoredFeatures read_map_features(const fs::path& folder, std::size_t keyframe) {
   const fs::path file = map_features_path(folder, keyframe);
-  return parse_map_features(read_table(file), file);
+  return parse_map_features(to_bytes(read_file(file, kMaxTableBytes, "map file")), file);
+}
+
+StoredFeatures read_map_features(const SavedMap& map, std::size_t keyframe) {
+  const fs::path file = map_features_path(map.folder, keyframe);
+  const std::string text = read_file(file, kMaxTableBytes, "map file");
+  if (keyframe < map.feature_digests.size() && fnv1a64(text) != map.feature_digests[keyframe]) {
+    std::string id;
+    try {
+      id = parse_map_manifest(read_file(map.folder / "map.json", kMaxManifestBytes, "map manifest"), map.folder / "map.json").id;
+    } catch (const InputError&) {
+      id = "unreadable";
+    }
+    throw InputError(file, fmt::format("map replaced or changed under this run: the file's digest is not the one the "
+                                       "map listed when the run read it ({}; map id {} then, {} now)",
+                                       map.folder.string(), map.manifest.id.empty() ? "none" : map.manifest.id,
+                                       id.empty() ? "none" : id));
+  }
+  return parse_map_features(to_bytes(text), file);
 }
 
 std::uintmax_t map_disk_bytes(const fs::path& folder) {

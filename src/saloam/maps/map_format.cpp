@@ -225,8 +225,22 @@ std::string encode_map_manifest(const MapManifest& m) {
                 {"keyframes", "keyframes.bin"},
                 {"edges", "edges.bin"},
                 {"places", "places.bin"},
-                {"features", "features/NNNNNN.bin"}};
+                {"features", "features/NNNNNN.bin"},
+                {"digests", "digests.bin"}};
+  j["id"] = m.id;
+  j["digest"] = "fnv1a-64";
+  j["digests"] = nlohmann::ordered_json::object();
+  for (const auto& [file, digest] : m.digests) j["digests"][file] = digest_text(digest);
   return j.dump(2) + '\n';
+}
+
+std::string digest_text(std::uint64_t digest) { return fmt::format("{:016x}", digest); }
+
+std::vector<std::byte> encode_map_digests(std::span<const std::uint64_t> digests) {
+  ByteWriter w;
+  w.header(MapTable::kDigests, digests.size());
+  for (const std::uint64_t d : digests) w.put(d);
+  return w.take();
 }
 
 std::vector<std::byte> encode_map_keyframes(std::span<const MapKeyframe> keyframes) {
@@ -380,6 +394,23 @@ MapManifest parse_map_manifest(std::string_view text, const fs::path& origin) {
   } else {
     m.sessions = {MapSession{m.source, m.first_frame, m.keyframes, true}};
   }
+  if (m.version >= 3) {
+    m.id = string_of("id");
+    if (m.id.size() != 32 || m.id.find_first_not_of("0123456789abcdef") != std::string::npos) {
+      throw InputError(origin, "\"id\" is not 32 hexadecimal digits");
+    }
+    if (string_of("digest") != "fnv1a-64") throw InputError(origin, "\"digest\" is not \"fnv1a-64\"");
+    const auto& digests = field("digests");
+    if (!digests.is_object()) throw InputError(origin, "\"digests\" is not an object");
+    for (const std::string_view file : kMapDigestedFiles) {
+      const auto it = digests.find(std::string(file));
+      if (it == digests.end() || !it->is_string() || it->get<std::string>().size() != 16 ||
+          it->get<std::string>().find_first_not_of("0123456789abcdef") != std::string::npos) {
+        throw InputError(origin, fmt::format("\"digests\" has no digest (16 hexadecimal digits) of {}", file));
+      }
+      m.digests[std::string(file)] = std::stoull(it->get<std::string>(), nullptr, 16);
+    }
+  }
   return m;
 }
 
@@ -529,6 +560,17 @@ std::vector<PlaceDescriptor> parse_map_places(std::span<const std::byte> bytes, 
   }
   r.finish();
   return places;
+}
+
+std::vector<std::uint64_t> parse_map_digests(std::span<const std::byte> bytes, std::size_t keyframes,
+                                             const fs::path& origin) {
+  ByteReader r(bytes, origin);
+  const std::size_t n = r.count(r.header(MapTable::kDigests), 8, "digests", kMaxMapKeyframes);
+  if (n != keyframes) r.fail(fmt::format("{} digests for {} keyframes", n, keyframes));
+  std::vector<std::uint64_t> digests(n);
+  for (std::uint64_t& d : digests) d = r.get<std::uint64_t>("a digest");
+  r.finish();
+  return digests;
 }
 
 StoredFeatures parse_map_features(std::span<const std::byte> bytes, const fs::path& origin) {

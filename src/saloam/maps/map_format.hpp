@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <map>
 #include <span>
 #include <string>
 #include <string_view>
@@ -42,14 +43,20 @@
 namespace saloam {
 
 /// Version written; the reader also reads every version from kMapFormatOldestVersion
-/// (version 1: one session, no session per keyframe).
-inline constexpr std::uint32_t kMapFormatVersion = 2;
+/// (version 1: one session, no session per keyframe; version 2: no map id
+/// and no digests, so nothing is checked against them).
+inline constexpr std::uint32_t kMapFormatVersion = 3;
 inline constexpr std::uint32_t kMapFormatOldestVersion = 1;
 inline constexpr std::string_view kMapFormatName = "saloam-map";
 inline constexpr std::string_view kMapMagic = "SALOAMAP";  ///< 8 bytes, no terminator in the files
 
 /// Table kinds of the binary files' headers.
-enum class MapTable : std::uint32_t { kKeyframes = 1, kEdges = 2, kPlaces = 3, kFeatures = 4 };
+enum class MapTable : std::uint32_t { kKeyframes = 1, kEdges = 2, kPlaces = 3, kFeatures = 4, kDigests = 5 };
+
+/// The files of a map whose digests map.json holds (version 3); each
+/// keyframe's features file has its digest in digests.bin.
+inline constexpr std::string_view kMapDigestedFiles[] = {"config.yaml", "keyframes.bin", "edges.bin", "places.bin",
+                                                         "digests.bin"};
 
 /// Bounds the reader enforces (a map beyond them is refused, naming the file).
 inline constexpr double kMaxMapCoordinate = 1.0e7;     ///< [m] pose translations
@@ -96,6 +103,12 @@ struct MapManifest {
   /// s-1). Version 1 maps read as one session (source, first_frame).
   std::vector<MapSession> sessions;
   std::uint64_t cross_session_loops = 0;  ///< loop edges between keyframes of different sessions
+  /// The map's identity (version 3): 32 hexadecimal digits drawn at random
+  /// each time a map is saved; "" for older versions.
+  std::string id;
+  /// FNV-1a 64 digest (core/hash.hpp) of each of kMapDigestedFiles (version
+  /// 3; empty for older versions).
+  std::map<std::string, std::uint64_t> digests;
 };
 
 /// Everything of a map but the feature clouds: what a run holds in memory.
@@ -106,6 +119,9 @@ struct SavedMap {
   std::vector<MapKeyframe> keyframes;
   std::vector<PoseGraphEdge> edges;
   std::vector<PlaceDescriptor> places;  ///< one per keyframe (empty parts: not used by the detector)
+  /// Digest of each keyframe's features file (digests.bin; empty for a map
+  /// before version 3): a features file read later is checked against it.
+  std::vector<std::uint64_t> feature_digests;
 };
 
 /// Writes `map` into `folder` (see above): features(k) gives keyframe k's
@@ -132,6 +148,10 @@ std::vector<MapSession> map_sessions(const SavedMap& map);
 std::filesystem::path map_features_path(const std::filesystem::path& folder, std::size_t keyframe);
 /// Reads and validates one keyframe's features.
 StoredFeatures read_map_features(const std::filesystem::path& folder, std::size_t keyframe);
+/// The same from the map `map` read (read_map), checked against its digest:
+/// a file that no longer matches (another run replaced the map, or the file
+/// was changed) is an InputError "map replaced or changed under this run".
+StoredFeatures read_map_features(const SavedMap& map, std::size_t keyframe);
 
 // The parsers behind the readers (also what the fuzz harness feeds): each
 // takes the bytes of one file and `origin`, the file named in errors.
@@ -144,6 +164,9 @@ std::vector<PoseGraphEdge> parse_map_edges(std::span<const std::byte> bytes, std
 std::vector<PlaceDescriptor> parse_map_places(std::span<const std::byte> bytes, const SaloamConfig& config,
                                               const std::filesystem::path& origin);
 StoredFeatures parse_map_features(std::span<const std::byte> bytes, const std::filesystem::path& origin);
+/// digests.bin: one FNV-1a 64 digest per keyframe's features file (`keyframes` of them).
+std::vector<std::uint64_t> parse_map_digests(std::span<const std::byte> bytes, std::size_t keyframes,
+                                             const std::filesystem::path& origin);
 
 // The encoders (write_map uses them; tests and the fuzz corpus too).
 std::string encode_map_manifest(const MapManifest& manifest);
@@ -151,6 +174,9 @@ std::vector<std::byte> encode_map_keyframes(std::span<const MapKeyframe> keyfram
 std::vector<std::byte> encode_map_edges(std::span<const PoseGraphEdge> edges);
 std::vector<std::byte> encode_map_places(std::span<const PlaceDescriptor> places);
 std::vector<std::byte> encode_map_features(const StoredFeatures& features);
+std::vector<std::byte> encode_map_digests(std::span<const std::uint64_t> digests);
+/// A digest as the manifest writes it (16 lower-case hexadecimal digits).
+std::string digest_text(std::uint64_t digest);
 
 /// Bytes the map takes on disk (every file in the folder).
 std::uintmax_t map_disk_bytes(const std::filesystem::path& folder);

@@ -23,7 +23,12 @@ PriorMap PriorMap::open(const std::filesystem::path& folder, std::size_t cached)
 }
 
 PriorMap PriorMap::open(const std::filesystem::path& folder, SavedMap saved, std::size_t cached) {
-  return PriorMap(std::move(saved), [folder](std::size_t k) { return read_map_features(folder, k); }, cached);
+  // What a features read checks against (folder, identity, digests), kept apart from the tables.
+  auto digests = std::make_shared<SavedMap>();
+  digests->folder = folder;
+  digests->manifest = saved.manifest;
+  digests->feature_digests = saved.feature_digests;
+  return PriorMap(std::move(saved), [digests](std::size_t k) { return read_map_features(*digests, k); }, cached);
 }
 
 std::shared_ptr<const StoredFeatures> PriorMap::features(std::size_t k) const {

@@ -249,15 +249,17 @@ ViewerScene load_map_viewer_scene(const fs::path& map_folder, const ViewerOption
   LabelledCloud map;
   map.has_labels = true;
   for (std::size_t k = 0; k < keyframes; ++k) {
-    const LabelledCloud cloud = features_cloud(read_map_features(map_folder, k), saved.keyframes[k].pose);
+    const LabelledCloud cloud = features_cloud(read_map_features(saved, k), saved.keyframes[k].pose);
     scene.map_points_total += cloud.size();
     const LabelledCloud part = decimate_cloud(cloud, share);
     for (std::size_t i = 0; i < part.size(); ++i) map.push_back_from(part, i);
   }
   scene.map = decimate_cloud(map, options.max_map_points);
-  scene.scan_of = [map_folder](std::size_t frame) {
-    return features_cloud(read_map_features(map_folder, frame), Pose::Identity());
-  };
+  auto digests = std::make_shared<SavedMap>();
+  digests->folder = saved.folder;
+  digests->manifest = saved.manifest;
+  digests->feature_digests = saved.feature_digests;
+  scene.scan_of = [digests](std::size_t frame) { return features_cloud(read_map_features(*digests, frame), Pose::Identity()); };
   return scene;
 }
 
