@@ -1,7 +1,8 @@
 // `saloam info PATH`: what a scan source holds before anything runs on it:
 // format, frames, rate, duration, point fields, beams, the sensor a run would
 // take (--sensor: the guess from the first scan by default), labels,
-// calibration, reference poses.
+// calibration, reference poses, and the reader's notes (where times,
+// calibration and reference come from, the intensity range found or given).
 
 #include <iostream>
 

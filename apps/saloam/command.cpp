@@ -17,6 +17,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/core/frame_range.hpp"
+#include "saloam/io/intensity_scale.hpp"
 #include "saloam/sources/open_source.hpp"
 #include "saloam/sources/sensor_guess.hpp"
 
@@ -196,6 +197,11 @@ void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
                  "Sensor profile: auto (guessed from the first scan), none, a shipped one (hdl64e, hdl32e, vlp16, os1-64, "
                  "os1-128: config/sensors/) or a profile file")
       ->capture_default_str();
+  app.add_option("--intensity-scale", intensity_scale,
+                 "What the scans' intensity values are divided by to make remission 0..1: auto (from the field's "
+                 "type or the first scan's values), 1 (KITTI), 255 (Velodyne drivers, most PCD/PLY), 65535 (uint16)")
+      ->check(CLI::IsMember(intensity_scale_names()))
+      ->capture_default_str();
   app.add_option("--labels", labels, "Folder of .label files (named like the scans) instead of SEQ_DIR/labels");
   app.add_option("--frames", frames, "Frame range A:B (B exclusive; A: = to the end)");
   segment.add_to(app);
@@ -213,6 +219,7 @@ SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
   if (!format) throw ConfigError(fmt::format("--format {}: not one of {}", args.format, fmt::join(scan_format_names(), ", ")));
   options.format = *format;
   options.topic = args.topic;
+  options.intensity_scale = parse_intensity_scale(args.intensity_scale);
   if (!args.labels.empty()) options.labels = args.labels;
   options.ignore_labels = ignore_labels;
   options.ignore_calib = args.no_calib;
@@ -233,6 +240,7 @@ std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& 
   SourceOptions options = source_options(*this, ignore_labels);
   options.segmentation = segment.stage(config);  // checks the model before anything is read
   auto reader = open_reader(path, options);
+  if (const auto intensity = intensity_note(reader->info().notes)) spdlog::info("{}", *intensity);
   SensorChoice choice = choose_sensor(sensor, *reader);
   if (choice.profile) {
     apply_sensor_profile(*choice.profile, config.odometry.features);

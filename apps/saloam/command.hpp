@@ -68,7 +68,7 @@ struct SegmentOptions {
 /// The options that choose a run's frames, shared by the commands that read
 /// a source (odom, slam, place-eval, bench, info, convert, segment): SEQ_DIR
 /// (any layout of sources/source_options.hpp), --format, --topic, --sensor,
-/// --labels, --frames and the segmentation's options;
+/// --intensity-scale, --labels, --frames and the segmentation's options;
 /// commands where calibration matters add --no-calib (add_no_calib_flag).
 /// Call `open()` after parsing.
 /// The sensor profile a run works with (--sensor), and how it was chosen.
@@ -96,6 +96,7 @@ struct SourceArgs {
   std::string format = "auto";
   std::string sensor = "auto";
   std::string topic;
+  std::string intensity_scale = "auto";
   std::string labels;
   std::string frames;
   bool no_calib = false;
@@ -107,7 +108,8 @@ struct SourceArgs {
   void add_with_no_calib_to(CLI::App& app);
   /// open_source() with these options; whether labels are read is the
   /// command's choice (ConfigError when it ignores them but --segment asks
-  /// for them). The sensor (--sensor, chosen on the reader and said in one
+  /// for them). The intensity range the reader found or was given is said
+  /// in one log line. The sensor (--sensor, chosen on the reader and said in one
   /// log line) goes into config.odometry.features (apply_sensor_profile)
   /// before `config` sets up the segmentation stage; `chosen` receives it.
   [[nodiscard]] std::unique_ptr<FrameSource> open(bool ignore_labels, SaloamConfig& config,

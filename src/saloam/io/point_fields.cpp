@@ -208,6 +208,7 @@ DecodedCloud CloudAssembler::decoded(std::size_t points_in_file, std::optional<d
   decoded.fields = roles_.describe(fields_);
   decoded.cloud = finish(scan_stamp, file);
   decoded.time_reference = absolute_reference_;
+  if (roles_.intensity) decoded.intensity_type = fields_[*roles_.intensity].type;
   return decoded;
 }
 

@@ -5,7 +5,9 @@
 // Which fields become which part of a LabelledCloud:
 //   x, y, z                        the point [m] (required; any numeric type)
 //   intensity, else remission      LabelledCloud::remission, as stored (KITTI
-//                                  scans hold 0..1, Velodyne drivers 0..255)
+//                                  scans hold 0..1, Velodyne drivers 0..255;
+//                                  the sources bring it to 0..1, see
+//                                  intensity_scale.hpp)
 //   ring                           LabelledCloud::ring (beam index)
 //   time, t, timestamp, offset_time LabelledCloud::time, see PointTimeUnits
 //   label, instance                class and instance ids (low 16 bits)
@@ -59,6 +61,9 @@ struct DecodedCloud {
   std::string fields;                   ///< the fields taken, as named in the file ("x y z intensity ring t")
   std::size_t points_in_file = 0;       ///< before dropping non-finite points
   std::optional<double> time_reference; ///< absolute per-point times were made relative to this [s]
+  /// The type of the field taken for the remission; none when the file has
+  /// no intensity field (what intensity_scale.hpp decides the range by).
+  std::optional<ScalarType> intensity_type;
 };
 
 /// The record the writers (PCD, PLY scans, PointCloud2) write for a cloud,

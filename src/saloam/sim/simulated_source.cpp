@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "saloam/io/intensity_scale.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
@@ -35,6 +36,7 @@ SourceInfo simulated_info(const SimulatedSequence& sequence) {
   info.sensor_camera_poses = moved_sensor_poses(sequence);
   info.format = "simulated";
   info.point_fields = "x y z remission";
+  info.notes.push_back(IntensityScale{1.0F, "the simulator's remission"}.note());
   return info;
 }
 

@@ -42,6 +42,15 @@ KittiRawDrive::KittiRawDrive(fs::path drive, const SourceOptions& options) : dri
     }
   }
   info_.has_labels = !label_files_.empty();
+  intensity_ = unread_intensity_scale(options.intensity_scale);
+  if (!options.intensity_scale && !scans_.empty()) {
+    try {
+      intensity_ = choose_intensity_scale(std::nullopt, ScalarType::kFloat32, read_scan(scans_.front()).remission);
+    } catch (const InputError&) {
+      // The run fails on that scan, naming it; the range stays 1.
+    }
+  }
+  info_.notes.push_back(intensity_.note());
 }
 
 void KittiRawDrive::read_times() {
@@ -114,7 +123,10 @@ void KittiRawDrive::read_reference() {
 }
 
 LabelledCloud KittiRawDrive::scan(std::size_t i) {
-  return read_scan(scans_.at(i), label_files_.empty() ? std::nullopt : std::optional<fs::path>(label_files_[i]));
+  LabelledCloud cloud =
+      read_scan(scans_.at(i), label_files_.empty() ? std::nullopt : std::optional<fs::path>(label_files_[i]));
+  intensity_.apply(cloud);
+  return cloud;
 }
 
 }  // namespace saloam

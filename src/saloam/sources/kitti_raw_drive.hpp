@@ -17,12 +17,15 @@
 // No Tr: a KITTI raw drive runs in the LiDAR frame, and info().camera_poses
 // holds the reference in the LiDAR frame (Q_i). Labels only from
 // SourceOptions::labels (a drive has no labels folder of its own).
+// Remission is divided by the range found in the first scan's values, or
+// given (io/intensity_scale.hpp).
 
 #include <filesystem>
 #include <optional>
 #include <vector>
 
 #include "saloam/io/frame_source.hpp"
+#include "saloam/io/intensity_scale.hpp"
 #include "saloam/sources/source_options.hpp"
 
 namespace saloam {
@@ -48,6 +51,7 @@ class KittiRawDrive final : public FrameSource {
   std::vector<std::filesystem::path> label_files_;
   double first_stamp_ = 0.0;
   std::optional<std::vector<double>> sweep_durations_;
+  IntensityScale intensity_;
   SourceInfo info_;
 };
 

@@ -55,7 +55,8 @@ std::unique_ptr<FrameSource> open_semantic_kitti(const fs::path& path, const Sou
   SequenceOptions sequence;
   sequence.labels_dir = options.labels;
   sequence.ignore_labels = options.ignore_labels;
-  return std::make_unique<SequenceFolderSource>(SequenceReader(path, sequence), !options.ignore_calib);
+  return std::make_unique<SequenceFolderSource>(SequenceReader(path, sequence), !options.ignore_calib,
+                                                options.intensity_scale);
 }
 
 }  // namespace

@@ -3,7 +3,8 @@
 // a path, then the stages every frame goes through before a run sees it.
 //   readers  every layout of source_options.hpp, each a FrameSource that
 //            fills SourceInfo (times, labels?, Tr?, reference poses, folder,
-//            format, point fields, notes):
+//            format, point fields, intensity range, notes) and serves
+//            remission in 0..1 (io/intensity_scale.hpp):
 //              semantickitti  SequenceFolderSource (io/sequence_source.hpp)
 //              kitti-raw      KittiRawDrive        (sources/kitti_raw_drive.hpp)
 //              pcd, ply       PointCloudFolder     (sources/point_cloud_folder.hpp)

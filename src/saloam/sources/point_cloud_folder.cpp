@@ -43,7 +43,10 @@ PointCloudFolder::PointCloudFolder(fs::path path, ScanFormat format, const Sourc
   read_calibration_and_reference(options);
   find_labels(options);
   info_.has_labels = !label_files_.empty();
-  info_.point_fields = decode(0).fields;
+  const DecodedCloud first = decode(0);
+  info_.point_fields = first.fields;
+  intensity_ = choose_intensity_scale(options.intensity_scale, first.intensity_type, first.cloud.remission);
+  info_.notes.push_back(intensity_.note());
 }
 
 void PointCloudFolder::read_calibration_and_reference(const SourceOptions& options) {
@@ -141,6 +144,7 @@ LabelledCloud PointCloudFolder::scan(std::size_t i) {
     std::fill(decoded.cloud.instance.begin(), decoded.cloud.instance.end(), 0);
     decoded.cloud.has_labels = false;
   }
+  intensity_.apply(decoded.cloud);
   return std::move(decoded.cloud);
 }
 

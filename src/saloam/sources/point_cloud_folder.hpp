@@ -10,7 +10,9 @@
 // Fields are read as point_fields.hpp says; absolute per-point times are
 // taken relative to the scan's timestamp when that is a real time (from the
 // file names, or a times.txt of times since the epoch). info().point_fields
-// are the first scan's (read when the folder is opened).
+// are the first scan's (read when the folder is opened), and so is the
+// intensity range every scan's remission is divided by (its field's type or
+// values, io/intensity_scale.hpp), unless SourceOptions gives it.
 
 #include <filesystem>
 #include <optional>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "saloam/io/frame_source.hpp"
+#include "saloam/io/intensity_scale.hpp"
 #include "saloam/io/point_fields.hpp"
 #include "saloam/sources/source_options.hpp"
 
@@ -45,6 +48,7 @@ class PointCloudFolder final : public FrameSource {
   std::vector<std::filesystem::path> files_;
   std::vector<std::filesystem::path> label_files_;  ///< empty, or one per scan
   bool stamps_are_absolute_ = false;
+  IntensityScale intensity_;
   SourceInfo info_;
 };
 

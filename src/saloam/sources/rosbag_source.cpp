@@ -200,10 +200,12 @@ RosbagSource::RosbagSource(fs::path bag, const SourceOptions& options)
   });
   info_.name = fmt::format("{} (topic {})", bag_.string(), impl_->topic);
   info_.format = "rosbag";
-  info_.point_fields = parse(0).decoded.fields;
+  const PointCloud2Scan first = parse(0);
+  info_.point_fields = first.decoded.fields;
+  intensity_ = choose_intensity_scale(options.intensity_scale, first.decoded.intensity_type, first.decoded.cloud.remission);
   info_.notes = {fmt::format("topic: {} ({} messages), frame '{}'", impl_->topic, impl_->messages.size(), impl_->frame_id),
                  "times: the messages' header stamps", "calibration: none: runs in the LiDAR frame",
-                 "reference: none (a bag of point clouds)"};
+                 "reference: none (a bag of point clouds)", intensity_.note()};
 }
 
 PointCloud2Scan RosbagSource::parse(std::size_t i) const {
@@ -211,7 +213,11 @@ PointCloud2Scan RosbagSource::parse(std::size_t i) const {
   return parse_pointcloud2(bytes, bag_, fmt::format("topic {}, message {}", impl_->topic, i));
 }
 
-LabelledCloud RosbagSource::scan(std::size_t i) { return std::move(parse(i).decoded.cloud); }
+LabelledCloud RosbagSource::scan(std::size_t i) {
+  LabelledCloud cloud = std::move(parse(i).decoded.cloud);
+  intensity_.apply(cloud);
+  return cloud;
+}
 
 const std::string& RosbagSource::topic() const { return impl_->topic; }
 

@@ -10,7 +10,9 @@
 // allocate 4 GB under the fuzzer).
 // Scans are in the message's frame (header.frame_id, said in info().notes); a
 // bag has no reference poses and no calibration: it runs in the LiDAR frame.
-// info().point_fields are the first message's (parsed when the bag is opened).
+// info().point_fields are the first message's (parsed when the bag is opened),
+// and so is the intensity range every scan's remission is divided by (its
+// field's type or values, io/intensity_scale.hpp), unless SourceOptions gives it.
 //
 // Built only when rosbag_storage is found (rosbag_available()); otherwise
 // opening a bag is an InputError saying so.
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include "saloam/io/frame_source.hpp"
+#include "saloam/io/intensity_scale.hpp"
 #include "saloam/io/pointcloud2.hpp"
 #include "saloam/sources/source_options.hpp"
 
@@ -67,6 +70,7 @@ class RosbagSource final : public FrameSource {
   struct Impl;
   std::filesystem::path bag_;
   std::unique_ptr<Impl> impl_;
+  IntensityScale intensity_;
   SourceInfo info_;
 };
 

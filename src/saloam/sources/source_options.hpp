@@ -1,8 +1,9 @@
 #pragma once
 // What a command asks of a source: the layout to read it as, the bag topic,
-// labels, calibration, the frame range and the segmentation stage. Shared by open_reader() and the
-// readers (sources/*.hpp); the commands fill it from cli::SourceArgs
-// (SEQ_DIR, --format, --topic, --labels, --frames, --no-calib).
+// labels, calibration, the intensity range, the frame range and the
+// segmentation stage. Shared by open_reader() and the readers
+// (sources/*.hpp); the commands fill it from cli::SourceArgs (SEQ_DIR,
+// --format, --topic, --labels, --frames, --no-calib, --intensity-scale).
 //
 // The layouts (--format):
 //   semantickitti  SEQ/velodyne/NNNNNN.bin (+ labels/, times.txt, poses.txt, calib.txt)
@@ -44,6 +45,10 @@ struct SourceOptions {
   /// (pose files hold LiDAR-frame poses, poses.txt is taken as such). A
   /// source without calib.txt runs so anyway.
   bool ignore_calib = false;
+  /// --intensity-scale: what the file's intensity values are divided by to
+  /// make remission 0..1 (1, 255 or 65535); none: each reader decides from
+  /// the field's type or its first scan (io/intensity_scale.hpp).
+  std::optional<float> intensity_scale;
   FrameRange frames;  ///< --frames A:B; everything by default
   /// --segment: every scan labelled by this model (the reader's labels are not read).
   std::optional<SegmentationStageOptions> segmentation;
