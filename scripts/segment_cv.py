@@ -142,6 +142,7 @@ def main():
     p.add_argument("--out", required=True)
     p.add_argument("--saloam", default=os.path.join(os.path.dirname(__file__), "..", "build", "saloam"))
     p.add_argument("--folds", default=DEFAULT_FOLDS, help=f"sequences per fold, ';' between folds ({DEFAULT_FOLDS})")
+    p.add_argument("--run-folds", help="only these folds (numbers, e.g. 0,1); each still trains on every other fold")
     p.add_argument("--model", help="score this model in every fold, without training (a baseline)")
     p.add_argument("--init", help="segment-train --init: the model to fine-tune")
     p.add_argument("--sim-recipe", help="a segment-train recipe whose train: sources are trained on beside the real ones")
@@ -166,7 +167,8 @@ def main():
         print(f"trained on {', '.join(sequences)}: {model}")
         return
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
-        results = list(pool.map(lambda kf: fold_job(args, kf[0], kf[1], sequences), enumerate(folds)))
+        chosen = [int(k) for k in args.run_folds.split(",")] if args.run_folds else range(len(folds))
+        results = list(pool.map(lambda k: fold_job(args, k, folds[k], sequences), chosen))
     with open(os.path.join(args.out, "folds.json"), "w") as f:
         json.dump(results, f, indent=1)
     text = table(results)

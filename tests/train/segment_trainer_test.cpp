@@ -4,12 +4,14 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/io/scan_io.hpp"
 #include "saloam/segmentation/segmenter_spec.hpp"
 #include "saloam/train/segment_trainer.hpp"
 #include "saloam/train/training_run.hpp"
@@ -205,6 +207,32 @@ fs::path real_sequence(const testing::TempDir& dir, int count) {
   const std::string command = "tar -xJf " + testing::quoted(archive) + " -C " + testing::quoted(dir.path()) + members;
   EXPECT_EQ(std::system(command.c_str()), 0) << command;
   return dir / "semantickitti_mini/sequences/00";
+}
+
+TEST(SegmentTrainer, AFolderStoredAt0To255TrainsAsIts0To1Twin) {
+  SALOAM_REQUIRE_SHARED_DATA();
+  testing::TempDir dir;
+  const fs::path unit = real_sequence(dir, 1);
+  const fs::path bytes = dir / "bytes";
+  fs::copy(unit, bytes, fs::copy_options::recursive);
+  LabelledCloud cloud = read_scan(unit / "velodyne/000000.bin");
+  for (auto& r : cloud.remission) r = std::round(r * 255.0f);
+  write_scan_bin(bytes / "velodyne/000000.bin", cloud);
+  SourceSpec spec;
+  spec.kind = SourceSpec::Kind::kFolder;
+  spec.frame_step = 1;
+  spec.path = unit;
+  const TrainingScanSet a = build_training_scans(spec, FeatureConfig{}, std::nullopt, false);
+  spec.path = bytes;
+  const TrainingScanSet b = build_training_scans(spec, FeatureConfig{}, std::nullopt, false);
+  ASSERT_EQ(a.scans.at(0).size(), b.scans.at(0).size());
+  std::size_t differ = 0, bright = 0;
+  for (std::size_t i = 0; i < a.scans[0].size(); ++i) {
+    differ += std::abs(int(a.scans[0].remission[i]) - int(b.scans[0].remission[i])) > 1;
+    bright += b.scans[0].remission[i] == 255;
+  }
+  EXPECT_EQ(differ, 0U) << "0..255 remission divided by 255, as a run reads it";
+  EXPECT_LT(bright, b.scans[0].size() / 100) << "not clipped at 1";
 }
 
 TEST(SegmentTrainer, TrainingOnRealAndSimulatedScansLowersTheLoss) {

@@ -22,6 +22,8 @@
 #include "saloam/core/hash.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/io/intensity_scale.hpp"
+#include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 
@@ -70,8 +72,17 @@ std::vector<TrainingScan> folder_scans(const SourceSpec& spec, const FeatureConf
   const auto [first, end] = FrameRange::parse(spec.frames, "frames").clip(reader.size(), "frames");
   std::vector<std::size_t> frames;
   for (std::size_t i = first; i < end; i += spec.frame_step) frames.push_back(i);
-  return build_all(frames.size(), "scans of " + spec.name(), show_progress,
-                   [&](std::size_t k) { return labelled_scan(reader.load_scan(frames[k]), rings); });
+  // Remission in 0..1 as every run reads it (io/intensity_scale.hpp): one
+  // range for the folder, from its first scan.
+  const IntensityScale scale =
+      reader.size() == 0 ? IntensityScale{}
+                         : choose_intensity_scale(std::nullopt, ScalarType::kFloat32, read_scan(reader.scan_file(0)).remission);
+  if (scale.divisor != 1.0F) spdlog::info("{}: {}", spec.name(), scale.note());
+  return build_all(frames.size(), "scans of " + spec.name(), show_progress, [&](std::size_t k) {
+    LabelledCloud cloud = reader.load_scan(frames[k]);
+    scale.apply(cloud);
+    return labelled_scan(cloud, rings);
+  });
 }
 
 // ---- cache: magic, key, scans; written to a temporary name and renamed ----
@@ -97,11 +108,13 @@ bool read_vector(std::istream& in, std::vector<T>& v, std::uint64_t max_size, st
 }
 
 std::string cache_key(const SourceSpec& spec, const FeatureConfig& rings) {
-  return nlohmann::json{{"source", spec.to_json()},
-                        {"ring_rows", 2},  // version of point_rings(): rows of missing rings
-                        {"rings", {rings.num_beams, rings.ring_from_point_order, rings.sweep_start_azimuth_deg,
-                                   rings.sweep_clockwise, rings.sweep_duration}}}
-      .dump();
+  nlohmann::json key{{"source", spec.to_json()},
+                     {"ring_rows", 2},  // version of point_rings(): rows of missing rings
+                     {"rings", {rings.num_beams, rings.ring_from_point_order, rings.sweep_start_azimuth_deg,
+                                rings.sweep_clockwise, rings.sweep_duration}}};
+  // Folders' remission is brought to 0..1 since version 1 (0..255 files were clipped before).
+  if (spec.kind == SourceSpec::Kind::kFolder) key["intensity_scale"] = 1;
+  return key.dump();
 }
 
 // The cached scans when `file` holds them for `key`; nullopt when there is
