@@ -80,6 +80,10 @@ TEST(EvaluationJson, HoldsTheDocumentedKeys) {
   EXPECT_DOUBLE_EQ(bias.at("lateral_percent").get<double>(), ev.bias.lateral_percent);
   EXPECT_DOUBLE_EQ(bias.at("vertical_percent").get<double>(), ev.bias.vertical_percent);
   EXPECT_EQ(bias.at("body_up").size(), 3u);
+  const auto& axes = j.at("ate").at("per_axis_rmse");
+  EXPECT_DOUBLE_EQ(axes.at("sideways_m").get<double>(), ev.ate_axes.sideways_m);
+  EXPECT_DOUBLE_EQ(axes.at("vertical_m").get<double>(), ev.ate_axes.vertical_m);
+  EXPECT_DOUBLE_EQ(axes.at("forward_m").get<double>(), ev.ate_axes.forward_m);
 
   const auto compact = evaluation_to_json(ev, {}, false);
   EXPECT_FALSE(compact.at("ate").contains("per_pose_aligned_m"));
@@ -125,6 +129,10 @@ TEST(EvaluationMarkdown, ShowsHeadlineAndPerLengthTables) {
   EXPECT_NE(text.find("| ATE RMSE, se3-aligned | "), std::string::npos);
   EXPECT_NE(text.find("| ATE RMSE, unaligned | "), std::string::npos);
   EXPECT_NE(text.find("| RPE (1-frame) translation RMSE | "), std::string::npos);
+  EXPECT_NE(text.find(fmt::format("| ATE RMSE sideways / vertical / forward (sensor frame), se3-aligned | {:.4f} / ",
+                                  ev.ate_axes.sideways_m)),
+            std::string::npos)
+      << text;
   EXPECT_NE(text.find(fmt::format("| scale bias forward / lateral / vertical (10-frame) | {:.4f} / ",
                                   ev.bias.forward_percent)),
             std::string::npos)

@@ -383,6 +383,34 @@ TEST(ScaleBias, StandingStillAndUnknownAxes) {
   EXPECT_THROW(compute_scale_bias(gt, still), std::invalid_argument);
 }
 
+TEST(AteAxes, SplitsTheErrorAlongEachPosesOwnAxes) {
+  // Every position moved by a fixed offset in its own pose's frame (LiDAR
+  // axes: 0.1 m forward, 0.3 m left, 0.2 m up) along a path that turns and
+  // pitches: unaligned, each axis gets its own share, in both conventions.
+  const auto gt = winding_path(800, 1.0);
+  std::vector<Pose> est = gt;
+  for (auto& T : est) T.translation() -= T.linear() * Eigen::Vector3d(0.1, 0.3, 0.2);
+  for (const auto& [g, e] : {std::pair{gt, est}, std::pair{in_camera_frame(gt), in_camera_frame(est)}}) {
+    const AteMetrics ate = compute_ate(g, e, Alignment::kNone);
+    const AteAxes axes = compute_ate_axes(g, e, ate, body_up_axis(g));
+    EXPECT_NEAR(axes.sideways_m, 0.3, 1e-9);
+    EXPECT_NEAR(axes.vertical_m, 0.2, 1e-9);
+    EXPECT_NEAR(axes.forward_m, 0.1, 1e-9);
+  }
+  // Aligned, the three squared add up to the ATE's squared RMSE.
+  const auto drifting = biased(gt, -0.001, 0.0005, 0.002);
+  const TrajectoryEvaluation ev = evaluate_trajectories(gt, drifting);
+  const AteAxes& a = ev.ate_axes;
+  EXPECT_NEAR(a.sideways_m * a.sideways_m + a.vertical_m * a.vertical_m + a.forward_m * a.forward_m,
+              ev.ate.aligned.rmse * ev.ate.aligned.rmse, 1e-9);
+  EXPECT_GT(a.vertical_m, a.sideways_m);  // the climb (0.2 %) is the largest drift
+  // Motion along body y fits neither convention.
+  std::vector<Pose> sideways;
+  for (int i = 0; i < 21; ++i) sideways.push_back(make_pose(Eigen::Matrix3d::Identity(), Eigen::Vector3d(0, i, 0)));
+  const AteAxes none = compute_ate_axes(sideways, sideways, compute_ate(sideways, sideways), body_up_axis(sideways));
+  EXPECT_TRUE(std::isnan(none.vertical_m));
+}
+
 TEST(EvaluateTrajectories, IdenticalTrajectoriesAreZeroEverywhere) {
   const auto gt = winding_path(1500, 0.9);
   const auto ev = evaluate_trajectories(gt, gt);

@@ -56,6 +56,12 @@ nlohmann::json ate_json(const AteMetrics& ate, bool per_frame) {
   return j;
 }
 
+nlohmann::json ate_axes_json(const AteAxes& axes) {
+  return {{"sideways_m", number(axes.sideways_m)},
+          {"vertical_m", number(axes.vertical_m)},
+          {"forward_m", number(axes.forward_m)}};
+}
+
 nlohmann::json rpe_json(const RpeMetrics& rpe, bool per_frame) {
   nlohmann::json j;
   j["delta"] = rpe.delta;
@@ -103,6 +109,7 @@ nlohmann::json evaluation_to_json(const TrajectoryEvaluation& ev, const Evaluati
   j["gt_length_m"] = number(ev.gt_length_m);
   j["kitti"] = kitti_json(ev.kitti);
   j["ate"] = ate_json(ev.ate, per_frame);
+  j["ate"]["per_axis_rmse"] = ate_axes_json(ev.ate_axes);
   j["rpe"] = rpe_json(ev.rpe, per_frame);
   j["scale_bias"] = bias_json(ev.bias);
   j["warnings"] = ev.warnings;
@@ -143,6 +150,10 @@ void print_evaluation_markdown(std::ostream& out, const TrajectoryEvaluation& ev
                      format_metric(ev.ate.unaligned.median, 4), format_metric(ev.ate.unaligned.max, 4));
   out << fmt::format("| RPE ({}-frame) translation RMSE | {} m |\n", ev.rpe.delta, format_metric(ev.rpe.trans_rmse_m, 6));
   out << fmt::format("| RPE ({}-frame) rotation RMSE | {} deg |\n", ev.rpe.delta, format_metric(ev.rpe.rot_rmse_deg, 6));
+  out << fmt::format("| ATE RMSE sideways / vertical / forward (sensor frame), {} | {} / {} / {} m |\n",
+                     ev.ate.alignment == Alignment::kNone ? "unaligned" : align + "-aligned",
+                     format_metric(ev.ate_axes.sideways_m, 4), format_metric(ev.ate_axes.vertical_m, 4),
+                     format_metric(ev.ate_axes.forward_m, 4));
   out << fmt::format("| scale bias forward / lateral / vertical ({}-frame) | {} / {} / {} % |\n", ev.bias.delta,
                      format_metric(ev.bias.forward_percent, 4), format_metric(ev.bias.lateral_percent, 4),
                      format_metric(ev.bias.vertical_percent, 4));

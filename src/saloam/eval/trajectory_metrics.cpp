@@ -310,6 +310,37 @@ ScaleBias compute_scale_bias(const std::vector<Pose>& gt, const std::vector<Pose
 }
 
 // ---------------------------------------------------------------------------
+// ATE per axis
+// ---------------------------------------------------------------------------
+
+AteAxes compute_ate_axes(const std::vector<Pose>& gt, const std::vector<Pose>& est, const AteMetrics& ate,
+                         const Eigen::Vector3d& body_up) {
+  require_same_size(gt, est, "ATE per axis");
+  AteAxes axes;
+  // The forward axis of the two conventions body_up_axis() knows.
+  Eigen::Vector3d forward = Eigen::Vector3d::Zero();
+  if (body_up == -Eigen::Vector3d::UnitY()) forward = Eigen::Vector3d::UnitZ();
+  if (body_up == Eigen::Vector3d::UnitZ()) forward = Eigen::Vector3d::UnitX();
+  if (gt.empty() || forward.squaredNorm() == 0.0) {
+    axes.sideways_m = axes.vertical_m = axes.forward_m = kNaN;
+    return axes;
+  }
+  const Eigen::Vector3d left = body_up.cross(forward);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();  // sideways, vertical, forward
+  for (std::size_t i = 0; i < gt.size(); ++i) {
+    const Eigen::Vector3d error = gt[i].translation() - ate.transform.apply(Eigen::Vector3d(est[i].translation()));
+    // Into the pose's frame: R^T, as the frame's rotation is orthonormal to ~1e-6.
+    const Eigen::Vector3d body = gt[i].linear().transpose() * error;
+    sum += Eigen::Vector3d(body.dot(left), body.dot(body_up), body.dot(forward)).cwiseAbs2();
+  }
+  const Eigen::Vector3d rms = (sum / static_cast<double>(gt.size())).cwiseSqrt();
+  axes.sideways_m = rms[0];
+  axes.vertical_m = rms[1];
+  axes.forward_m = rms[2];
+  return axes;
+}
+
+// ---------------------------------------------------------------------------
 // Everything
 // ---------------------------------------------------------------------------
 
@@ -341,6 +372,7 @@ TrajectoryEvaluation evaluate_trajectories(const std::vector<Pose>& gt, const st
   ev.ate = compute_ate(gt_common, est_common, options.alignment);
   ev.rpe = compute_rpe(gt_common, est_common, options.rpe_delta);
   ev.bias = compute_scale_bias(gt_common, est_common, options.bias_delta);
+  ev.ate_axes = compute_ate_axes(gt_common, est_common, ev.ate, ev.bias.body_up);
   return ev;
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Trajectory accuracy metrics: the KITTI odometry benchmark's relative error,
 // the absolute trajectory error (ATE) after Umeyama alignment, the relative
-// pose error (RPE) between consecutive frames, and the scale bias (forward,
+// pose error (RPE) between consecutive frames, the ATE per axis of the
+// sensor's frame (sideways, vertical, forward), and the scale bias (forward,
 // lateral, vertical) of the distance travelled.
 //
 // Pure computation, no I/O: reading files, printing and plotting live in
@@ -195,6 +196,31 @@ Eigen::Vector3d body_up_axis(const std::vector<Pose>& gt, std::size_t delta = 10
 ScaleBias compute_scale_bias(const std::vector<Pose>& gt, const std::vector<Pose>& est, std::size_t delta = 10);
 
 // ---------------------------------------------------------------------------
+// ATE per axis of the sensor's frame
+// ---------------------------------------------------------------------------
+
+/// The aligned position errors resolved in each ground-truth pose's own body
+/// frame: per pose the error p_gt - T p_est (T the ATE's alignment) is
+/// rotated into that pose's frame and split into sideways (left), vertical
+/// (the body's up axis) and forward components; each field is the RMS of
+/// one component over all poses, so the three squared add up to the ATE's
+/// squared RMSE. Unlike the world axes, these follow the vehicle: on a
+/// climbing route "vertical" is the sensor's up, the direction a pitch or
+/// ground-height error moves it. The axes are read from the ground truth's
+/// convention as in ScaleBias (camera frame: up -y, forward z; LiDAR frame:
+/// up z, forward x); with neither all three are NaN.
+struct AteAxes {
+  double sideways_m = 0.0;
+  double vertical_m = 0.0;
+  double forward_m = 0.0;
+};
+
+/// AteAxes of `est` against `gt` with the alignment `ate` found (its
+/// transform), the body's up axis `body_up` (body_up_axis()). Requires equal sizes.
+AteAxes compute_ate_axes(const std::vector<Pose>& gt, const std::vector<Pose>& est, const AteMetrics& ate,
+                         const Eigen::Vector3d& body_up);
+
+// ---------------------------------------------------------------------------
 // Everything at once
 // ---------------------------------------------------------------------------
 
@@ -212,6 +238,7 @@ struct TrajectoryEvaluation {
   double gt_length_m = 0.0;         ///< path length of the evaluated ground truth
   KittiMetrics kitti;
   AteMetrics ate;
+  AteAxes ate_axes;  ///< the aligned ATE per axis of the sensor's frame
   RpeMetrics rpe;
   ScaleBias bias;
   /// Non-fatal problems (e.g. different lengths); the caller decides how to show them.
