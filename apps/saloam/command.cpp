@@ -133,6 +133,11 @@ std::filesystem::path segmenter_description_path(const std::string& given, const
                                   shipped.parent_path().string()));
   }
   if (!projection.empty()) return projection;
+  // A bare name (`--segmenter saloam_real`) names a shipped model, unless a file of that name is here.
+  if (!model.has_parent_path() && !model.has_extension() && !std::filesystem::exists(model, error)) {
+    const auto shipped = data_dir() / "models" / "segmenter" / (model.string() + ".yaml");
+    if (std::filesystem::is_regular_file(shipped, error)) return shipped;
+  }
   if (model.extension() != ".pt") return model;
   auto beside = model;
   beside.replace_extension(".yaml");
@@ -146,8 +151,9 @@ void SegmentOptions::add_to(CLI::App& app) {
   app.add_flag("--segment", segment,
                "Label every scan in-process with the segmentation network (the shipped model unless --segmenter)");
   app.add_option("--segmenter", segmenter,
-                 "Segmentation model: a description (.yaml) or a TorchScript network (.pt) with its description beside "
-                 "it or in --projection; implies --segment");
+                 "Segmentation model: a description (.yaml), a TorchScript network (.pt) with its description beside "
+                 "it or in --projection, or a shipped model's name (saloam_real: fine-tuned on real KITTI scans); "
+                 "implies --segment");
   app.add_option("--projection", projection, "Description (.yaml) of a --segmenter TorchScript network's projection");
 }
 

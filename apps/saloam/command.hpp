@@ -142,6 +142,8 @@ std::filesystem::path segmentation_plugin_path();
 
 /// The segmentation model to load: `given` (--segmenter), else the config's
 /// segmentation.model, else the shipped data_dir()/models/segmenter/saloam.yaml.
+/// A bare name without extension (`saloam_real`) is a shipped model's
+/// (data_dir()/models/segmenter/NAME.yaml) when no file of that name is here.
 /// A TorchScript file (.pt) needs its description: `projection` (--projection
 /// FILE.yaml) or the .yaml of the same name beside it. ConfigError saying how
 /// to pass one when there is none.
