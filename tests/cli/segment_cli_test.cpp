@@ -61,7 +61,7 @@ TEST(SegmentCli, TrainsLabelsScoresAndRunsInProcess) {
   EXPECT_TRUE(fs::is_regular_file(dir / "pred" / "segment_000003.png"));
   // Never over an input.
   EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(seq / "labels") + model, &output), 0);
-  EXPECT_NE(output.find("labels folder"), std::string::npos) << output;
+  EXPECT_NE(output.find("lies inside the input SEQ_DIR"), std::string::npos) << output;
 
   // In-process, the stage's time in timing.json; --segment with --labels or --no-semantics is refused.
   ASSERT_EQ(run_command(saloam_cmd("-q odom ") + quoted(seq) + " --out " + quoted(dir / "odom") + model, &output), 0)
