@@ -1,5 +1,6 @@
 #include "saloam/io/point_checks.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
