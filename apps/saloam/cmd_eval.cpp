@@ -2,6 +2,7 @@
 // (KITTI relative error, ATE, RPE) as Markdown, optionally JSON and a plot;
 // with --map, a saved map's keyframe error per session (runs/session_eval.hpp).
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -114,6 +115,41 @@ void pair_by_frame(const EvalOptions& options, Trajectory& gt, Trajectory& est) 
                est_first, gt_first);
 }
 
+/// Two TUM files carry their times: their poses are paired by time (the
+/// nearest within 0.02 s, or half the ground truth's median interval when
+/// that is less), never by line; poses without a partner are left out.
+void pair_by_time(const EvalOptions& options, Trajectory& gt, Trajectory& est) {
+  double tolerance = 0.02;  // [s] TUM's associate.py
+  if (gt.timestamps.size() > 1) {
+    std::vector<double> gaps;
+    for (std::size_t i = 1; i < gt.timestamps.size(); ++i) gaps.push_back(gt.timestamps[i] - gt.timestamps[i - 1]);
+    std::nth_element(gaps.begin(), gaps.begin() + static_cast<std::ptrdiff_t>(gaps.size() / 2), gaps.end());
+    tolerance = std::min(tolerance, 0.5 * gaps[gaps.size() / 2]);
+  }
+  const auto pairs = associate_by_time(gt.timestamps, est.timestamps, tolerance);
+  if (pairs.size() < 2) {
+    throw InputError(options.est_file,
+                     fmt::format("{} of its {} times ({:.9f}..{:.9f}) lie within {:.3g} s of one of the ground "
+                                 "truth's {} ({:.9f}..{:.9f}): TUM files are paired by time (do their clocks differ?)",
+                                 pairs.size(), est.size(), est.timestamps.front(), est.timestamps.back(), tolerance,
+                                 gt.size(), gt.timestamps.front(), gt.timestamps.back()));
+  }
+  Trajectory paired_gt, paired_est;
+  for (const auto& [g, e] : pairs) {
+    paired_gt.timestamps.push_back(gt.timestamps[g]);
+    paired_gt.poses.push_back(gt.poses[g]);
+    paired_est.timestamps.push_back(est.timestamps[e]);
+    paired_est.poses.push_back(est.poses[e]);
+  }
+  if (pairs.size() != gt.size() || pairs.size() != est.size()) {
+    spdlog::warn("paired {} poses by time (within {:.3g} s): {} of the ground truth's {} and {} of the estimate's {} "
+                 "have no partner and are left out",
+                 pairs.size(), tolerance, gt.size() - pairs.size(), gt.size(), est.size() - pairs.size(), est.size());
+  }
+  gt = std::move(paired_gt);
+  est = std::move(paired_est);
+}
+
 /// `eval --map MAP --gt SEQ_0 --gt SEQ_1 ...`: per-session error of a saved map.
 int run_map_eval(const EvalOptions& options) {
   if (!options.est_file.empty() || !options.plot_file.empty() || !options.calib_file.empty() ||
@@ -152,7 +188,11 @@ int run_eval(EvalOptions options) {
   Trajectory gt = read_trajectory(options.gt_file, &gt_format);
   Trajectory est = read_trajectory(options.est_file, &est_format);
   make_frames_consistent(options, gt, gt_format, est, est_format);
-  pair_by_frame(options, gt, est);
+  if (gt_format == TrajectoryFormat::kTum && est_format == TrajectoryFormat::kTum) {
+    pair_by_time(options, gt, est);
+  } else {
+    pair_by_frame(options, gt, est);
+  }
 
   EvaluationOptions eval_options;
   eval_options.alignment = parse_alignment(options.alignment);  // validated by CLI11 already

@@ -50,9 +50,7 @@ int run_localize_command(const LocalizeOptions& options) {
   // --config instead, then --set on top.
   SavedMap saved = read_map(options.map);
   SaloamConfig config = options.config.resolve_for_map(saved.config);
-  if (uses_sgpr(parse_place_detector(config.loop.detector))) {
-    config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
-  }
+  use_model_option(options.model, config);
   const PriorMap map =
       PriorMap::open(options.map, std::move(saved), static_cast<std::size_t>(config.localize.cached_keyframes));
   const double load_s = load_timer.elapsed_s();

@@ -34,9 +34,7 @@ int run_merge_command(const MergeOptions& options) {
   const StageTimer timer;
   SavedMap a = read_map(options.map_a);
   SaloamConfig config = options.config.resolve_for_map(a.config);
-  if (uses_sgpr(parse_place_detector(config.loop.detector))) {
-    config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
-  }
+  use_model_option(options.model, config);
   const auto cached = static_cast<std::size_t>(config.localize.cached_keyframes);
   const PriorMap base = PriorMap::open(options.map_a, std::move(a), cached);
   const PriorMap joining = PriorMap::open(options.map_b, cached);

@@ -57,7 +57,11 @@ int run_place_eval_command(PlaceEvalArgs args) {
   run.check();  // before the sequence is read
   SaloamConfig config = args.config.resolve();
   const PlaceDetector detector = parse_place_detector(run.method);
-  if (uses_sgpr(detector)) run.model = sgpr_model_path(args.model, config);
+  if (uses_sgpr(detector)) {
+    run.model = sgpr_model_path(args.model, config);
+  } else {
+    refuse_unused_model(args.model, run.method);
+  }
   run.labels = args.source.segment.enabled() ? std::string("segmented in-process")
                : args.source.labels.empty()  ? std::string("labels/")
                                              : args.source.labels;

@@ -94,9 +94,7 @@ int run_slam_command(const SlamOptions& options) {
   if (!options.detector.empty()) apply_config_option(config, "--detector", "loop.detector", options.detector);
   std::unique_ptr<PriorMap> join_map;
   if (!options.map.empty()) join_map = open_join_map(options, config);
-  if (uses_sgpr(parse_place_detector(config.loop.detector))) {
-    config.loop.sgpr_model = sgpr_model_path(options.model, config).string();
-  }
+  use_model_option(options.model, config);
   const bool labels = config.odometry.use_semantics || needs_labels(parse_place_detector(config.loop.detector));
   SensorChoice sensor;
   const std::unique_ptr<FrameSource> source = options.source.open(!labels, config, &sensor);

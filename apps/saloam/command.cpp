@@ -18,6 +18,7 @@
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/core/frame_range.hpp"
 #include "saloam/io/intensity_scale.hpp"
+#include "saloam/place/place_recognizer.hpp"
 #include "saloam/sources/open_source.hpp"
 #include "saloam/sources/sensor_guess.hpp"
 
@@ -113,6 +114,21 @@ std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConf
       shipped.parent_path().string()));
 }
 
+void use_model_option(const std::string& given, SaloamConfig& config) {
+  if (uses_sgpr(parse_place_detector(config.loop.detector))) {
+    config.loop.sgpr_model = sgpr_model_path(given, config).string();
+  } else {
+    refuse_unused_model(given, config.loop.detector);
+  }
+}
+
+void refuse_unused_model(const std::string& given, const std::string& detector) {
+  if (given.empty()) return;
+  throw ConfigError(fmt::format("--model {}: the {} detector has no model (--model gives the SGPR weights of the sgpr "
+                                "and hybrid detectors)",
+                                given, detector));
+}
+
 std::filesystem::path segmentation_plugin_path() {
   const auto bin = program_dir();
   if (!bin) return kSegmentationPlugin;
@@ -124,7 +140,21 @@ std::filesystem::path segmentation_plugin_path() {
 std::filesystem::path segmenter_description_path(const std::string& given, const std::string& projection,
                                                  const SaloamConfig& config) {
   const std::filesystem::path model = !given.empty() ? given : config.segmentation.model;
+  const std::string option = !given.empty() ? "--segmenter" : "segmentation.model";
   std::error_code error;
+  if (!projection.empty() && model.extension() != ".pt") {
+    // Every option used or refused (issue #39): a description names its own network.
+    throw ConfigError(model.empty()
+                          ? fmt::format("--projection {}: describes a TorchScript network given as --segmenter NET.pt; "
+                                        "there is none",
+                                        projection)
+                          : fmt::format("--projection {}: only for a TorchScript {} (.pt); {} is a description that "
+                                        "names its own network",
+                                        projection, option, model.string()));
+  }
+  if (model.extension() == ".pt" && !std::filesystem::is_regular_file(model, error)) {
+    throw ConfigError(fmt::format("{} {}: no such TorchScript file", option, model.string()));
+  }
   if (model.empty()) {
     const auto shipped = data_dir() / "models" / "segmenter" / "saloam.yaml";
     if (std::filesystem::is_regular_file(shipped, error)) return shipped;
@@ -184,6 +214,12 @@ std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig
   const std::filesystem::path description = segmenter_description_path(segmenter, projection, config);
   spdlog::info("segmenting with {}", description.string());
   stage.model = read_segmenter_spec(description);
+  const std::filesystem::path model = !segmenter.empty() ? segmenter : config.segmentation.model;
+  if (model.extension() == ".pt") {
+    // The network run is the one given, never one named inside its description.
+    stage.model.network.format = NetworkFormat::kTorchScript;
+    stage.model.network.weights = std::filesystem::absolute(model).string();
+  }
   stage.plugin = segmentation_plugin_path();
   stage.rings = config.odometry.features;
   stage.workers = config.segmentation.workers;

@@ -135,6 +135,12 @@ std::filesystem::path config_file_path(const std::string& name);
 /// loop.sgpr_model, else the model shipped in data_dir()/models/sgpr/saloam.sgw;
 /// ConfigError saying how to pass one when there is none.
 std::filesystem::path sgpr_model_path(const std::string& given, const SaloamConfig& config);
+/// config.loop.sgpr_model = sgpr_model_path(given, config) when the
+/// configured detector uses SGPR; else refuse_unused_model.
+void use_model_option(const std::string& given, SaloamConfig& config);
+/// ConfigError when --model was given (`given` not empty) for `detector`,
+/// which has no model: an option is used or refused, never ignored.
+void refuse_unused_model(const std::string& given, const std::string& detector);
 /// The network plugin of the segmentation (beside the program in a build
 /// tree, in <prefix>/lib/saloam when installed); it exists only in builds
 /// with libtorch.

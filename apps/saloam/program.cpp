@@ -1,7 +1,10 @@
 #include "program.hpp"
 
+#include <cerrno>
 #include <csignal>
+#include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 
 #include <iostream>
@@ -45,7 +48,14 @@ int run_guarded(const std::function<int()>& command) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
-    const int code = command();
+    int code = command();
+    // What went to standard output must have arrived (`saloam eval ... > /dev/full`).
+    errno = 0;
+    std::cout.flush();
+    if (std::fflush(stdout) != 0 || std::ferror(stdout) || !std::cout.good()) {
+      spdlog::error("standard output: cannot write ({})", std::strerror(errno != 0 ? errno : EIO));
+      if (code == 0) code = 2;
+    }
     if (stop_requested()) {
       spdlog::warn("interrupted: results written so far are kept");
       return 130;

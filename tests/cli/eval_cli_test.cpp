@@ -4,6 +4,7 @@
 #include <fstream>
 #include <string>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -96,6 +97,40 @@ TEST(EvalCli, PointsToTheSensorPosesOfASimulatedSequence) {
   std::filesystem::copy_file(dir / "poses.txt", dir / "poses_sensor.txt");
   ASSERT_EQ(run_command(command, &output), 0) << output;
   EXPECT_NE(output.find("score an odometry against --gt"), std::string::npos) << output;
+}
+
+// Old cases of issue #39: two TUM files are paired by time, not by line;
+// sim3 on a ground truth that does not move is refused; a standard output
+// that cannot be written (/dev/full) is an error.
+TEST(EvalCli, TumFilesArePairedByTimeAndOutputErrorsFail) {
+  TempDir dir;
+  std::ofstream gt(dir / "gt_tum.txt"), est(dir / "est_tum.txt"), still(dir / "still_tum.txt");
+  for (int i = 0; i < 20; ++i) {
+    const double x = 1.0 * i, y = 0.05 * i * i;
+    gt << fmt::format("{:.9f} {} {} 0 0 0 0 1\n", 100.0 + 0.1 * i, x, y);
+    still << fmt::format("{:.9f} 0 0 0 0 0 0 1\n", 100.0 + 0.1 * i);
+    // The estimate: poses 5..14 only, stamped 3 ms late.
+    if (i >= 5 && i < 15) est << fmt::format("{:.9f} {} {} 0 0 0 0 1\n", 100.003 + 0.1 * i, x, y);
+  }
+  gt.close();
+  est.close();
+  still.close();
+  const std::string eval = quoted(cli_path()) + " eval --gt " + quoted(dir / "gt_tum.txt") + " --est " +
+                           quoted(dir / "est_tum.txt");
+  std::string output;
+  ASSERT_EQ(run_command(eval + " --json " + quoted(dir / "e.json"), &output), 0) << output;
+  std::ifstream json_in(dir / "e.json");
+  const auto j = nlohmann::json::parse(json_in);
+  EXPECT_EQ(j.at("num_poses"), 10);
+  EXPECT_LT(j.at("ate").at("rmse_aligned").get<double>(), 1e-6) << j.dump();
+  // Static ground truth with sim3: refused, not a scale of 0 and an ATE of 0.
+  EXPECT_NE(run_command(quoted(cli_path()) + " eval --gt " + quoted(dir / "still_tum.txt") + " --est " +
+                            quoted(dir / "gt_tum.txt") + " --align sim3",
+                        &output),
+            0);
+  EXPECT_NE(output.find("the ground truth does not move"), std::string::npos) << output;
+  // Standard output on a full device.
+  EXPECT_NE(run_command(eval + " > /dev/full", &output), 0) << output;
 }
 
 TEST(EvalCli, MalformedPoseFileNamesFileAndLine) {

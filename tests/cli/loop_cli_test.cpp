@@ -240,6 +240,27 @@ TEST(LoopCli, PlaceEvalLeavesOutUnreadableFrames) {
   EXPECT_EQ(summary["frames_left_out"].get<int>(), 1);
 }
 
+// Every option used or refused (issue #39): --model with a detector that has no model.
+TEST(LoopCli, AModelForADetectorWithoutOneIsRefused) {
+  testing::TempDir tmp;
+  const auto seq = write_revisit_sequence(tmp);
+  std::ofstream(tmp / "w.sgw") << "x";
+  std::string output;
+  EXPECT_EQ(testing::run_command(saloam_cmd(fmt::format("place-eval {} --method scancontext --model {} --out {}",
+                                                        quoted(seq), quoted(tmp / "w.sgw"), quoted(tmp / "e"))),
+                                 &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("w.sgw: the scancontext detector has no model"), std::string::npos) << output;
+  EXPECT_EQ(testing::run_command(saloam_cmd(fmt::format("slam {} --detector scancontext --model {} --out {}",
+                                                        quoted(seq), quoted(tmp / "w.sgw"), quoted(tmp / "s"))),
+                                 &output),
+            2)
+      << output;
+  EXPECT_NE(output.find("w.sgw: the scancontext detector has no model"), std::string::npos) << output;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "s" / "poses.txt"));
+}
+
 TEST(LoopCli, PlaceEvalRejectsInconsistentDistances) {
   testing::TempDir tmp;  // checked before the sequence is read: no data needed
   std::string output;

@@ -61,7 +61,7 @@ TEST(SegmentCli, TrainsLabelsScoresAndRunsInProcess) {
   EXPECT_TRUE(fs::is_regular_file(dir / "pred" / "segment_000003.png"));
   // Never over an input.
   EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(seq / "labels") + model, &output), 0);
-  EXPECT_NE(output.find("labels folder"), std::string::npos) << output;
+  EXPECT_NE(output.find("lies inside the input SEQ_DIR"), std::string::npos) << output;
 
   // In-process, the stage's time in timing.json; --segment with --labels or --no-semantics is refused.
   ASSERT_EQ(run_command(saloam_cmd("-q odom ") + quoted(seq) + " --out " + quoted(dir / "odom") + model, &output), 0)
@@ -137,11 +137,39 @@ TEST(SegmentCli, AModelThatIsNotThereIsNamed) {
                         &output),
             0);
   EXPECT_NE(output.find("missing.yaml: segmentation model description not found"), std::string::npos) << output;
+  std::ofstream(dir / "net.pt") << "x";  // there, but without its description
   EXPECT_NE(run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(dir / "pred") +
                             " --segmenter " + quoted(dir / "net.pt"),
                         &output),
             0);
   EXPECT_NE(output.find("--projection"), std::string::npos) << output;
+}
+
+// Every option used or refused (issue #39): --segmenter NET.pt --projection
+// DESC.yaml runs NET.pt, not the network DESC.yaml names, and a NET.pt that
+// is not there is named; --projection beside a description is refused.
+TEST(SegmentCli, TheGivenNetworkIsRunOrRefused) {
+  TempDir dir;
+  const fs::path seq = simulate(dir);
+  std::ofstream(dir / "desc.yaml") << "format: saloam-segmenter 1\n"
+                                      "network: {type: torchscript, file: named.pt}\n"
+                                      "projection: {rows: 64, fov_up_deg: 3.0, fov_down_deg: -25.0, columns: 1024,\n"
+                                      "  channels: [range], means: [0], stds: [1]}\n"
+                                      "classes: semantickitti\nknn: {k: 5, window: 5, cutoff: 1.0, sigma: 1.0}\n";
+  std::ofstream(dir / "named.pt") << "not a network";
+  std::ofstream(dir / "given.pt") << "not a network either";
+  const auto segment = [&](const std::string& options, std::string* output) {
+    return run_command(saloam_cmd("segment ") + quoted(seq) + " --out " + quoted(dir / "pred") + options, output);
+  };
+  std::string output;
+  EXPECT_EQ(segment(" --segmenter " + quoted(dir / "missing.pt") + " --projection " + quoted(dir / "desc.yaml"), &output), 2);
+  EXPECT_NE(output.find("missing.pt: no such TorchScript file"), std::string::npos) << output;
+  EXPECT_NE(segment(" --segmenter " + quoted(dir / "given.pt") + " --projection " + quoted(dir / "desc.yaml"), &output), 0);
+  EXPECT_NE(output.find("given.pt"), std::string::npos) << output;
+  EXPECT_EQ(output.find("named.pt"), std::string::npos) << output;
+  EXPECT_EQ(segment(" --segmenter " + quoted(dir / "desc.yaml") + " --projection " + quoted(dir / "desc.yaml"), &output), 2);
+  EXPECT_NE(output.find("only for a TorchScript --segmenter (.pt)"), std::string::npos) << output;
+  EXPECT_FALSE(fs::exists(dir / "pred" / "000000.label"));
 }
 
 #else

@@ -232,6 +232,36 @@ TEST(Ate, Sim3RemovesScale) {
   EXPECT_GT(se3.aligned.rmse, 1.0);
 }
 
+// Issue #39: a static ground truth has no scale; sim3 refuses instead of
+// scaling the estimate to a point (scale 0, ATE 0).
+TEST(Ate, Sim3OnAStaticTrajectoryIsRefused) {
+  std::vector<Pose> still(10, Pose::Identity()), moving;
+  for (int i = 0; i < 10; ++i) {
+    Pose p = Pose::Identity();
+    p.translation() = Eigen::Vector3d(1.0 * i, 0.1 * i * i, 0.0);
+    moving.push_back(p);
+  }
+  try {
+    (void)compute_ate(still, moving, Alignment::kSim3);
+    FAIL() << "sim3 on a static ground truth was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("the ground truth does not move"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW((void)compute_ate(moving, still, Alignment::kSim3), std::invalid_argument);
+  EXPECT_GT(compute_ate(still, moving, Alignment::kSE3).aligned.rmse, 1.0);  // se3 still scores it
+}
+
+TEST(Ate, AssociateByTimePairsTheNearestWithinTheTolerance) {
+  const std::vector<double> gt{0.0, 0.1, 0.2, 0.3, 0.4, 0.5};
+  const std::vector<double> est{0.099, 0.21, 0.35, 0.401, 0.9};
+  const auto pairs = associate_by_time(gt, est, 0.02);
+  const std::vector<std::pair<std::size_t, std::size_t>> expected{{1, 0}, {2, 1}, {4, 3}};
+  EXPECT_EQ(pairs, expected);
+  EXPECT_TRUE(associate_by_time(gt, {10.0, 11.0}, 0.02).empty());
+  // Each ground-truth time once.
+  EXPECT_EQ(associate_by_time({1.0}, {0.995, 1.0, 1.005}, 0.02).size(), 1u);
+}
+
 TEST(Ate, ParseAlignment) {
   EXPECT_EQ(parse_alignment("se3"), Alignment::kSE3);
   EXPECT_EQ(parse_alignment("SIM3"), Alignment::kSim3);

@@ -4,6 +4,8 @@
 
 #include <cstring>
 #include <fstream>
+#include <iterator>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -244,6 +246,81 @@ TEST(Ply, CorruptFilesAreErrorsNamingTheFile) {
   EXPECT_NE(error_of("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2\n").find("line 8: 2 values"), std::string::npos);
   EXPECT_NE(error_of("ply\nelement vertex 1\n").find("no end_header"), std::string::npos);
   EXPECT_NE(error_of("ply\nformat binary_little_endian 1.0\nelement f 1\nproperty list uchar int i\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n").find("before the vertices has a list property"), std::string::npos);
+}
+
+// One set of checks for every format (io/point_checks.hpp, issue #39): points
+// at 1e30 and rings that fit no sensor dropped and counted, times beyond a
+// sweep clamped and counted, a wrongly stated byte order refused.
+TEST(PointChecks, EveryFormatDropsFarPointsAndBadRingsAndClampsTimes) {
+  testing::TempDir dir;
+  LabelledCloud cloud = sweep_cloud(40);
+  cloud.points[3].x() = 1e30f;    // beyond kMaxScanCoordinate
+  cloud.points[4].z() = -2e4f;    // too
+  cloud.ring[5] = 5000;           // no sensor has 5000 lasers
+  cloud.time[6] = -100.0f;        // 100 s before the scan's timestamp
+  cloud.time[7] = 50.0f;          // 50 s after it (below kAbsoluteTimeThreshold: not an absolute time)
+  const auto check = [](const DecodedCloud& d, const std::string& what) {
+    SCOPED_TRACE(what);
+    EXPECT_EQ(d.points_in_file, 40u);
+    ASSERT_EQ(d.cloud.size(), 37u);
+    EXPECT_EQ(d.checks.out_of_range, 2u);
+    EXPECT_EQ(d.checks.bad_ring, 1u);
+    EXPECT_EQ(d.checks.time_before_sweep, 1u);
+    EXPECT_EQ(d.checks.time_after_sweep, 1u);
+    for (std::size_t i = 0; i < d.cloud.size(); ++i) {
+      EXPECT_LE(d.cloud.points[i].cwiseAbs().maxCoeff(), kMaxScanCoordinate) << i;
+      EXPECT_LT(d.cloud.ring[i], kMaxRings) << i;
+      EXPECT_LE(std::abs(d.cloud.time[i]), kMaxSweepSeconds) << i;
+    }
+    EXPECT_EQ(d.cloud.time[3], -static_cast<float>(kMaxSweepSeconds));  // point 6, after 3 dropped
+    EXPECT_EQ(d.cloud.time[4], static_cast<float>(kMaxSweepSeconds));
+  };
+  for (const auto encoding : {PcdEncoding::kAscii, PcdEncoding::kBinary}) {
+    const auto file = dir / fmt::format("c{}.pcd", static_cast<int>(encoding));
+    write_pcd(file, cloud, encoding);
+    check(read_pcd(file), file.string());
+  }
+  for (const auto encoding : {PlyEncoding::kAscii, PlyEncoding::kBinaryLittleEndian, PlyEncoding::kBinaryBigEndian}) {
+    const auto file = dir / fmt::format("c{}.ply", static_cast<int>(encoding));
+    write_ply_scan(file, cloud, encoding);
+    check(read_ply_cloud(file), file.string());
+  }
+  const auto bytes = serialize_pointcloud2(cloud, 1317042145.125, "velodyne", 7);
+  check(parse_pointcloud2(bytes, "x.bag", "topic /points, message 0").decoded, "PointCloud2");
+  // Nothing left: an error that says why.
+  LabelledCloud far = sweep_cloud(3);
+  for (auto& p : far.points) p.y() = 1e30f;
+  write_pcd(dir / "far.pcd", far, PcdEncoding::kBinary);
+  EXPECT_NE(input_error_of([&] { (void)read_pcd(dir / "far.pcd"); }).find("no point with finite coordinates within 10000 m"),
+            std::string::npos);
+}
+
+TEST(PointChecks, AWronglyStatedByteOrderIsRefused) {
+  testing::TempDir dir;
+  const LabelledCloud cloud = sweep_cloud(200);
+  write_ply_scan(dir / "le.ply", cloud, PlyEncoding::kBinaryLittleEndian);
+  std::ifstream in(dir / "le.ply", std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto at = text.find("binary_little_endian");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, std::strlen("binary_little_endian"), "binary_big_endian");  // the same length: the data stays
+  const std::string error = input_error_of([&] { (void)parse_ply(bytes_of(text), "swapped.ply"); });
+  EXPECT_NE(error.find("swapped.ply: the data is little-endian although the header says big-endian"), std::string::npos)
+      << error;
+  // A cloud of mostly missing (NaN) returns stated rightly is no such case.
+  LabelledCloud sparse = sweep_cloud(200);
+  for (std::size_t i = 0; i < 150; ++i) sparse.points[i].x() = std::numeric_limits<float>::quiet_NaN();
+  write_ply_scan(dir / "sparse.ply", sparse, PlyEncoding::kBinaryBigEndian);
+  EXPECT_EQ(read_ply_cloud(dir / "sparse.ply").cloud.size(), 50u);
+  // PointCloud2: is_bigendian wrongly set (the byte after the fields).
+  auto bytes = serialize_pointcloud2(cloud, 5.0, "velodyne");
+  const std::size_t fields_end = 4 + 8 + 4 + 8 + 8 + 4 + (4 + 1 + 4 + 1 + 4) * 3 + (4 + 9 + 4 + 1 + 4) +
+                                 (4 + 4 + 4 + 1 + 4) + (4 + 4 + 4 + 1 + 4);
+  ASSERT_EQ(bytes[fields_end], std::byte{0});
+  bytes[fields_end] = std::byte{1};
+  EXPECT_NE(input_error_of([&] { (void)parse_pointcloud2(bytes, "x.bag", "message 0"); })
+                .find("x.bag: message 0: the data is little-endian although the header says big-endian"),
+            std::string::npos);
 }
 
 TEST(PointCloud2, SerialisedMessagesRoundTrip) {

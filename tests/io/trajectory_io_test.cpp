@@ -212,6 +212,31 @@ TEST(TrajectoryIo, ByteOrderMarkIsSkippedAndDirectoriesNamed) {
   EXPECT_NE(msg.find("poses.txt: is a directory, not a file"), std::string::npos) << msg;
 }
 
+// Old cases of issue #39, each with its test.
+TEST(TrajectoryIo, TumTimestampsKeepNanoseconds) {
+  testing::TempDir dir;
+  Trajectory t;
+  for (int i = 0; i < 3; ++i) {
+    t.timestamps.push_back(1e-9 * i);
+    t.poses.push_back(Pose::Identity());
+  }
+  write_tum_trajectory(dir / "ns.txt", t);
+  const Trajectory back = read_tum_trajectory(dir / "ns.txt");
+  ASSERT_EQ(back.size(), 3u);
+  EXPECT_NEAR(back.timestamps[1], 1e-9, 1e-15);
+  EXPECT_NEAR(back.timestamps[2], 2e-9, 1e-15);
+}
+
+TEST(Calibration, ANonFiniteTrIsNamedSo) {
+  testing::TempDir dir;
+  std::ofstream(dir / "nan.txt") << "Tr: nan 0 0 0 0 1 0 0 0 0 1 0\n";
+  const std::string error = input_error_of([&] { (void)read_velo_to_cam(dir / "nan.txt"); });
+  EXPECT_NE(error.find("line 1: 'Tr' holds the non-finite value 'nan'"), std::string::npos) << error;
+  std::ofstream(dir / "inf.txt") << "Tr: 1 0 0 0 0 1 0 1e999 0 0 1 0\n";
+  EXPECT_NE(input_error_of([&] { (void)read_velo_to_cam(dir / "inf.txt"); }).find("non-finite value '1e999'"),
+            std::string::npos);
+}
+
 TEST(TrajectoryIo, FormatIsReported) {
   testing::TempDir dir;
   write_text(dir / "k.txt", kitti_line(Eigen::Matrix3d::Identity()));

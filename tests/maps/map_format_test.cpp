@@ -354,6 +354,27 @@ TEST(MapFormat, AMapKnowsItself) {
   EXPECT_NE(error.find((dir / "live/features/000001.bin").string()), std::string::npos) << error;
 }
 
+// Bounded memory (issue #39): a table larger than its header's records can
+// take is refused before it is read (a map table once was read whole, up to
+// 16 GiB, and copied before its header was looked at).
+TEST(MapFormat, ATableLargerThanItsHeaderAllowsIsNotRead) {
+  testing::TempDir dir("saloam_map_sizes");
+  const TestMap t = make_map(3);
+  for (const std::string name : {"keyframes.bin", "edges.bin", "digests.bin", "features/000001.bin"}) {
+    SCOPED_TRACE(name);
+    const auto folder = dir / ("map_" + std::to_string(name.size()));
+    write_test_map(folder, t);
+    edit_file(folder / name, [](std::string& b) { b.append(std::size_t{1} << 20, '\0'); });
+    const std::string error = testing::input_error_of([&] {
+      const SavedMap map = read_map(folder);
+      (void)read_map_features(map, 1);
+    });
+    EXPECT_NE(error.find((folder / name).string() + ": "), std::string::npos) << error;
+    EXPECT_NE(error.find("records can take: not read"), std::string::npos) << error;
+  }
+  EXPECT_EQ(max_map_record_bytes(MapTable::kKeyframes, SaloamConfig{}), 220u);
+}
+
 TEST(MapFormat, ReadsVersion1Maps) {
   testing::TempDir dir("saloam_map_v1");
   const TestMap t = make_map(5);

@@ -294,6 +294,20 @@ TEST(Viewer, ServerAnswersOnlyToLoopbackHostNames) {
   EXPECT_FALSE(viewer_host_allowed(":8080", 8080));
 }
 
+// Bounded memory (issue #39): a request body beyond 64 KiB is refused (413),
+// not buffered; the server keeps answering.
+TEST(Viewer, LargeRequestBodiesAreRefused) {
+  ServingRun serving;
+  httplib::Client client("127.0.0.1", serving.port);
+  const httplib::Headers host{{"Host", fmt::format("127.0.0.1:{}", serving.port)}};
+  const auto big = client.Post("/", host, std::string(4 << 20, 'x'), "application/octet-stream");
+  ASSERT_TRUE(big);
+  EXPECT_EQ(big->status, 413);
+  const auto small = client.Get("/map.bin", host);
+  ASSERT_TRUE(small);
+  EXPECT_EQ(small->status, 200);
+}
+
 TEST(Viewer, IdleConnectionsDoNotStallTheServer) {
   // Twelve connections that send nothing (more than httplib's default pool
   // of 8 workers, each of which would wait 5 s on one): a request still

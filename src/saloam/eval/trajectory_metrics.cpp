@@ -6,6 +6,7 @@
 #include <limits>
 #include <numeric>
 #include <stdexcept>
+#include <utility>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -203,6 +204,30 @@ ErrorStats error_stats(const std::vector<double>& errors) {
   return s;
 }
 
+std::vector<std::pair<std::size_t, std::size_t>> associate_by_time(const std::vector<double>& gt,
+                                                                   const std::vector<double>& est,
+                                                                   double max_difference) {
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;
+  std::size_t next_gt = 0;  // gt times before this are used or passed
+  for (std::size_t e = 0; e < est.size(); ++e) {
+    const auto at = std::lower_bound(gt.begin() + static_cast<std::ptrdiff_t>(next_gt), gt.end(), est[e]);
+    std::size_t best = gt.size();
+    double best_gap = max_difference;
+    for (auto it : {at - (at != gt.begin() + static_cast<std::ptrdiff_t>(next_gt) ? 1 : 0), at}) {
+      if (it == gt.end()) continue;
+      const double gap = std::abs(*it - est[e]);
+      if (gap <= best_gap) {
+        best_gap = gap;
+        best = static_cast<std::size_t>(it - gt.begin());
+      }
+    }
+    if (best == gt.size()) continue;
+    pairs.emplace_back(best, e);
+    next_gt = best + 1;
+  }
+  return pairs;
+}
+
 AteMetrics compute_ate(const std::vector<Pose>& gt, const std::vector<Pose>& est, Alignment alignment) {
   require_same_size(gt, est, "ATE");
   if (gt.empty()) throw std::invalid_argument("ATE: empty trajectories");
@@ -216,6 +241,26 @@ AteMetrics compute_ate(const std::vector<Pose>& gt, const std::vector<Pose>& est
 
   AteMetrics m;
   m.alignment = alignment;
+  if (alignment == Alignment::kSim3) {
+    // A trajectory that does not move has no scale: Umeyama's would be 0 (or
+    // undefined) and shrink the other onto one point, an ATE of 0.
+    const auto spread = [](const std::vector<Eigen::Vector3d>& p) {
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (const auto& x : p) mean += x;
+      mean /= static_cast<double>(p.size());
+      double sum = 0.0;
+      for (const auto& x : p) sum += (x - mean).squaredNorm();
+      return std::sqrt(sum / static_cast<double>(p.size()));
+    };
+    constexpr double kMinSpread = 1e-6;  // [m]
+    for (const auto& [name, points] : {std::pair{"ground truth", &p_gt}, std::pair{"estimate", &p_est}}) {
+      if (spread(*points) < kMinSpread) {
+        throw std::invalid_argument(fmt::format("sim3 alignment: the {} does not move (positions spread {:.3g} m "
+                                                "about their mean): its scale is undefined; use --align se3",
+                                                name, spread(*points)));
+      }
+    }
+  }
   if (alignment != Alignment::kNone) m.transform = umeyama_alignment(p_est, p_gt, alignment == Alignment::kSim3);
   m.aligned_errors.reserve(gt.size());
   m.unaligned_errors.reserve(gt.size());

@@ -132,9 +132,20 @@ struct AteMetrics {
 };
 
 /// Absolute trajectory error of the positions (evo's APE, translation part).
-/// Requires equal sizes.
+/// Requires equal sizes. kSim3 on a trajectory that does not move (positions
+/// within 1 um of their mean) throws std::invalid_argument: its scale is
+/// undefined (Umeyama's would be 0, an ATE of 0).
 AteMetrics compute_ate(const std::vector<Pose>& gt, const std::vector<Pose>& est,
                        Alignment alignment = Alignment::kSE3);
+
+/// Pairs two timestamped trajectories by time, as TUM's associate.py: each
+/// time of `est` with the nearest of `gt` when they are at most
+/// `max_difference` [s] apart, each `gt` time used once, in time order. Both
+/// lists increase. Returns (gt index, est index) pairs; times without a
+/// partner are left out.
+std::vector<std::pair<std::size_t, std::size_t>> associate_by_time(const std::vector<double>& gt,
+                                                                   const std::vector<double>& est,
+                                                                   double max_difference);
 
 // ---------------------------------------------------------------------------
 // Relative pose error

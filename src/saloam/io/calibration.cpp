@@ -33,6 +33,23 @@ std::optional<std::vector<double>> parse_values(const std::string& text) {
   return v;
 }
 
+/// The first word of `text` that reads as a non-finite number ("nan", "inf", "1e999"), if any.
+std::optional<std::string> non_finite_word(const std::string& text) {
+  std::istringstream ss(text);
+  std::string token;
+  while (ss >> token) {
+    try {
+      std::size_t used = 0;
+      const double v = std::stod(token, &used);
+      if (used == token.size() && !std::isfinite(v)) return token;
+    } catch (const std::out_of_range&) {
+      return token;  // beyond double's range
+    } catch (const std::exception&) {
+    }
+  }
+  return std::nullopt;
+}
+
 std::string trimmed(const std::string& text) {
   const auto first = text.find_first_not_of(" \t");
   if (first == std::string::npos) return "";
@@ -60,8 +77,13 @@ Pose read_velo_to_cam(std::istream& in, const std::filesystem::path& file, int s
     if (relevant && key.empty()) ++bare_lines;
     if (!relevant || (key.empty() && bare)) return;
     if (!values || values->size() != 12) {
-      throw InputError(file, fmt::format("line {}: '{}' needs 12 numbers (3x4 row-major)", line_no,
-                                         key.empty() ? "Tr" : key));
+      const std::string name = key.empty() ? "Tr" : key;
+      if (const auto bad = non_finite_word(colon == std::string::npos ? line : line.substr(colon + 1))) {
+        throw InputError(file, fmt::format("line {}: '{}' holds the non-finite value '{}' (12 finite numbers, 3x4 "
+                                           "row-major)",
+                                           line_no, name, bad->substr(0, 40)));
+      }
+      throw InputError(file, fmt::format("line {}: '{}' needs 12 numbers (3x4 row-major)", line_no, name));
     }
     const Pose T = checked_rigid_pose(pose_from_3x4(values->data()), file, line_no,
                                       fmt::format("rotation of '{}'", key.empty() ? "Tr" : key));

@@ -153,6 +153,8 @@ void decode_binary(std::span<const std::byte> data, const PlyHeader& header, std
     throw InputError(file, fmt::format("truncated PLY: {} vertices of {} bytes, {} bytes of data", v.count, v.stride, available));
   }
   const bool big = header.encoding == PlyEncoding::kBinaryBigEndian;
+  check_byte_order(v.count, [&](std::size_t i) { return data.data() + offset + i * v.stride; }, v.properties,
+                   FieldRoles::find(v.properties, file), big, file);
   for (std::size_t i = 0; i < v.count; ++i) out.add_binary(data.data() + offset + i * v.stride, big);
 }
 

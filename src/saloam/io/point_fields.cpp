@@ -187,11 +187,9 @@ void CloudAssembler::add_values(std::span<const double> values) {
 
 void CloudAssembler::add(double x, double y, double z, double intensity, double ring, double time, double label,
                          double instance) {
+  ++points_seen_;
+  if (!keep_coordinates(x, y, z, checks_) || (roles_.ring && !keep_ring(ring, checks_))) return;
   const Eigen::Vector3f p(to_float(x), to_float(y), to_float(z));
-  if (!p.allFinite()) {
-    ++dropped_;
-    return;
-  }
   const float remission = std::isfinite(intensity) ? to_float(intensity) : 0.0f;
   cloud_.points.push_back(p);
   cloud_.remission.push_back(std::isfinite(remission) ? remission : 0.0f);
@@ -209,6 +207,7 @@ DecodedCloud CloudAssembler::decoded(std::size_t points_in_file, std::optional<d
   decoded.cloud = finish(scan_stamp, file);
   decoded.time_reference = absolute_reference_;
   if (roles_.intensity) decoded.intensity_type = fields_[*roles_.intensity].type;
+  decoded.checks = checks_;
   return decoded;
 }
 
@@ -244,10 +243,12 @@ double ScanRecordLayout::value(const LabelledCloud& cloud, std::size_t i, std::s
 
 LabelledCloud CloudAssembler::finish(std::optional<double> scan_stamp, const std::filesystem::path& file) {
   if (cloud_.empty()) {
-    throw InputError(file, dropped_ > 0 ? fmt::format("no finite point among {} points", dropped_)
-                                        : std::string("no points"));
+    throw InputError(file, checks_.dropped() > 0
+                               ? fmt::format("no point with finite coordinates within {:g} m (and a ring within "
+                                             "0..{:g}) among {} points",
+                                             kMaxScanCoordinate, kMaxRings - 1, checks_.dropped())
+                               : std::string("no points"));
   }
-  if (dropped_ > 0) spdlog::debug("{}: dropped {} points with NaN/Inf coordinates", file.string(), dropped_);
   if (roles_.time) {
     double earliest = std::numeric_limits<double>::infinity(), largest = 0.0;
     for (const double t : raw_times_) {
@@ -262,11 +263,10 @@ LabelledCloud CloudAssembler::finish(std::optional<double> scan_stamp, const std
     }
     cloud_.time.resize(raw_times_.size());
     for (std::size_t i = 0; i < raw_times_.size(); ++i) {
-      const double t = raw_times_[i] - reference;
-      const float seconds = to_float(t);
-      cloud_.time[i] = std::isfinite(seconds) ? seconds : 0.0f;
+      cloud_.time[i] = checked_time(raw_times_[i] - reference, checks_);
     }
   }
+  warn_point_checks(file, points_seen_, checks_, true);
   return std::move(cloud_);
 }
 

@@ -11,8 +11,10 @@
 //   ring                           LabelledCloud::ring (beam index)
 //   time, t, timestamp, offset_time LabelledCloud::time, see PointTimeUnits
 //   label, instance                class and instance ids (low 16 bits)
-// Other fields are skipped. Points with non-finite coordinates are dropped
-// (organised clouds mark missing returns with NaN).
+// Other fields are skipped. Every point goes through io/point_checks.hpp:
+// points with non-finite or out-of-range coordinates or rings are dropped
+// (organised clouds mark missing returns with NaN), times clamped into the
+// sweep, each counted and warned once per file.
 
 #include <cstddef>
 #include <cstdint>
@@ -24,6 +26,7 @@
 #include <vector>
 
 #include "saloam/core/types.hpp"
+#include "saloam/io/point_checks.hpp"
 
 namespace saloam {
 
@@ -64,6 +67,7 @@ struct DecodedCloud {
   /// The type of the field taken for the remission; none when the file has
   /// no intensity field (what intensity_scale.hpp decides the range by).
   std::optional<ScalarType> intensity_type;
+  PointCheckCounts checks;              ///< what the point checks dropped or clamped
 };
 
 /// The record the writers (PCD, PLY scans, PointCloud2) write for a cloud,
@@ -107,7 +111,8 @@ class CloudAssembler {
   /// The absolute time the per-point times were taken relative to, when they
   /// were absolute (after finish()).
   [[nodiscard]] std::optional<double> absolute_reference() const { return absolute_reference_; }
-  [[nodiscard]] std::size_t dropped_nonfinite() const { return dropped_; }
+  /// What the point checks dropped (so far) and clamped (after finish()).
+  [[nodiscard]] const PointCheckCounts& checks() const { return checks_; }
   /// finish() with what a file's reader reports: the fields taken and the
   /// number of records in the file.
   DecodedCloud decoded(std::size_t points_in_file, std::optional<double> scan_stamp, const std::filesystem::path& file);
@@ -120,7 +125,8 @@ class CloudAssembler {
   double time_scale_ = 1.0;  ///< to seconds
   LabelledCloud cloud_;
   std::vector<double> raw_times_;
-  std::size_t dropped_ = 0;
+  PointCheckCounts checks_;
+  std::size_t points_seen_ = 0;
   std::optional<double> absolute_reference_;
 };
 

@@ -163,6 +163,16 @@ PointCloud2Scan parse_pointcloud2(std::span<const std::byte> message, const std:
       throw in.error(fmt::format("data of {} bytes is shorter than height {} x row_step {}", data_size, scan.height, row_step));
     }
   }
+  if (scan.width > 0 && scan.height > 0) {
+    try {
+      check_byte_order(
+          scan.width * scan.height,
+          [&](std::size_t i) { return data.data() + (i / scan.width) * row_step + (i % scan.width) * point_step; },
+          fields, roles, big_endian, file);
+    } catch (const InputError& e) {
+      throw in.error(std::string(e.what()).substr(file.string().size() + 2));
+    }
+  }
   CloudAssembler out(fields, roles, scan.width * scan.height);
   for (std::size_t r = 0; r < scan.height && scan.width > 0; ++r) {
     for (std::size_t c = 0; c < scan.width; ++c) out.add_binary(data.data() + r * row_step + c * point_step, big_endian);

@@ -71,20 +71,13 @@ LabelledCloud parse_scan(std::span<const std::byte> bin, const std::filesystem::
 
   ScanReadStats local;
   local.points_in_file = n;
+  PointCheckCounts checks;
   LabelledCloud cloud;
   cloud.has_labels = label_bytes.has_value();
   cloud.reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const float* p = &raw[4 * i];
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
-      ++local.dropped_nonfinite;
-      continue;
-    }
-    if (std::abs(p[0]) > kMaxScanCoordinate || std::abs(p[1]) > kMaxScanCoordinate ||
-        std::abs(p[2]) > kMaxScanCoordinate) {
-      ++local.dropped_out_of_range;
-      continue;
-    }
+    if (!keep_coordinates(p[0], p[1], p[2], checks)) continue;
     const float remission = std::isfinite(p[3]) ? p[3] : 0.0f;
     std::uint16_t cls = 0, inst = 0;
     if (!labels.empty()) {
@@ -97,14 +90,9 @@ LabelledCloud parse_scan(std::span<const std::byte> bin, const std::filesystem::
   if (cloud.empty()) {
     throw InputError(bin_file, fmt::format("no finite point within {:g} m among {} points", kMaxScanCoordinate, n));
   }
-  if (local.dropped_nonfinite > 0) {
-    spdlog::warn("{}: dropped {} of {} points with NaN/Inf coordinates", bin_file.string(),
-                 local.dropped_nonfinite, n);
-  }
-  if (local.dropped_out_of_range > 0) {
-    spdlog::warn("{}: dropped {} of {} points with a coordinate beyond {:g} m", bin_file.string(),
-                 local.dropped_out_of_range, n, kMaxScanCoordinate);
-  }
+  local.dropped_nonfinite = checks.nonfinite;
+  local.dropped_out_of_range = checks.out_of_range;
+  warn_point_checks(bin_file, n, checks);
   if (local.unknown_labels > 0) {
     spdlog::warn("{}: {} points carry class ids unknown to SemanticKITTI", label_file.string(),
                  local.unknown_labels);

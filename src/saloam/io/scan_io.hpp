@@ -10,12 +10,10 @@
 #include <vector>
 
 #include "saloam/core/types.hpp"
+#include "saloam/io/point_checks.hpp"  // kMaxScanCoordinate: the checks every reader makes
 
 namespace saloam {
 
-/// A scan's coordinates are in the sensor frame: a point farther than this
-/// along any axis (metres; no LiDAR sees 10 km) is not a measurement.
-inline constexpr float kMaxScanCoordinate = 1.0e4F;
 
 struct ScanReadStats {
   std::size_t points_in_file = 0;

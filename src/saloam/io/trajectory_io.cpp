@@ -121,7 +121,8 @@ Trajectory read_tum_trajectory(std::istream& in, const std::filesystem::path& fi
 std::string tum_pose_line(double timestamp, const Pose& pose) {
   const Eigen::Quaterniond q(pose.linear());
   const Eigen::Vector3d t = pose.translation();
-  return fmt::format("{:.6f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}", timestamp, t.x(), t.y(), t.z(),
+  // Nanoseconds (LiDAR drivers stamp in ns): times 1e-9 s apart stay apart.
+  return fmt::format("{:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}", timestamp, t.x(), t.y(), t.z(),
                      q.x(), q.y(), q.z(), q.w());
 }
 

@@ -3,6 +3,9 @@
 // (core/folder_replace.hpp), read back table by table with every count and
 // reference checked; the tables' bytes are map_format.cpp's.
 #include <algorithm>
+#include <array>
+#include <fstream>
+#include <span>
 #include <cstring>
 #include <random>
 
@@ -29,12 +32,6 @@ namespace {
 constexpr std::size_t kMaxManifestBytes = std::size_t{1} << 20;
 constexpr std::size_t kMaxTableBytes = std::size_t{16} << 30;
 
-std::vector<std::byte> to_bytes(const std::string& text) {
-  std::vector<std::byte> bytes(text.size());
-  if (!text.empty()) std::memcpy(bytes.data(), text.data(), text.size());
-  return bytes;
-}
-
 std::string_view as_text(const std::vector<std::byte>& bytes) {
   return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
 }
@@ -54,9 +51,39 @@ std::string read_checked(const fs::path& folder, const MapManifest& manifest, co
   return text;
 }
 
-std::vector<std::byte> read_table(const fs::path& folder, const MapManifest& manifest, const std::string& name) {
-  return to_bytes(read_checked(folder, manifest, name, kMaxTableBytes));
+// The size a table file may have, from its header's record count, checked
+// before the file is read (a map table once was read whole, up to 16 GiB,
+// and copied before its header was looked at).
+std::size_t checked_table_size(const fs::path& file, MapTable table, const SaloamConfig& config) {
+  std::error_code error;
+  if (!fs::is_regular_file(file, error)) return kMaxTableBytes;  // read_file names what it is
+  const std::uintmax_t size = fs::file_size(file, error);
+  if (error) return kMaxTableBytes;
+  std::array<std::byte, kMapTableHeadBytes> head{};
+  std::ifstream in(file, std::ios::binary);
+  in.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  std::uint64_t most = kMaxTableBytes;
+  try {
+    most = std::min<std::uint64_t>(
+        most, map_table_max_bytes(std::span<const std::byte>(head.data(), static_cast<std::size_t>(in.gcount())),
+                                  table, config, file));
+  } catch (const InputError&) {
+    return kMaxTableBytes;  // a bad header: the digest and the parser name the problem
+  }
+  if (size > most) {
+    throw InputError(file, fmt::format("{} bytes, more than the {} its header's records can take: not read", size,
+                                       most));
+  }
+  return static_cast<std::size_t>(most);
 }
+
+// A table's bytes, as read (no copy), checked against its digest.
+std::string read_table(const fs::path& folder, const MapManifest& manifest, const std::string& name, MapTable table,
+                       const SaloamConfig& config) {
+  return read_checked(folder, manifest, name, checked_table_size(folder / name, table, config));
+}
+
+std::span<const std::byte> bytes_of(const std::string& text) { return std::as_bytes(std::span<const char>(text)); }
 
 void collect_keys(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& keys) {
   if (!node.IsMap()) {
@@ -254,23 +281,23 @@ SavedMap read_map(const fs::path& folder) {
                                                 map.manifest.detector, map.config.loop.detector));
   }
   const fs::path keyframes_file = folder / "keyframes.bin";
-  map.keyframes = parse_map_keyframes(read_table(folder, map.manifest, "keyframes.bin"), keyframes_file);
+  map.keyframes = parse_map_keyframes(bytes_of(read_table(folder, map.manifest, "keyframes.bin", MapTable::kKeyframes, map.config)), keyframes_file);
   if (map.keyframes.size() != map.manifest.keyframes) {
     throw InputError(keyframes_file, fmt::format("{} keyframes, map.json says {}", map.keyframes.size(), map.manifest.keyframes));
   }
   check_sessions(map, keyframes_file);
   const fs::path edges_file = folder / "edges.bin";
-  map.edges = parse_map_edges(read_table(folder, map.manifest, "edges.bin"), map.keyframes.size(), edges_file);
+  map.edges = parse_map_edges(bytes_of(read_table(folder, map.manifest, "edges.bin", MapTable::kEdges, map.config)), map.keyframes.size(), edges_file);
   if (map.edges.size() != map.manifest.edges) {
     throw InputError(edges_file, fmt::format("{} edges, map.json says {}", map.edges.size(), map.manifest.edges));
   }
   const fs::path places_file = folder / "places.bin";
-  map.places = parse_map_places(read_table(folder, map.manifest, "places.bin"), map.config, places_file);
+  map.places = parse_map_places(bytes_of(read_table(folder, map.manifest, "places.bin", MapTable::kPlaces, map.config)), map.config, places_file);
   if (map.places.size() != map.keyframes.size()) {
     throw InputError(places_file, fmt::format("{} descriptors for {} keyframes", map.places.size(), map.keyframes.size()));
   }
   if (map.manifest.version >= 3) {
-    map.feature_digests = parse_map_digests(read_table(folder, map.manifest, "digests.bin"), map.keyframes.size(),
+    map.feature_digests = parse_map_digests(bytes_of(read_table(folder, map.manifest, "digests.bin", MapTable::kDigests, map.config)), map.keyframes.size(),
                                             folder / "digests.bin");
   }
   const PlaceDetector detector = parse_place_detector(map.manifest.detector);
@@ -288,12 +315,12 @@ SavedMap read_map(const fs::path& folder) {
 
 StoredFeatures read_map_features(const fs::path& folder, std::size_t keyframe) {
   const fs::path file = map_features_path(folder, keyframe);
-  return parse_map_features(to_bytes(read_file(file, kMaxTableBytes, "map file")), file);
+  return parse_map_features(bytes_of(read_file(file, checked_table_size(file, MapTable::kFeatures, SaloamConfig{}), "map file")), file);
 }
 
 StoredFeatures read_map_features(const SavedMap& map, std::size_t keyframe) {
   const fs::path file = map_features_path(map.folder, keyframe);
-  const std::string text = read_file(file, kMaxTableBytes, "map file");
+  const std::string text = read_file(file, checked_table_size(file, MapTable::kFeatures, map.config), "map file");
   if (keyframe < map.feature_digests.size() && fnv1a64(text) != map.feature_digests[keyframe]) {
     std::string id;
     try {
@@ -306,7 +333,7 @@ StoredFeatures read_map_features(const SavedMap& map, std::size_t keyframe) {
                                        map.folder.string(), map.manifest.id.empty() ? "none" : map.manifest.id,
                                        id.empty() ? "none" : id));
   }
-  return parse_map_features(to_bytes(text), file);
+  return parse_map_features(bytes_of(text), file);
 }
 
 std::uintmax_t map_disk_bytes(const fs::path& folder) {

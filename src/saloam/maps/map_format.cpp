@@ -5,6 +5,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include <Eigen/Cholesky>
 #include <fmt/format.h>
@@ -571,6 +572,39 @@ std::vector<std::uint64_t> parse_map_digests(std::span<const std::byte> bytes, s
   for (std::uint64_t& d : digests) d = r.get<std::uint64_t>("a digest");
   r.finish();
   return digests;
+}
+
+std::uint64_t map_table_max_bytes(std::span<const std::byte> head, MapTable table, const SaloamConfig& config,
+                                  const fs::path& origin) {
+  ByteReader r(head, origin);
+  const std::uint64_t records = r.header(table);
+  if (table == MapTable::kFeatures && records == 1 && head.size() >= kHeaderBytes + 16) {
+    const std::uint64_t edges = r.get<std::uint64_t>("edge count"), planars = r.get<std::uint64_t>("planar count");
+    if (edges > kMaxKeyframeFeatures || planars > kMaxKeyframeFeatures) {
+      r.fail(fmt::format("{} edge and {} planar points exceed the limit of {}", edges, planars, kMaxKeyframeFeatures));
+    }
+    return kHeaderBytes + 16 + (edges + planars) * 13;
+  }
+  const std::uint64_t per_record = max_map_record_bytes(table, config);
+  constexpr std::uint64_t kNoLimit = std::numeric_limits<std::uint64_t>::max();
+  return records > (kNoLimit - kHeaderBytes) / per_record ? kNoLimit : kHeaderBytes + records * per_record;
+}
+
+std::uint64_t max_map_record_bytes(MapTable table, const SaloamConfig& config) {
+  switch (table) {
+    case MapTable::kKeyframes: return 8 + 8 + 8 + 96 + 96 + 4;
+    case MapTable::kEdges: return 12 + 96 + 21 * 8;
+    case MapTable::kDigests: return 8;
+    case MapTable::kFeatures: return 16 + 2 * kMaxKeyframeFeatures * 13;
+    case MapTable::kPlaces: {
+      const ScanContextConfig sc;
+      const std::uint64_t context = 8 + 4ull * static_cast<std::uint64_t>(sc.num_rings * sc.num_sectors);
+      const std::uint64_t ssc = 4 + 9ull * kMaxSscPoints + 4 + 12ull * static_cast<std::uint64_t>(std::max(0, config.loop.ssc.key_sectors));
+      const std::uint64_t sgpr = 4 + 28ull * kMaxGraphNodes + 4ull * kSgprEmbeddingSize;
+      return 4 + context + ssc + sgpr;
+    }
+  }
+  return 0;
 }
 
 StoredFeatures parse_map_features(std::span<const std::byte> bytes, const fs::path& origin) {

@@ -153,6 +153,19 @@ StoredFeatures read_map_features(const std::filesystem::path& folder, std::size_
 /// was changed) is an InputError "map replaced or changed under this run".
 StoredFeatures read_map_features(const SavedMap& map, std::size_t keyframe);
 
+/// The bytes at a table file's start that map_table_max_bytes looks at (the
+/// 24-byte header; a features file's point counts after it).
+inline constexpr std::size_t kMapTableHeadBytes = 40;
+/// The most bytes a table file may hold, from its first bytes `head` (up to
+/// kMapTableHeadBytes): the header checked (magic, version, kind `table`),
+/// then its record count times max_map_record_bytes (a features file: its
+/// exact size from its point counts). A larger file is refused before it is
+/// read (issue #39). InputError naming `origin` for a bad header.
+std::uint64_t map_table_max_bytes(std::span<const std::byte> head, MapTable table, const SaloamConfig& config,
+                                  const std::filesystem::path& origin);
+/// The most bytes one record of `table` takes in a map made with `config`.
+std::uint64_t max_map_record_bytes(MapTable table, const SaloamConfig& config);
+
 // The parsers behind the readers (also what the fuzz harness feeds): each
 // takes the bytes of one file and `origin`, the file named in errors.
 MapManifest parse_map_manifest(std::string_view text, const std::filesystem::path& origin);

@@ -131,7 +131,9 @@ LabelledCloud PointCloudFolder::scan(std::size_t i) {
                                                     decoded.points_in_file, file.filename().string()));
     }
     if (decoded.cloud.size() != decoded.points_in_file) {
-      throw InputError(file, "has points with NaN coordinates: its labels cannot be matched to the points kept");
+      throw InputError(file, fmt::format("{} of its points were dropped (non-finite or out-of-range coordinates or "
+                                         "rings): its labels cannot be matched to the points kept",
+                                         decoded.points_in_file - decoded.cloud.size()));
     }
     for (std::size_t k = 0; k < labels.size(); ++k) {
       decoded.cloud.label[k] = static_cast<std::uint16_t>(labels[k] & 0xFFFFu);

@@ -26,6 +26,9 @@ constexpr std::size_t kWorkerThreads = 64;
 constexpr time_t kKeepAliveSeconds = 2;
 constexpr time_t kReadSeconds = 5;
 constexpr time_t kWriteSeconds = 10;
+// The viewer takes no request bodies: a larger one is answered 413 and
+// skipped, never buffered (httplib's default buffers any size).
+constexpr std::size_t kMaxRequestBodyBytes = 64 * 1024;
 }  // namespace
 
 struct ViewerServer::Impl {
@@ -98,6 +101,7 @@ ViewerServer::ViewerServer(ViewerScene scene, const ViewerOptions& options) : im
   impl_->server.set_keep_alive_timeout(kKeepAliveSeconds);
   impl_->server.set_read_timeout(kReadSeconds, 0);
   impl_->server.set_write_timeout(kWriteSeconds, 0);
+  impl_->server.set_payload_max_length(kMaxRequestBodyBytes);
 }
 
 ViewerServer::~ViewerServer() { stop(); }
