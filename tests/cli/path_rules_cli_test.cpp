@@ -115,7 +115,8 @@ TEST_F(PathRulesCli, EveryCommandRefusesAnOutputOverAnInput) {
     std::istringstream words(c.args);
     for (std::string word; words >> word;) {
       const bool path = word.find('/') != std::string::npos || fs::exists(d / word) || word == "run2" || word == "e.json";
-      full += " " + (path && word[0] != '-' ? quoted(d / word) : word);
+      full += ' ';
+      full += path && word[0] != '-' ? quoted(d / word) : word;
     }
     const std::string output = failure_of(full);
     expect_has(output, (d / c.output).string());
