@@ -98,33 +98,23 @@ std::vector<fs::path> folder_leftovers(const fs::path& target) {
 }
 
 bool recover_folder(const fs::path& target, const FolderCheck& complete) {
-  bool recovered = false;
   std::vector<Leftover> found = leftovers(target);
-  if (!path_taken(target)) {
+  // Puts the first complete leftover of the kind into the missing target's place.
+  const auto put_back = [&](bool previous, std::string_view before, std::string_view after) {
+    if (path_taken(target)) return false;
     for (const Leftover& l : found) {
-      if (!l.previous || !complete(l.path)) continue;
+      if (l.previous != previous || !path_taken(l.path) || !complete(l.path)) continue;
       std::error_code ec;
       fs::rename(l.path, target, ec);
       if (ec) continue;
-      spdlog::warn("{}: put back from {}, where a replacement killed before it ended had left it", target.string(),
-                   l.path.string());
-      recovered = true;
-      break;
+      spdlog::warn("{}: {} {}{}", target.string(), before, l.path.string(), after);
+      return true;
     }
-  }
-  if (!path_taken(target)) {
-    // No previous folder: a complete new one is kept rather than removed.
-    for (const Leftover& l : found) {
-      if (l.previous || !path_taken(l.path) || !complete(l.path)) continue;
-      std::error_code ec;
-      fs::rename(l.path, target, ec);
-      if (ec) continue;
-      spdlog::warn("{}: put in place from {}, complete, whose writer was killed before it ended", target.string(),
-                   l.path.string());
-      recovered = true;
-      break;
-    }
-  }
+    return false;
+  };
+  bool recovered = put_back(true, "put back from", ", where a replacement killed before it ended had left it");
+  // No previous folder: a complete new one is kept rather than removed.
+  recovered = put_back(false, "put in place from", ", complete, whose writer was killed before it ended") || recovered;
   const bool missing = !path_taken(target);
   for (const Leftover& l : found) {
     if (!path_taken(l.path)) continue;

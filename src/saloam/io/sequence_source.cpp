@@ -35,19 +35,10 @@ std::vector<std::string> notes(const SequenceReader& reader, bool calib) {
   return out;
 }
 
-IntensityScale intensity_of(const SequenceReader& reader, std::optional<float> given) {
-  if (given || reader.size() == 0) return unread_intensity_scale(given);
-  try {
-    return choose_intensity_scale(given, ScalarType::kFloat32, read_scan(reader.scan_file(0)).remission);
-  } catch (const InputError&) {
-    return unread_intensity_scale(given);  // the run fails on that scan, naming it
-  }
-}
-
 }  // namespace
 
 SequenceFolderSource::SequenceFolderSource(SequenceReader reader, bool read_calib, std::optional<float> intensity_scale)
-    : reader_(std::move(reader)), intensity_(intensity_of(reader_, intensity_scale)) {
+    : reader_(std::move(reader)), intensity_(sequence_intensity_scale(reader_, intensity_scale)) {
   info_.name = reader_.root().string();
   info_.times = reader_.times();
   info_.has_labels = reader_.has_labels();
@@ -60,6 +51,15 @@ SequenceFolderSource::SequenceFolderSource(SequenceReader reader, bool read_cali
   info_.point_fields = "x y z remission";
   info_.notes = notes(reader_, info_.velo_to_cam.has_value());
   info_.notes.push_back(intensity_.note());
+}
+
+IntensityScale sequence_intensity_scale(const SequenceReader& reader, std::optional<float> given) {
+  if (given || reader.size() == 0) return unread_intensity_scale(given);
+  try {
+    return choose_intensity_scale(given, ScalarType::kFloat32, read_scan(reader.scan_file(0)).remission);
+  } catch (const InputError&) {
+    return unread_intensity_scale(given);  // the run fails on that scan, naming it
+  }
 }
 
 LabelledCloud SequenceFolderSource::scan(std::size_t i) {

@@ -35,4 +35,9 @@ class SequenceFolderSource final : public FrameSource {
   SourceInfo info_;
 };
 
+/// The intensity range of a sequence folder (io/intensity_scale.hpp): `given`
+/// when set, else decided on its first .bin scan; a first scan that cannot
+/// be read counts as 0..1 (whatever reads it fails on it, naming it).
+IntensityScale sequence_intensity_scale(const SequenceReader& reader, std::optional<float> given = std::nullopt);
+
 }  // namespace saloam

@@ -22,9 +22,8 @@
 #include "saloam/core/hash.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/core/semantic_classes.hpp"
-#include "saloam/io/intensity_scale.hpp"
-#include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
+#include "saloam/io/sequence_source.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 
 namespace saloam {
@@ -74,9 +73,7 @@ std::vector<TrainingScan> folder_scans(const SourceSpec& spec, const FeatureConf
   for (std::size_t i = first; i < end; i += spec.frame_step) frames.push_back(i);
   // Remission in 0..1 as every run reads it (io/intensity_scale.hpp): one
   // range for the folder, from its first scan.
-  const IntensityScale scale =
-      reader.size() == 0 ? IntensityScale{}
-                         : choose_intensity_scale(std::nullopt, ScalarType::kFloat32, read_scan(reader.scan_file(0)).remission);
+  const IntensityScale scale = sequence_intensity_scale(reader);
   if (scale.divisor != 1.0F) spdlog::info("{}: {}", spec.name(), scale.note());
   return build_all(frames.size(), "scans of " + spec.name(), show_progress, [&](std::size_t k) {
     LabelledCloud cloud = reader.load_scan(frames[k]);
