@@ -33,6 +33,15 @@ Pose random_pose(std::mt19937& rng) {
   return orthonormalized(T);
 }
 
+// A keyframe's motion from the one before: 1-3 m ahead, turning a little.
+Pose small_step(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  Pose T = Pose::Identity();
+  T.linear() = Eigen::AngleAxisd(0.1 * u(rng), Eigen::Vector3d(0.1 * u(rng), 0.1 * u(rng), 1).normalized()).toRotationMatrix();
+  T.translation() = Eigen::Vector3d(2 + u(rng), 0.2 * u(rng), 0.05 * u(rng));
+  return orthonormalized(T);
+}
+
 StoredFeatures random_features(std::mt19937& rng, std::size_t n) {
   std::uniform_real_distribution<float> u(-50, 50);
   StoredFeatures f;
@@ -60,14 +69,19 @@ TestMap make_map(std::size_t keyframes) {
   t.map.manifest.first_frame = 12;
   t.map.manifest.camera_frame_outputs = true;
   t.map.manifest.velo_to_cam = random_pose(rng);
+  const Pose map_from_odometry = random_pose(rng);
   std::uniform_real_distribution<float> u(0, 10);
   for (std::size_t k = 0; k < keyframes; ++k) {
     MapKeyframe kf;
     kf.frame = 3 * k;
     kf.timestamp = 0.3 * static_cast<double>(k);
     kf.travelled = 1.5 * static_cast<double>(k);
-    kf.pose = random_pose(rng);
-    kf.odometry_pose = random_pose(rng);
+    // The odometry poses chain the odometry edges' measurements; the
+    // optimised poses are the odometry's in the map frame, a loop's
+    // correction (10 cm) apart (read_map checks both).
+    const Pose step = k == 0 ? Pose::Identity() : small_step(rng);
+    kf.odometry_pose = k == 0 ? random_pose(rng) : orthonormalized(t.map.keyframes.back().odometry_pose * step);
+    kf.pose = orthonormalized(map_from_odometry * kf.odometry_pose * Eigen::Translation3d(0.1, 0, 0));
     t.map.keyframes.push_back(kf);
     PlaceDescriptor p;
     Eigen::MatrixXf sc(20, 60);
@@ -91,7 +105,7 @@ TestMap make_map(std::size_t keyframes) {
       PoseGraphEdge e;
       e.from = k - 1;
       e.to = k;
-      e.measured = random_pose(rng);
+      e.measured = step;
       Matrix6d a = Matrix6d::Random();
       e.information = a * a.transpose() + Matrix6d::Identity();
       t.map.edges.push_back(e);
@@ -251,6 +265,7 @@ TEST(MapFormat, SessionsRoundTrip) {
     t.map.keyframes[k].travelled = 0.5 * static_cast<double>(k - 4);
   }
   t.map.manifest.sessions = {MapSession{"/data/a", 12, 0, true}, MapSession{"/data/b", 3, 0, false}};
+  t.map.edges.erase(t.map.edges.begin() + 3);  // no odometry edge 3 -> 4 between the sessions
   PoseGraphEdge cross;
   cross.from = 1;
   cross.to = 5;
@@ -352,6 +367,54 @@ TEST(MapFormat, AMapKnowsItself) {
   error = testing::input_error_of([&] { (void)live.features(1); });
   EXPECT_NE(error.find("map replaced or changed under this run"), std::string::npos) << error;
   EXPECT_NE(error.find((dir / "live/features/000001.bin").string()), std::string::npos) << error;
+}
+
+// A map's graph agrees with its keyframes and manifest (issue #39): an edit
+// whose digests were fitted to it is still refused when it moves a keyframe,
+// changes an edge or the manifest's loop counts.
+TEST(MapFormat, EditsThatFitTheDigestsAreRefusedByTheGraph) {
+  testing::TempDir dir("saloam_map_graph");
+  const TestMap t = make_map(5);
+  const auto refused = [&](const std::string& name, const std::function<void(TestMap&)>& edit) {
+    TestMap changed = t;
+    edit(changed);
+    write_test_map(dir / name, changed);  // written whole: every digest fits
+    return testing::input_error_of([&] { (void)read_map(dir / name); });
+  };
+  EXPECT_EQ(refused("whole", [](TestMap&) {}), "no error");
+
+  // A keyframe moved 9,900 km: refused by its odometry edges.
+  std::string error = refused("moved", [](TestMap& m) { m.map.keyframes[2].pose.translation().x() += 9.9e6; });
+  EXPECT_NE(error.find((dir / "moved/keyframes.bin").string() + ": keyframes 1 and 2: their poses are"), std::string::npos)
+      << error;
+  // Moved by half a metre along a 2 m edge: within a loop's correction.
+  EXPECT_EQ(refused("nudged", [](TestMap& m) { m.map.keyframes[2].pose.translation().z() += 0.5; }), "no error");
+
+  // An edge measuring 5,000 m between keyframes 2 m apart.
+  error = refused("long_edge", [](TestMap& m) { m.map.edges[1].measured.translation().x() = 5000; });
+  EXPECT_NE(error.find((dir / "long_edge/edges.bin").string() + ": odometry edge 1: measures 499"), std::string::npos)
+      << error;
+  // The odometry poses moved with it: the optimised poses still disagree.
+  error = refused("long_edge_and_odometry", [](TestMap& m) {
+    m.map.edges[1].measured.translation().x() += 5000;
+    for (std::size_t k = 2; k < m.map.keyframes.size(); ++k) {
+      m.map.keyframes[k].odometry_pose = m.map.keyframes[k - 1].odometry_pose * m.map.edges[k - 1].measured;
+    }
+  });
+  EXPECT_NE(error.find("keyframes 1 and 2: their poses are"), std::string::npos) << error;
+  // An odometry edge that skips a keyframe.
+  error = refused("skip", [](TestMap& m) { m.map.edges[1].to = 3; });
+  EXPECT_NE(error.find("odometry edge 1: keyframes 1 -> 3 are not consecutive"), std::string::npos) << error;
+
+  // The manifest's loop count (map.json has no digest of itself).
+  write_test_map(dir / "loops", t);
+  edit_file(dir / "loops/map.json", [](std::string& b) {
+    nlohmann::ordered_json j = nlohmann::ordered_json::parse(b);
+    j["loop_edges"] = 2;
+    b = j.dump(2);
+  });
+  error = testing::input_error_of([&] { (void)read_map(dir / "loops"); });
+  EXPECT_NE(error.find("1 loop edges (0 between sessions), map.json says 2 (0)"), std::string::npos) << error;
 }
 
 // Bounded memory (issue #39): a table larger than its header's records can

@@ -353,6 +353,7 @@ void write_two_session_map(const fs::path& folder) {
     kf.frame = kf.session == 0 ? k : k - 6;
     kf.pose.translation() = kf.session == 0 ? Eigen::Vector3d(5.0 * static_cast<double>(k), 0, 0)
                                             : Eigen::Vector3d(10 + 5.0 * static_cast<double>(k - 6), 2, 0);
+    kf.odometry_pose = kf.pose;  // no loop correction
     map.keyframes.push_back(kf);
     PlaceDescriptor place;  // the default detector's (Scan Context's 20 x 60); the viewer does not read it
     place.context = scan_context_from_descriptor(Eigen::MatrixXf::Zero(20, 60));

@@ -174,6 +174,69 @@ void check_sessions(const SavedMap& map, const fs::path& keyframes_file) {
   }
 }
 
+// How far a saved keyframe pose may sit from where its odometry edge puts it
+// relative to the keyframe before: the pose graph spreads a loop's
+// correction over the edges between, a few centimetres to decimetres per
+// edge on real drives; an edge or a pose changed by an edit is metres to
+// kilometres off.
+constexpr double kMaxEdgeCorrection = 1.0;          // [m], plus the fraction below of the edge's length
+constexpr double kMaxEdgeCorrectionFraction = 0.25;
+constexpr double kMaxEdgeRotationCorrection = 0.2;  // [rad]
+// An odometry edge is the odometry's motion between its keyframes' odometry
+// poses, computed from the same stored doubles: equal but for rounding.
+constexpr double kOdometryEdgeTolerance = 1e-3;          // [m]
+constexpr double kOdometryEdgeRotationTolerance = 1e-5;  // [rad]
+
+double rotation_angle(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle(); }
+
+// The edges agree with the keyframes and the manifest (issue #39: a map whose
+// digests were fitted to an edit is still refused): odometry edges join
+// consecutive keyframes of one session and measure the motion between their
+// odometry poses; the optimised poses are within a loop correction of every
+// odometry edge; the loop counts are the manifest's.
+void check_graph(const SavedMap& map, const fs::path& edges_file) {
+  std::uint64_t loops = 0, cross_session = 0;
+  for (std::size_t i = 0; i < map.edges.size(); ++i) {
+    const PoseGraphEdge& e = map.edges[i];
+    const MapKeyframe& from = map.keyframes[e.from];
+    const MapKeyframe& to = map.keyframes[e.to];
+    if (e.kind == EdgeKind::kLoop) {
+      ++loops;
+      if (from.session != to.session) ++cross_session;
+      continue;
+    }
+    if (e.to != e.from + 1 || from.session != to.session) {
+      throw InputError(edges_file, fmt::format("odometry edge {}: keyframes {} -> {} are not consecutive keyframes of "
+                                               "one session",
+                                               i, e.from, e.to));
+    }
+    const Pose odometry = from.odometry_pose.inverse() * to.odometry_pose;
+    const double offset = (odometry.translation() - e.measured.translation()).norm();
+    const double turn = rotation_angle(odometry.linear().transpose() * e.measured.linear());
+    if (offset > kOdometryEdgeTolerance || turn > kOdometryEdgeRotationTolerance) {
+      throw InputError(edges_file, fmt::format("odometry edge {}: measures {:.3f} m and {:.5f} rad away from the motion "
+                                               "between the odometry poses of keyframes {} and {}",
+                                               i, offset, turn, e.from, e.to));
+    }
+    const Pose optimised = from.pose.inverse() * to.pose;
+    const double correction = (optimised.translation() - e.measured.translation()).norm();
+    const double allowed = kMaxEdgeCorrection + kMaxEdgeCorrectionFraction * e.measured.translation().norm();
+    const double rotation = rotation_angle(optimised.linear().transpose() * e.measured.linear());
+    if (correction > allowed || rotation > kMaxEdgeRotationCorrection) {
+      throw InputError(edges_file.parent_path() / "keyframes.bin",
+                       fmt::format("keyframes {} and {}: their poses are {:.3f} m and {:.3f} rad from their odometry "
+                                   "edge's {:.3f} m (at most {:.3f} m and {} rad: a loop's correction)",
+                                   e.from, e.to, correction, rotation, e.measured.translation().norm(), allowed,
+                                   kMaxEdgeRotationCorrection));
+    }
+  }
+  if (loops != map.manifest.loop_edges || cross_session != map.manifest.cross_session_loops) {
+    throw InputError(edges_file, fmt::format("{} loop edges ({} between sessions), map.json says {} ({})", loops,
+                                             cross_session, map.manifest.loop_edges,
+                                             map.manifest.cross_session_loops));
+  }
+}
+
 // Removes a folder when it goes out of scope still armed.
 struct RemoveOnFailure {
   const fs::path& path;
@@ -291,6 +354,7 @@ SavedMap read_map(const fs::path& folder) {
   if (map.edges.size() != map.manifest.edges) {
     throw InputError(edges_file, fmt::format("{} edges, map.json says {}", map.edges.size(), map.manifest.edges));
   }
+  check_graph(map, edges_file);
   const fs::path places_file = folder / "places.bin";
   map.places = parse_map_places(bytes_of(read_table(folder, map.manifest, "places.bin", MapTable::kPlaces, map.config)), map.config, places_file);
   if (map.places.size() != map.keyframes.size()) {
