@@ -11,6 +11,13 @@ The model scored is the last epoch's (`model.yaml`), never one chosen on
 the held-out scans. Without training (`--model`), a given model is scored
 fold by fold the same way (the baseline).
 
+Self-training (`--pseudo DRIVE --teacher T`): unlabelled real scans (a
+sequence folder or a KITTI raw drive) are labelled by a teacher and trained
+on beside the rest as a source of weight `--pseudo-weight`. In a fold the
+teacher is that fold's own model of an earlier cross-validation
+(`T/foldK/run/model.yaml`: it never saw the held-out sequences, so neither
+do its labels); with `--final`, T is a model.
+
   scripts/segment_cv.py --data SEQUENCES --out CV [--model M.yaml | --init M.yaml --sim-recipe R.yaml
                         --real-weight W --train-args "..."] [--jobs 2]
   scripts/segment_cv.py --final --data SEQUENCES --out RUN --init M.yaml --sim-recipe R.yaml ...
@@ -77,10 +84,21 @@ def pooled(scores):
     return iou, points
 
 
-def train_model(args, out_dir, train_sequences, validation, log):
-    """segment-train on the real sequences (and the simulated sources); returns the last epoch's model."""
+def pseudo_source(args, teacher, out_dir, log):
+    """The --pseudo drive labelled by `teacher`, as a recipe source."""
+    labels = os.path.join(out_dir, "pseudo_labels")
+    if not os.path.isdir(labels):  # a rerun of the fold reuses the labels
+        run([args.saloam, "segment", args.pseudo, "--segmenter", teacher, "--out", labels, "--no-score"], log)
+    return {"folder": args.pseudo, "labels": labels, "frame_step": 1, "weight": args.pseudo_weight}
+
+
+def train_model(args, out_dir, train_sequences, validation, log, teacher=None):
+    """segment-train on the real sequences (and the simulated and pseudo-labelled sources); returns the last
+    epoch's model."""
     train = [{"folder": os.path.join(args.data, s), "frame_step": 1, "weight": args.real_weight}
              for s in train_sequences]
+    if args.pseudo:
+        train.append(pseudo_source(args, teacher, out_dir, log))
     if args.sim_recipe:
         train += sim_sources(args.sim_recipe)
     recipe_file = os.path.join(out_dir, "recipe.yaml")
@@ -106,8 +124,10 @@ def fold_job(args, k, held_out, all_sequences):
     log = os.path.join(fold_dir, "log.txt")
     model = args.model
     if model is None:
+        teacher = os.path.join(args.teacher, f"fold{k}", "run", "model.yaml") if args.pseudo else None
         model = train_model(args, fold_dir, [s for s in all_sequences if s not in held_out],
-                             [{"folder": os.path.join(args.data, s), "frame_step": 1} for s in held_out], log)
+                            [{"folder": os.path.join(args.data, s), "frame_step": 1} for s in held_out], log,
+                            teacher)
     scores = []
     for s in held_out:
         labels = os.path.join(fold_dir, "labels", s)
@@ -149,6 +169,10 @@ def main():
     p.add_argument("--scan-cache", help="a run's scans/ folder holding the simulated sources' cache (hard-linked)")
     p.add_argument("--real-weight", type=float, default=1.0, help="the recipe weight of each real scan")
     p.add_argument("--train-args", default="", help="further segment-train options, e.g. '--epochs 8 --lovasz 1'")
+    p.add_argument("--pseudo", help="unlabelled real scans (sequence folder or KITTI raw drive) to self-train on")
+    p.add_argument("--teacher", help="with --pseudo: the cross-validation folder whose fold models label it (with "
+                                     "--final: a model)")
+    p.add_argument("--pseudo-weight", type=float, default=1.0, help="the recipe weight of each pseudo-labelled scan")
     p.add_argument("--segment-args", default="", help="further segment options")
     p.add_argument("--jobs", type=int, default=1, help="folds run at once")
     p.add_argument("--final", action="store_true",
@@ -156,6 +180,10 @@ def main():
                         "recipe's validation sources")
     args = p.parse_args()
     args.data = os.path.abspath(args.data)
+    if args.pseudo:
+        if not args.teacher:
+            sys.exit("--pseudo needs --teacher")
+        args.pseudo, args.teacher = os.path.abspath(args.pseudo), os.path.abspath(args.teacher)
     folds = [f.split(",") for f in args.folds.split(";")]
     sequences = [s for f in folds for s in f]
     os.makedirs(args.out, exist_ok=True)
@@ -163,7 +191,7 @@ def main():
         if not args.sim_recipe:
             sys.exit("--final needs --sim-recipe (its validation sources choose nothing, they are reported)")
         model = train_model(args, args.out, sequences, sim_sources(args.sim_recipe, "validation"),
-                            os.path.join(args.out, "log.txt"))
+                            os.path.join(args.out, "log.txt"), args.teacher)
         print(f"trained on {', '.join(sequences)}: {model}")
         return
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
