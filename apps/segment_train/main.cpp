@@ -124,6 +124,7 @@ int run_segment_train(const SegmentTrainArgs& args, const CLI::App& app) {
   defaults.noisy_labels = false;  // segmentation learns from the ground truth
   const DataRecipe recipe =
       read_data_recipe(args.data.empty() ? options.out / "recipe.yaml" : fs::path(args.data), defaults);
+  check_training_paths(recipe, args.data, options.resume ? fs::path() : options.init, options.out);
   keep_recipe(options.out, recipe);
   const auto train = build_sequences(recipe.train, options.out, !args.no_cache);
   if (stop_requested()) return 130;

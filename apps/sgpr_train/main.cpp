@@ -119,11 +119,7 @@ void choose_output(const SgprTrainArgs& args, SgprTrainOptions& options) {
 
 /// The options given on the command line (and --resume's run).
 void take_options(const SgprTrainArgs& args, SgprTrainOptions& options) {
-  if (!args.init.empty()) {
-    require_file(args.init, "initial SGPR weights");
-    if (fs::weakly_canonical(args.init).parent_path() == fs::weakly_canonical(options.out))
-      spdlog::warn("--init {} lies in the output folder, whose models are rewritten every epoch", args.init);
-  }
+  if (!args.init.empty()) require_file(args.init, "initial SGPR weights");
   options.init = args.init;
   options.epochs = args.epochs;
   options.batch = args.batch;
@@ -180,6 +176,7 @@ int run_sgpr_train(const SgprTrainArgs& given, const CLI::App& app) {
   if (args.data.empty() && !options.resume) throw ConfigError("--data RECIPE.yaml is required for a new run");
   const DataRecipe recipe = read_data_recipe(!args.data.empty() ? fs::path(args.data) : options.out / "recipe.yaml");
   take_options(args, options);
+  check_training_paths(recipe, args.data, options.resume ? fs::path() : options.init, options.out);
   keep_recipe(options.out, recipe);
 
   const auto train = build_sequences(recipe.train, options.out, !args.no_cache);

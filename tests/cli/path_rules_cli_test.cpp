@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <map>
 
 #include "cli/cli_fixture.hpp"
@@ -123,6 +124,44 @@ TEST_F(PathRulesCli, EveryCommandRefusesAnOutputOverAnInput) {
     expect_has(output, (d / c.other).string());
     EXPECT_EQ(snapshot(d), before) << "a refused command changed a file";
   }
+}
+
+// The trainers (libtorch builds): a run's folder never holds or lies inside
+// its recipe, its starting model or what the recipe's sources read.
+TEST_F(PathRulesCli, TrainersRefuseAnOutputOverTheirData) {
+#ifndef SALOAM_HAVE_TORCH
+  GTEST_SKIP() << "built without libtorch: no trainers";
+#else
+  const fs::path d = dir_->path() / "train";
+  fs::create_directories(d / "run");
+  const fs::path seq = dir_->path() / "seq";
+  const std::string recipe = fmt::format("train: [{{folder: {}}}]\nvalidation: [{{folder: {}}}]\n", seq.string(), seq.string());
+  std::ofstream(d / "recipe.yaml") << recipe;
+  std::ofstream(d / "run/recipe.yaml") << recipe;
+  const fs::path init = fs::path(SALOAM_TEST_SOURCE_DIR) / "models/segmenter/saloam.yaml";
+  struct PathCase {
+    std::string args;
+    fs::path output, other;
+  };
+  const std::vector<PathCase> cases = {
+      {fmt::format("segment-train --data {} --out {}", quoted(d / "recipe.yaml"), quoted(seq)), seq, seq},
+      {fmt::format("segment-train --data {} --out {}", quoted(d / "recipe.yaml"), quoted(seq / "run")), seq / "run", seq},
+      {fmt::format("segment-train --data {} --out {}", quoted(d / "run/recipe.yaml"), quoted(d / "run")), d / "run",
+       d / "run/recipe.yaml"},
+      {fmt::format("segment-train --data {} --init {} --out {}", quoted(d / "recipe.yaml"), quoted(init),
+                   quoted(init.parent_path())),
+       init.parent_path(), init},
+      {fmt::format("sgpr-train --data {} --out {}", quoted(d / "recipe.yaml"), quoted(seq / "run")), seq / "run", seq},
+  };
+  for (const PathCase& c : cases) {
+    SCOPED_TRACE(c.args);
+    const auto before = snapshot(dir_->path());
+    const std::string output = failure_of(c.args);
+    expect_has(output, c.output.string());
+    expect_has(output, c.other.string());
+    EXPECT_EQ(snapshot(dir_->path()), before) << "a refused command changed a file";
+  }
+#endif
 }
 
 TEST_F(PathRulesCli, NamesThatOnlyShareAPrefixAreSeparate) {

@@ -10,6 +10,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/frame_range.hpp"
+#include "saloam/core/path_rules.hpp"
 #include "saloam/core/yaml_documents.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
@@ -225,6 +226,21 @@ SimulationOptions simulation_options(const SourceSpec& spec) {
   options.labels = spec.noisy_labels ? LabelMode::kNoisy : LabelMode::kGroundTruth;
   options.show_progress = false;
   return options;
+}
+
+void check_training_paths(const DataRecipe& recipe, const std::filesystem::path& recipe_file,
+                          const std::filesystem::path& init, const std::filesystem::path& out) {
+  PathRules rules;
+  rules.input("--data", recipe_file).input("--init", init);
+  for (const auto* sources : {&recipe.train, &recipe.validation}) {
+    for (const SourceSpec& s : *sources) {
+      const bool folder = s.kind == SourceSpec::Kind::kFolder;
+      rules.input(folder ? "the recipe's folder" : "the recipe's simulate", s.path)
+          .input("the recipe's labels", s.labels)
+          .input("the recipe's calib", s.calib);
+    }
+  }
+  rules.output("--out", out, OutputUse::kFolder).check();
 }
 
 }  // namespace saloam

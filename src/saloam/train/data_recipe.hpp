@@ -56,6 +56,14 @@ struct DataRecipe {
 DataRecipe read_data_recipe(const std::filesystem::path& file, const SourceSpec& defaults = {});
 nlohmann::json recipe_to_json(const DataRecipe& recipe);
 
+/// The one path rule (core/path_rules.hpp) for a training run writing into
+/// the folder `out`: it never equals, holds or lies inside the recipe file
+/// `recipe_file` (empty when a resumed run reads its own copy), the model
+/// `init` it starts from (empty: none) or any file or folder a source of
+/// `recipe` reads. InputError naming both paths, before anything is written.
+void check_training_paths(const DataRecipe& recipe, const std::filesystem::path& recipe_file,
+                          const std::filesystem::path& init, const std::filesystem::path& out);
+
 /// The simulator's options for a simulated source (labels as the source
 /// says). InputError for an unreadable pose or calibration file.
 SimulationOptions simulation_options(const SourceSpec& spec);
