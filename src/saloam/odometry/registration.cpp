@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
+#include <variant>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -45,18 +47,14 @@ namespace {
 
 constexpr int kMaxNeighbours = kMaxFitNeighbours;
 
-struct EdgeMatch {
-  Line line;
-  bool valid = false;
-  /// A level line (RegistrationSettings::level_line_max_rise): matched as
-  /// `across`, the vertical plane through it, instead of as a line.
-  bool level = false;
-  Plane across;
-};
-struct PlaneMatch {
-  Plane plane;
-  bool valid = false;
-  bool rejected_by_constraint = false;
+// What a feature was matched to: nothing, a line (an edge feature) or a
+// plane (a planar feature's, or the vertical plane through a level line,
+// RegistrationSettings::level_line_max_rise). The kind is chosen once, here;
+// the fit visits the residual type.
+struct Match {
+  std::variant<std::monostate, PointToLine, PointToPlane> fit;
+  bool rejected_by_constraint = false;  ///< a plane the semantic plane constraint refused
+  [[nodiscard]] bool matched() const { return !std::holds_alternative<std::monostate>(fit); }
 };
 
 // Gathers the k nearest neighbours of q among the map points of class c;
@@ -67,26 +65,28 @@ bool gather(const NeighbourGrid& grid, const Eigen::Vector3d& q, ClassIndex c, i
   return grid.nearest(q, c, k, max_distance, out.data(), d2.data()) == k;
 }
 
-double huber_weight(double r, double k) {
-  const double a = std::abs(r);
-  return a <= k ? 1.0 : k / a;
-}
-
 // The residuals of a scan form one index space, the edges [0, edges) then the
 // planar points; sums over it go in blocks of this many residuals
 // (sum_in_blocks), so they are the same with any number of threads.
 constexpr std::size_t kResidualBlock = 512;
 
-// Calls on_edge(e) or on_planar(p) for residual i of that index space when
-// its feature is matched.
-template <class OnEdge, class OnPlanar>
-void visit_matched(std::size_t i, const std::vector<EdgeMatch>& edge_matches,
-                   const std::vector<PlaneMatch>& plane_matches, OnEdge&& on_edge, OnPlanar&& on_planar) {
-  if (i < edge_matches.size()) {
-    if (edge_matches[i].valid) on_edge(i);
-  } else if (plane_matches[i - edge_matches.size()].valid) {
-    on_planar(i - edge_matches.size());
-  }
+// Calls on_residual(fit, point, class) for residual i of that index space when
+// its feature is matched, `fit` of its residual type (PointToLine or
+// PointToPlane).
+template <class OnResidual>
+void visit_residual(std::size_t i, const FeatureCloud& edges, const FeatureCloud& planars,
+                    const std::vector<Match>& edge_matches, const std::vector<Match>& plane_matches,
+                    OnResidual&& on_residual) {
+  const bool edge = i < edge_matches.size();
+  const std::size_t j = edge ? i : i - edge_matches.size();
+  const FeatureCloud& cloud = edge ? edges : planars;
+  std::visit(
+      [&](const auto& fit) {
+        if constexpr (!std::is_same_v<std::decay_t<decltype(fit)>, std::monostate>) {
+          on_residual(fit, cloud.points[j], cloud.classes[j]);
+        }
+      },
+      (edge ? edge_matches : plane_matches)[j].fit);
 }
 
 // The fit's sums over the matched features (RegistrationResult's fields).
@@ -112,42 +112,26 @@ struct FitSums {
 };
 
 // Loss, inliers and Hessian of the matched features at pose T (no new association).
-void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
-                  const std::vector<PlaneMatch>& plane_matches, const Pose& T, const RegistrationSettings& settings,
+void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<Match>& edge_matches,
+                  const std::vector<Match>& plane_matches, const Pose& T, const RegistrationSettings& settings,
                   RegistrationResult& result) {
-  const double k = settings.robust_kernel_scale;
-  const double clip = kResidualClip * k;
+  const ClassWeightedHuber weight{settings.class_weight, settings.robust_kernel_scale};
+  const double clip = kResidualClip * settings.robust_kernel_scale;
   const auto term = [&](std::size_t i, FitSums& sum) {
-    auto add = [&](double distance, ClassIndex c, double dof, const auto& J) {
-      const double class_weight = settings.class_weight[c];
-      sum.loss += class_weight * distance;
-      if (distance < settings.inlier_distance) {
-        ++sum.inliers;
-        sum.inlier_residual_sum += distance;
-      }
-      sum.hessian.noalias() += class_weight * huber_weight(distance, k) * J.transpose() * J;
-      const double clipped = std::min(distance, clip);
-      sum.class_squared_residuals[c] += clipped * clipped;
-      sum.class_dof[c] += dof;
-    };
-    visit_matched(
-        i, edge_matches, plane_matches,
-        [&](std::size_t e) {
-          if (edge_matches[e].level) {
-            Eigen::Matrix<double, 1, 6> J;
-            const double r = point_to_plane_residual(T, edges.points[e], edge_matches[e].across, &J);
-            add(std::abs(r), edges.classes[e], 1.0, J);
-            return;
-          }
-          Eigen::Matrix<double, 3, 6> J;
-          const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
-          add(r.norm(), edges.classes[e], 2.0, J);
-        },
-        [&](std::size_t p) {
-          Eigen::Matrix<double, 1, 6> J;
-          const double r = point_to_plane_residual(T, planars.points[p], plane_matches[p].plane, &J);
-          add(std::abs(r), planars.classes[p], 1.0, J);
-        });
+    visit_residual(i, edges, planars, edge_matches, plane_matches,
+                   [&]<class Fit>(const Fit& fit, const Eigen::Vector3d& p, ClassIndex c) {
+                     typename Fit::Jacobian J;
+                     const double distance = Fit::distance(fit.residual(T, p, &J));
+                     sum.loss += settings.class_weight[c] * distance;
+                     if (distance < settings.inlier_distance) {
+                       ++sum.inliers;
+                       sum.inlier_residual_sum += distance;
+                     }
+                     sum.hessian.noalias() += weight(c, distance) * J.transpose() * J;
+                     const double clipped = std::min(distance, clip);
+                     sum.class_squared_residuals[c] += clipped * clipped;
+                     sum.class_dof[c] += Fit::kDof;
+                   });
   };
   const FitSums sums =
       sum_in_blocks(edges.size() + planars.size(), settings.parallel, kResidualBlock, FitSums{}, term);
@@ -162,22 +146,21 @@ void evaluate_fit(const FeatureCloud& edges, const FeatureCloud& planars, const 
 // Matches every feature at pose T to a line or plane fitted to its nearest
 // map neighbours of its class (the expensive part: neighbour queries and fits).
 void associate(const FeatureCloud& edges, const FeatureCloud& planars, const SemanticLocalMap& map, const Pose& T,
-               const RegistrationSettings& settings, std::vector<EdgeMatch>& edge_matches,
-               std::vector<PlaneMatch>& plane_matches, RegistrationResult& result) {
+               const RegistrationSettings& settings, std::vector<Match>& edge_matches,
+               std::vector<Match>& plane_matches, RegistrationResult& result) {
   const int ne = std::min(settings.edge_neighbours, kMaxNeighbours);
   const int np = std::min(settings.planar_neighbours, kMaxNeighbours);
   for_each_index(edges.size(), settings.parallel, 128, [&](std::size_t i) {
     std::array<Eigen::Vector3d, kMaxNeighbours> nb;
-    EdgeMatch m;
+    Match m;
     const Eigen::Vector3d q = T * edges.points[i];
     if (gather(map.edges(), q, edges.classes[i], ne, settings.max_correspondence_distance, nb)) {
       if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
-        m.line = *line;
-        m.valid = true;
         // d x z is horizontal and across d; it vanishes only for an upright line.
-        if (std::abs(m.line.direction.z()) < settings.level_line_max_rise) {
-          m.level = true;
-          m.across = Plane{m.line.point, m.line.direction.cross(Eigen::Vector3d::UnitZ()).normalized()};
+        if (std::abs(line->direction.z()) < settings.level_line_max_rise) {
+          m.fit = PointToPlane{Plane{line->point, line->direction.cross(Eigen::Vector3d::UnitZ()).normalized()}};
+        } else {
+          m.fit = PointToLine{*line};
         }
       }
     }
@@ -185,14 +168,13 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
   });
   for_each_index(planars.size(), settings.parallel, 128, [&](std::size_t i) {
     std::array<Eigen::Vector3d, kMaxNeighbours> nb;
-    PlaneMatch m;
+    Match m;
     const Eigen::Vector3d q = T * planars.points[i];
     const ClassIndex c = planars.classes[i];
     if (gather(map.planars(), q, c, np, settings.max_correspondence_distance, nb)) {
       if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
         if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.plane_normal_tolerance)) {
-          m.plane = *plane;
-          m.valid = true;
+          m.fit = PointToPlane{*plane};
         } else {
           m.rejected_by_constraint = true;
         }
@@ -204,9 +186,9 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
   result.edge_matches = 0;
   result.planar_matches = 0;
   result.rejected_by_constraint = 0;
-  for (const auto& m : edge_matches) result.edge_matches += m.valid;
+  for (const auto& m : edge_matches) result.edge_matches += m.matched();
   for (const auto& m : plane_matches) {
-    result.planar_matches += m.valid;
+    result.planar_matches += m.matched();
     result.rejected_by_constraint += m.rejected_by_constraint;
   }
 }
@@ -226,35 +208,16 @@ struct NormalEquations {
 
 // The normal equations at pose T over the given correspondences.
 NormalEquations normal_equations(const FeatureCloud& edges, const FeatureCloud& planars,
-                                 const std::vector<EdgeMatch>& edge_matches,
-                                 const std::vector<PlaneMatch>& plane_matches, const Pose& T,
-                                 const RegistrationSettings& settings) {
-  const double k = settings.robust_kernel_scale;
+                                 const std::vector<Match>& edge_matches, const std::vector<Match>& plane_matches,
+                                 const Pose& T, const RegistrationSettings& settings) {
+  const ClassWeightedHuber weight{settings.class_weight, settings.robust_kernel_scale};
   const auto term = [&](std::size_t i, NormalEquations& sum) {
-    visit_matched(
-        i, edge_matches, plane_matches,
-        [&](std::size_t e) {
-          if (edge_matches[e].level) {
-            Eigen::Matrix<double, 1, 6> J;
-            const double r = point_to_plane_residual(T, edges.points[e], edge_matches[e].across, &J);
-            const double w = settings.class_weight[edges.classes[e]] * huber_weight(r, k);
-            sum.H.noalias() += w * J.transpose() * J;
-            sum.g.noalias() += (w * r) * J.transpose();
-            return;
-          }
-          Eigen::Matrix<double, 3, 6> J;
-          const Eigen::Vector3d r = point_to_line_residual(T, edges.points[e], edge_matches[e].line, &J);
-          const double w = settings.class_weight[edges.classes[e]] * huber_weight(r.norm(), k);
-          sum.H.noalias() += w * J.transpose() * J;
-          sum.g.noalias() += w * J.transpose() * r;
-        },
-        [&](std::size_t p) {
-          Eigen::Matrix<double, 1, 6> J;
-          const double r = point_to_plane_residual(T, planars.points[p], plane_matches[p].plane, &J);
-          const double w = settings.class_weight[planars.classes[p]] * huber_weight(r, k);
-          sum.H.noalias() += w * J.transpose() * J;
-          sum.g.noalias() += (w * r) * J.transpose();
-        });
+    visit_residual(i, edges, planars, edge_matches, plane_matches,
+                   [&]<class Fit>(const Fit& fit, const Eigen::Vector3d& p, ClassIndex c) {
+                     typename Fit::Jacobian J;
+                     const typename Fit::Residual r = fit.residual(T, p, &J);
+                     Fit::add_normal_terms(weight(c, Fit::distance(r)), J, r, sum.H, sum.g);
+                   });
   };
   return sum_in_blocks(edges.size() + planars.size(), settings.parallel, kResidualBlock, NormalEquations{}, term);
 }
@@ -297,8 +260,8 @@ Vector6d without_degenerate_directions(const Vector6d& delta, const Eigen::Matri
 
 // Gauss-Newton over the given correspondences from T; false when a step is
 // not finite (T is then the last finite pose).
-bool solve(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<EdgeMatch>& edge_matches,
-           const std::vector<PlaneMatch>& plane_matches, const RegistrationSettings& settings, double lever, Pose& T,
+bool solve(const FeatureCloud& edges, const FeatureCloud& planars, const std::vector<Match>& edge_matches,
+           const std::vector<Match>& plane_matches, const RegistrationSettings& settings, double lever, Pose& T,
            RegistrationResult& result) {
   for (int it = 0; it < settings.max_iterations; ++it) {
     auto [H, g] = normal_equations(edges, planars, edge_matches, plane_matches, T, settings);
@@ -329,8 +292,8 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   RegistrationResult result;
   result.pose = initial;
   Pose T = initial;
-  std::vector<EdgeMatch> edge_matches(edges.size());
-  std::vector<PlaneMatch> plane_matches(planars.size());
+  std::vector<Match> edge_matches(edges.size());
+  std::vector<Match> plane_matches(planars.size());
   const double lever = feature_lever(edges, planars);
   for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
     const Pose round_start = T;

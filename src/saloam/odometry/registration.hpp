@@ -18,6 +18,16 @@
 
 namespace saloam {
 
+/// A residual's weight in the fit (Eq. 2's w^l times the robust kernel): its
+/// class's weight times the Huber weight at its distance, the one place that
+/// combines them.
+struct ClassWeightedHuber {
+  const std::array<double, kNumClassIndices>& class_weight;
+  double scale;  ///< [m] Huber scale
+
+  double operator()(ClassIndex c, double distance) const { return class_weight[c] * huber_weight(distance, scale); }
+};
+
 /// Built from the configuration (odometry.*), which holds the defaults; a
 /// default-constructed value is all zeros.
 struct RegistrationSettings {

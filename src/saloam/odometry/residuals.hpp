@@ -12,6 +12,7 @@
 // translation through that lever arm; the damped solver then converged too
 // slowly to follow sharp turns (simulated KITTI 00, ~370 m from the origin).
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -61,6 +62,56 @@ double point_to_plane_residual(const Pose& T, const Eigen::Vector3d& p, const Pl
 /// distance to the line, and its 3x6 Jacobian w.r.t. delta.
 Eigen::Vector3d point_to_line_residual(const Pose& T, const Eigen::Vector3d& p, const Line& line,
                                        Eigen::Matrix<double, 3, 6>* jacobian = nullptr);
+
+/// The residual kinds of the registration, one type each (small_gicp's
+/// factors): the geometry a feature was matched to, its residual with the
+/// Jacobian, the distance the robust kernel sees, the constraints it adds
+/// (dof) and its terms of Gauss-Newton's normal equations.
+///
+/// An edge feature against a line (Eq. 2's point-to-line distance).
+struct PointToLine {
+  using Residual = Eigen::Vector3d;
+  using Jacobian = Eigen::Matrix<double, 3, 6>;
+  static constexpr double kDof = 2.0;  ///< across the line, both ways
+
+  Line line;
+
+  Residual residual(const Pose& T, const Eigen::Vector3d& p, Jacobian* jacobian) const {
+    return point_to_line_residual(T, p, line, jacobian);
+  }
+  static double distance(const Residual& r) { return r.norm(); }
+  /// H += w J^T J, g += w J^T r.
+  static void add_normal_terms(double w, const Jacobian& J, const Residual& r, Eigen::Matrix<double, 6, 6>& H, Vector6d& g) {
+    H.noalias() += w * J.transpose() * J;
+    g.noalias() += w * J.transpose() * r;
+  }
+};
+
+/// A planar feature against a plane (Eq. 2's point-to-plane distance), or an
+/// edge feature against the vertical plane through a level line.
+struct PointToPlane {
+  using Residual = double;
+  using Jacobian = Eigen::Matrix<double, 1, 6>;
+  static constexpr double kDof = 1.0;  ///< along the normal
+
+  Plane plane;
+
+  Residual residual(const Pose& T, const Eigen::Vector3d& p, Jacobian* jacobian) const {
+    return point_to_plane_residual(T, p, plane, jacobian);
+  }
+  static double distance(Residual r) { return std::abs(r); }
+  /// H += w J^T J, g += w r J^T.
+  static void add_normal_terms(double w, const Jacobian& J, Residual r, Eigen::Matrix<double, 6, 6>& H, Vector6d& g) {
+    H.noalias() += w * J.transpose() * J;
+    g.noalias() += (w * r) * J.transpose();
+  }
+};
+
+/// The Huber kernel's weight at `distance` with scale `k`: 1 within k, k / |r| beyond.
+inline double huber_weight(double distance, double k) {
+  const double a = std::abs(distance);
+  return a <= k ? 1.0 : k / a;
+}
 
 /// Applies the right update T <- T exp(delta) and re-orthonormalizes the rotation.
 Pose apply_update(const Vector6d& delta, const Pose& T);
