@@ -67,15 +67,15 @@ int run_convert(const ConvertArgs& args) {
 }
 
 const CommandRegistration kRegistration{Command{
-    "convert", "Write a scan source in another layout (SemanticKITTI, KITTI raw, PCD, PLY, ROS bag)", 16,
+    "convert", "Write a scan source in another layout (SemanticKITTI, KITTI raw, PCD, PLY, ROS 1 and 2 bags, MCAP)", 16,
     [](CLI::App& app) {
       auto args = std::make_shared<ConvertArgs>();
       args->source.add_with_no_calib_to(app);
-      app.add_option("--out", args->out, "The new folder (or .bag file); must not exist or be an empty folder")
+      app.add_option("--out", args->out, "The new folder (or .bag / .mcap file); must not exist or be an empty folder")
           ->required();
-      app.add_option("--to", args->to, "Layout to write: semantickitti, kitti-raw, pcd, ply, rosbag")
+      app.add_option("--to", args->to, "Layout to write: semantickitti, kitti-raw, pcd, ply, rosbag, rosbag2, mcap")
           ->required()
-          ->check(CLI::IsMember({"semantickitti", "kitti-raw", "pcd", "ply", "rosbag"}));
+          ->check(CLI::IsMember({"semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "rosbag2", "mcap"}));
       app.add_option("--encoding", args->encoding,
                      "PCD: ascii, binary (default), binary_compressed; PLY: ascii, binary_little_endian (default), "
                      "binary_big_endian");
