@@ -94,6 +94,7 @@ struct Channel {
 struct Chunk {
   std::uint64_t at = 0;  ///< the chunk record's opcode in the file
   bool cut_off = false;  ///< the file ends inside it
+  std::uint64_t length = 0;  ///< of the whole record, as its chunk index says (0: not indexed)
 };
 
 /// A message: in a chunk (offset of its record in the decompressed records)
@@ -291,7 +292,7 @@ void McapReader::Impl::read_chunk_index(std::span<const std::byte> content, cons
   if (chunk_at < kMcapMagic.size() || chunk_at > size || chunk_length > size - chunk_at) {
     throw place.error(fmt::format("chunk of {} bytes at byte {} is not inside the file", chunk_length, chunk_at));
   }
-  chunks.push_back({chunk_at, false});
+  chunks.push_back({chunk_at, false, chunk_length});
   const auto offsets = f.prefixed("message_index_offsets");
   if (offsets.size() % 10 != 0) throw place.error(fmt::format("message_index_offsets of {} bytes", offsets.size()));
   for (std::size_t k = 0; k < offsets.size(); k += 10) {
@@ -334,7 +335,7 @@ void McapReader::Impl::scan_linearly() {
     const auto [op, length] = record_head(pos);
     const bool whole = length <= size - pos - kRecordHead;
     if (op == kChunk) {
-      chunks.push_back({pos, !whole});
+      chunks.push_back({pos, !whole, 0});
       scan_cut_off_chunk_too(chunks.size() - 1);
     } else if (!whole) {
       cut_short = true;
@@ -413,6 +414,10 @@ std::span<const std::byte> McapReader::Impl::chunk_records(std::size_t chunk) {
   const Place place = at(c.at, "chunk");
   const auto [op, length] = record_head(c.at);
   if (op != kChunk) throw place.error(fmt::format("op {} where a chunk should be", op));
+  if (!c.cut_off && length > size - c.at - kRecordHead) throw place.error(fmt::format("{} bytes run past the end of the file", length));
+  if (c.length != 0 && c.length != length + kRecordHead) {
+    throw place.error(fmt::format("{} bytes long, its chunk index says {}", length + kRecordHead, c.length));
+  }
   const std::uint64_t available = std::min(length, size - c.at - kRecordHead);
   const auto content = read(c.at + kRecordHead, available, "chunk");
   Fields f(content, place);
