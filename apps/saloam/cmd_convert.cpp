@@ -27,6 +27,8 @@ struct ConvertArgs {
 
 const std::map<std::string, PcdEncoding> kPcdEncodings{
     {"ascii", PcdEncoding::kAscii}, {"binary", PcdEncoding::kBinary}, {"binary_compressed", PcdEncoding::kBinaryCompressed}};
+const std::map<std::string, McapCompression> kMcapEncodings{
+    {"zstd", McapCompression::kZstd}, {"lz4", McapCompression::kLz4}, {"none", McapCompression::kNone}};
 const std::map<std::string, PlyEncoding> kPlyEncodings{{"ascii", PlyEncoding::kAscii},
                                                        {"binary_little_endian", PlyEncoding::kBinaryLittleEndian},
                                                        {"binary_big_endian", PlyEncoding::kBinaryBigEndian}};
@@ -48,7 +50,8 @@ SequenceWriteOptions write_options(const ConvertArgs& args) {
   if (!args.encoding.empty()) {
     if (o.format == ScanFormat::kPcd) o.pcd = encoding_of(kPcdEncodings, args.encoding, "PCD");
     else if (o.format == ScanFormat::kPly) o.ply = encoding_of(kPlyEncodings, args.encoding, "PLY");
-    else throw ConfigError(fmt::format("--encoding: only for --to pcd or ply, not {}", args.to));
+    else if (o.format == ScanFormat::kMcap) o.mcap_compression = encoding_of(kMcapEncodings, args.encoding, "MCAP");
+    else throw ConfigError(fmt::format("--encoding: only for --to pcd, ply or mcap, not {}", args.to));
   }
   o.topic = args.bag_topic;
   return o;
@@ -78,7 +81,7 @@ const CommandRegistration kRegistration{Command{
           ->check(CLI::IsMember({"semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "rosbag2", "mcap"}));
       app.add_option("--encoding", args->encoding,
                      "PCD: ascii, binary (default), binary_compressed; PLY: ascii, binary_little_endian (default), "
-                     "binary_big_endian");
+                     "binary_big_endian; MCAP chunks: zstd (default), lz4, none");
       app.add_option("--bag-topic", args->bag_topic, "Topic of the written bag's PointCloud2 messages")
           ->capture_default_str();
       app.add_flag("--no-labels", args->no_labels, "Leave the labels out");

@@ -143,6 +143,12 @@ TEST(Ros2Bags, McapRoundTripsInEveryCompressionAndByteOrder) {
     EXPECT_TRUE(reader.indexed());
     EXPECT_TRUE(reader.notes().empty());
   }
+  // No chunks at all: messages straight in the data section, read from the start.
+  write_as(fields, dir / "flat.mcap", ScanFormat::kMcap, McapCompression::kNone, false, 0);
+  EXPECT_FALSE(McapReader(dir / "flat.mcap").indexed());
+  EXPECT_TRUE(McapReader(dir / "flat.mcap").notes().empty());
+  auto flat = open_reader(dir / "flat.mcap", {});
+  expect_same_scans(fields, *flat);
   // Big-endian CDR in a rosbag2 folder too.
   write_as(fields, dir / "big_bag", ScanFormat::kRosbag2, McapCompression::kZstd, true);
   auto big = open_reader(dir / "big_bag", {});

@@ -445,7 +445,8 @@ std::vector<std::byte> McapReader::Impl::message(const MessageRef& ref, std::siz
   std::string where;
   if (ref.chunk == kNoChunk) {
     const auto [op, length] = record_head(pos);
-    record = read(pos, kRecordHead + std::min<std::uint64_t>(length, kMessageHead + max_bytes), "message");
+    const std::uint64_t wanted = max_bytes >= length ? length : std::min<std::uint64_t>(length, kMessageHead + max_bytes);
+    record = read(pos, kRecordHead + wanted, "message");
     from = record;
     pos = 0;
     where = fmt::format("message at byte {}", ref.offset);
@@ -600,6 +601,17 @@ struct McapWriter::Impl {
   }
   void flush_chunk();
   void write_summary();
+  /// Where a data-section record goes: the open chunk, or (unchunked) the file.
+  template <class F>
+  void data_record(std::uint8_t op, F&& content) {
+    if (chunk_bytes > 0) {
+      Out(chunk).record(op, content);
+      return;
+    }
+    std::vector<std::byte> bytes;
+    Out(bytes).record(op, content);
+    put(bytes);
+  }
 };
 
 void McapWriter::Impl::flush_chunk() {
@@ -702,32 +714,26 @@ McapWriter::~McapWriter() {
 
 std::uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding, std::string_view data) {
   const auto id = ++impl_->schemas;
-  const auto add = [&](std::vector<std::byte>& to) {
-    Out(to).record(kSchema, [&](Out& o) {
-      o.integer(id).string(name).string(encoding).string(data);
-    });
-  };
-  add(impl_->chunk);
-  add(impl_->summary_schemas);
+  const auto content = [&](Out& o) { o.integer(id).string(name).string(encoding).string(data); };
+  impl_->data_record(kSchema, content);
+  Out(impl_->summary_schemas).record(kSchema, content);
   return id;
 }
 
 std::uint16_t McapWriter::add_channel(const std::string& topic, std::uint16_t schema_id, const std::string& message_encoding) {
   const auto id = impl_->channels++;
-  const auto add = [&](std::vector<std::byte>& to) {
-    Out(to).record(kChannel, [&](Out& o) {
-      o.integer(id).integer(schema_id).string(topic).string(message_encoding).integer(std::uint32_t{0});
-    });
+  const auto content = [&](Out& o) {
+    o.integer(id).integer(schema_id).string(topic).string(message_encoding).integer(std::uint32_t{0});
   };
-  add(impl_->chunk);
-  add(impl_->summary_channels);
+  impl_->data_record(kChannel, content);
+  Out(impl_->summary_channels).record(kChannel, content);
   return id;
 }
 
 void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std::span<const std::byte> data) {
   Impl& w = *impl_;
-  w.chunk_index[channel_id].emplace_back(log_time_ns, w.chunk.size());
-  Out(w.chunk).record(kMessage, [&](Out& o) {
+  if (w.chunk_bytes > 0) w.chunk_index[channel_id].emplace_back(log_time_ns, w.chunk.size());
+  w.data_record(kMessage, [&](Out& o) {
     o.integer(channel_id).integer(static_cast<std::uint32_t>(w.counts[channel_id])).integer(log_time_ns).integer(log_time_ns).raw(data);
   });
   ++w.counts[channel_id];
@@ -736,7 +742,7 @@ void McapWriter::write(std::uint16_t channel_id, std::uint64_t log_time_ns, std:
   w.last = std::max(w.last, log_time_ns);
   w.chunk_start = std::min(w.chunk_start, log_time_ns);
   w.chunk_end = std::max(w.chunk_end, log_time_ns);
-  if (w.chunk.size() >= w.chunk_bytes) w.flush_chunk();
+  if (w.chunk_bytes > 0 && w.chunk.size() >= w.chunk_bytes) w.flush_chunk();
 }
 
 void McapWriter::close() {

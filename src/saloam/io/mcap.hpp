@@ -70,7 +70,9 @@ class McapReader final : public MessageStorage {
 /// chunks of about `chunk_bytes` (uncompressed), each followed by its
 /// message indexes; on close() a summary with the schemas, channels,
 /// statistics and chunk indexes, summary offsets, the footer. CRCs of chunks
-/// and of the summary are written.
+/// and of the summary are written. `chunk_bytes` 0: no chunks, the records
+/// straight in the data section (no compression, no index: what a reader
+/// reads from the start).
 class McapWriter {
  public:
   McapWriter(std::filesystem::path file, McapCompression compression, std::size_t chunk_bytes = 1u << 20);
