@@ -28,6 +28,9 @@ constexpr std::uint64_t kMessageHead = 2 + 4 + 8 + 8;  // channel_id, sequence, 
 constexpr std::uint64_t kMaxChunkRatio = 100;      // point clouds compress far less
 constexpr std::uint64_t kChunkSlack = 64ull << 20;
 constexpr std::size_t kNoChunk = std::numeric_limits<std::size_t>::max();
+/// Asked for fewer bytes of a message (a header), a chunk is decompressed
+/// only as far as them, and not kept.
+constexpr std::size_t kWholeChunkFrom = 1u << 16;
 
 std::uint32_t crc32(std::span<const std::byte> bytes, std::uint32_t crc = 0) {
   static const std::array<std::uint32_t, 256> table = [] {
@@ -206,6 +209,7 @@ struct McapReader::Impl {
   void schema(std::span<const std::byte> content, const Place& place);
   void channel(std::span<const std::byte> content, const Place& place);
   std::span<const std::byte> chunk_records(std::size_t chunk);
+  std::vector<std::byte> decode_chunk(std::size_t chunk, std::uint64_t limit);
   std::vector<std::byte> message(const MessageRef& ref, std::size_t max_bytes);
 };
 
@@ -410,6 +414,16 @@ void McapReader::Impl::scan_chunk(std::size_t chunk) {
 /// The decompressed records of a chunk (the last one asked for is kept).
 std::span<const std::byte> McapReader::Impl::chunk_records(std::size_t chunk) {
   if (cached_chunk == chunk) return cache;
+  cached_chunk = kNoChunk;
+  cache = decode_chunk(chunk, std::numeric_limits<std::uint64_t>::max());
+  cached_chunk = chunk;
+  return cache;
+}
+
+/// The first `limit` bytes of a chunk's records (all of them when it holds
+/// fewer; only those the file holds of a chunk cut off). The CRC is checked
+/// when all are decoded.
+std::vector<std::byte> McapReader::Impl::decode_chunk(std::size_t chunk, std::uint64_t limit) {
   const Chunk& c = chunks.at(chunk);
   const Place place = at(c.at, "chunk");
   const auto [op, length] = record_head(c.at);
@@ -431,11 +445,11 @@ std::span<const std::byte> McapReader::Impl::chunk_records(std::size_t chunk) {
     throw place.error(fmt::format("{} bytes cannot come from {} compressed bytes", uncompressed, compressed));
   }
   const auto stored = c.cut_off ? f.rest() : f.take(compressed, "records");
-  cached_chunk = kNoChunk;
-  cache = decompress(compression, stored.first(std::min<std::uint64_t>(stored.size(), compressed)), uncompressed, c.cut_off, place);
-  if (!c.cut_off && crc != 0 && crc32(cache) != crc) throw place.error("the records' CRC does not match");
-  cached_chunk = chunk;
-  return cache;
+  const bool whole = !c.cut_off && limit >= uncompressed;
+  auto records = decompress(compression, stored.first(std::min<std::uint64_t>(stored.size(), compressed)),
+                            std::min(uncompressed, limit), !whole, place);
+  if (whole && crc != 0 && crc32(records) != crc) throw place.error("the records' CRC does not match");
+  return records;
 }
 
 std::vector<std::byte> McapReader::Impl::message(const MessageRef& ref, std::size_t max_bytes) {
@@ -450,8 +464,12 @@ std::vector<std::byte> McapReader::Impl::message(const MessageRef& ref, std::siz
     from = record;
     pos = 0;
     where = fmt::format("message at byte {}", ref.offset);
-  } else {
+  } else if (cached_chunk == ref.chunk || max_bytes >= kWholeChunkFrom) {
     from = chunk_records(ref.chunk);
+    where = fmt::format("message at byte {} of the chunk at byte {}", ref.offset, chunks[ref.chunk].at);
+  } else {  // a header: the chunk decompressed only as far as the message's first bytes
+    record = decode_chunk(ref.chunk, ref.offset + kRecordHead + kMessageHead + max_bytes);
+    from = record;
     where = fmt::format("message at byte {} of the chunk at byte {}", ref.offset, chunks[ref.chunk].at);
   }
   const Place place{file, where};
@@ -460,7 +478,10 @@ std::vector<std::byte> McapReader::Impl::message(const MessageRef& ref, std::siz
   std::memcpy(&length, from.data() + pos + 1, 8);
   if (static_cast<std::uint8_t>(from[pos]) != kMessage) throw place.error(fmt::format("op {}, not a message", static_cast<unsigned>(from[pos])));
   const auto content = from.subspan(pos + kRecordHead, std::min<std::uint64_t>(length, from.size() - pos - kRecordHead));
-  if (ref.chunk != kNoChunk && content.size() != length) throw place.error(fmt::format("{} bytes run past its chunk", length));
+  const std::uint64_t needed = max_bytes >= length ? length : std::min<std::uint64_t>(length, kMessageHead + max_bytes);
+  if (content.size() < needed) {
+    throw place.error(fmt::format("{} bytes run past its chunk", length));
+  }
   Fields f(content, place);
   if (f.integer<std::uint16_t>("channel id") != ref.channel) throw place.error("not on the channel its index says");
   f.take(kMessageHead - 2, "message header");
@@ -631,7 +652,10 @@ void McapWriter::Impl::flush_chunk() {
   put(bytes);
   entry.length = bytes.size();
   const std::uint64_t index_at = written;
-  for (const auto& [channel, entries] : chunk_index) {
+  // (No structured bindings captured by the lambdas: clang 14 cannot.)
+  for (const auto& channel_entries : chunk_index) {
+    const std::uint16_t channel = channel_entries.first;
+    const auto& entries = channel_entries.second;
     entry.index_offsets.emplace_back(channel, written);
     std::vector<std::byte> index;
     Out(index).record(kMessageIndex, [&](Out& o) {
@@ -681,8 +705,8 @@ void McapWriter::Impl::write_summary() {
     }
   });
   const std::uint64_t offsets_start = summary_start + summary.size();
-  for (const auto& [op, range] : groups) {
-    Out(summary).record(kSummaryOffset, [&](Out& o) { o.integer(op).integer(range.first).integer(range.second); });
+  for (const auto& g : groups) {
+    Out(summary).record(kSummaryOffset, [&](Out& o) { o.integer(g.first).integer(g.second.first).integer(g.second.second); });
   }
   Out(summary).integer(kFooter).integer(std::uint64_t{20}).integer(summary_start).integer(offsets_start);
   Out(summary).integer(crc32(summary));
