@@ -110,6 +110,8 @@ TEST(Ros2Bags, Db3FolderRoundTripsScansRingsTimesAndStamps) {
   WithPointFields fields(*seq);
   testing::TempDir dir;
   write_as(fields, dir / "bag", ScanFormat::kRosbag2);
+  EXPECT_EQ(format_name(ScanFormat::kRosbag2), "rosbag2");
+  EXPECT_EQ(format_name(ScanFormat::kMcap), "mcap");
   EXPECT_EQ(detect_scan_format(dir / "bag"), ScanFormat::kRosbag2);
   EXPECT_EQ(detect_scan_format(dir / "bag" / "bag_0.db3"), ScanFormat::kRosbag2);
   auto back = open_reader(dir / "bag", {});
@@ -120,6 +122,9 @@ TEST(Ros2Bags, Db3FolderRoundTripsScansRingsTimesAndStamps) {
   EXPECT_EQ(metadata.storage, "sqlite3");
   ASSERT_EQ(metadata.files.size(), 1u);
   EXPECT_EQ(metadata.files[0].filename(), "bag_0.db3");
+  // A folder named with a trailing separator names its file alike.
+  write_as(fields, (dir / "slash").string() + "/", ScanFormat::kRosbag2);
+  EXPECT_TRUE(fs::exists(dir / "slash" / "slash_0.db3"));
 }
 
 TEST(Ros2Bags, McapRoundTripsInEveryCompressionAndByteOrder) {

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 #include <optional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -60,7 +61,7 @@ struct Place {
 /// against the bytes left.
 class Fields {
  public:
-  Fields(std::span<const std::byte> bytes, const Place& place) : bytes_(bytes), place_(place) {}
+  Fields(std::span<const std::byte> bytes, Place place) : bytes_(bytes), place_(std::move(place)) {}
   std::span<const std::byte> take(std::uint64_t n, std::string_view what) {
     if (n > bytes_.size() - at_) {
       throw place_.error(fmt::format("{} of {} bytes runs past its record ({} left)", what, n, bytes_.size() - at_));
@@ -85,7 +86,7 @@ class Fields {
 
  private:
   std::span<const std::byte> bytes_;
-  const Place& place_;
+  Place place_;  ///< a copy: callers pass temporaries (at(pos, "message"))
   std::size_t at_ = 0;
 };
 

@@ -99,7 +99,10 @@ void write_bag(FrameSource& in, const fs::path& out, const SequenceWriteOptions&
 std::int64_t stamp_ns(double stamp) { return std::llround(stamp * 1e9); }
 
 void write_rosbag2(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
-  const std::string name = out.filename().string() + "_0.db3";
+  // Named after the folder, as rosbag2 names its files ("bag/" has no filename: its parent's name).
+  const fs::path folder = out.has_filename() ? out.filename() : out.parent_path().filename();
+  const std::string stem = folder.empty() || folder == "." || folder == ".." ? std::string("rosbag2") : folder.string();
+  const std::string name = stem + "_0.db3";
   Db3Writer db(out / name);
   const std::int64_t topic = db.add_topic(options.topic, std::string(kRos2PointCloud2Type));
   const auto& times = in.info().times;
