@@ -39,7 +39,7 @@ std::vector<std::unique_ptr<MessageStorage>> open_ros2_storage(const fs::path& p
     const Rosbag2Metadata metadata = read_rosbag2_metadata(path);
     for (const auto& file : metadata.files) files.push_back(open_file(file, metadata.storage == "mcap"));
   } else {
-    files.push_back(open_file(path, format == ScanFormat::kMcap));
+    files.push_back(open_file(path, format == ScanFormat::kMcap || path.extension() == ".mcap"));
   }
   return files;
 }

@@ -36,9 +36,10 @@ namespace saloam {
 /// The first 16 bytes of every SQLite database ("SQLite format 3" and NUL).
 inline constexpr std::string_view kSqliteMagic{"SQLite format 3\0", 16};
 
-/// The files of a recording, opened: `path` is a rosbag2 folder, a .db3 or
-/// an .mcap file (`format` kRosbag2 or kMcap says which files take which
-/// storage). InputError naming the file that cannot be read.
+/// The files of a recording, opened: `path` is a rosbag2 folder (its
+/// metadata.yaml names the storage), or one file: MCAP when `format` is
+/// kMcap or the name ends in .mcap, else a .db3. InputError naming the file
+/// that cannot be read.
 std::vector<std::unique_ptr<MessageStorage>> open_ros2_storage(const std::filesystem::path& path, ScanFormat format);
 
 /// The topics of a ROS 2 recording with their types and message counts
