@@ -127,6 +127,42 @@ TEST(Ros2Bags, Db3FolderRoundTripsScansRingsTimesAndStamps) {
   EXPECT_TRUE(fs::exists(dir / "slash" / "slash_0.db3"));
 }
 
+// rosbag2 folders with MCAP storage, and bags split into several files
+// (rosbag2's --max-bag-size): the files named by metadata.yaml, read one
+// after the other.
+TEST(Ros2Bags, FoldersOfMcapFilesAndSplitBagsAreReadFileByFile) {
+  auto seq = open_reader(simulated_sequence(), {});
+  testing::TempDir dir;
+  fs::create_directories(dir / "mcap_bag");
+  write_as(*seq, dir / "mcap_bag" / "mcap_bag_0.mcap", ScanFormat::kMcap);
+  write_bytes(dir / "mcap_bag" / "metadata.yaml",
+              "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths:\n"
+              "    - mcap_bag_0.mcap\n  compression_format: \"\"\n");
+  auto mcap_bag = open_reader(dir / "mcap_bag", {});
+  EXPECT_EQ(mcap_bag->info().format, "rosbag2");
+  expect_same_scans(*seq, *mcap_bag);
+
+  fs::create_directories(dir / "split");
+  for (std::size_t part = 0; part < 2; ++part) {
+    Db3Writer db(dir / "split" / fmt::format("split_{}.db3", part));
+    const auto topic = db.add_topic("/points", std::string(kRos2PointCloud2Type));
+    for (std::size_t i = 3 * part; i < 3 * part + 3; ++i) {
+      const double t = seq->info().times[i];
+      db.write(topic, std::llround(t * 1e9), serialize_pointcloud2_cdr(seq->scan(i), t, "velodyne"));
+    }
+    db.close("");
+  }
+  write_bytes(dir / "split" / "metadata.yaml",
+              "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths: [split_0.db3, split_1.db3]\n");
+  auto split = open_reader(dir / "split", {});
+  expect_same_scans(*seq, *split);
+  // Listed in the wrong order, the second file's stamps do not follow the first's.
+  write_bytes(dir / "split" / "metadata.yaml",
+              "rosbag2_bagfile_information:\n  storage_identifier: sqlite3\n  relative_file_paths: [split_1.db3, split_0.db3]\n");
+  EXPECT_NE(input_error_of([&] { open_reader(dir / "split", {}); }).find("split_0.db3: topic /points, message 3: header stamp"),
+            std::string::npos);
+}
+
 TEST(Ros2Bags, McapRoundTripsInEveryCompressionAndByteOrder) {
   auto seq = open_reader(simulated_sequence(), {});
   WithPointFields fields(*seq);
