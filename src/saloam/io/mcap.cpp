@@ -300,6 +300,7 @@ void McapReader::Impl::read_chunk_index(std::span<const std::byte> content, cons
   chunks.push_back({chunk_at, false, chunk_length});
   const auto offsets = f.prefixed("message_index_offsets");
   if (offsets.size() % 10 != 0) throw place.error(fmt::format("message_index_offsets of {} bytes", offsets.size()));
+  if (offsets.empty()) return scan_chunk(chunks.size() - 1);  // a chunk without message indexes: its records say
   for (std::size_t k = 0; k < offsets.size(); k += 10) {
     std::uint64_t pos;
     std::memcpy(&pos, offsets.data() + k + 2, 8);

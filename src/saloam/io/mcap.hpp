@@ -13,7 +13,8 @@
 //
 // McapReader: with a footer whose summary holds chunk indexes, the chunks
 // and their message indexes are found through it (nothing else is read when
-// the file is opened; message counts from the indexes); otherwise (no
+// the file is opened; message counts from the indexes; a chunk indexed
+// without message indexes is decompressed and read through); otherwise (no
 // summary, or a file cut short: no footer) the data section is read from
 // the start, chunk by chunk, up to the last whole record; a chunk cut off is
 // decompressed as far as its bytes go. A file cut short is noted (notes()).
