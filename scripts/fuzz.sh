@@ -27,6 +27,7 @@ declare -A MAX_LEN=(
   [scan]=4096 [label]=1024 [kitti_poses]=4096 [tum_poses]=4096 [calib]=8192
   [times]=2048 [sgw]=200000 [graph_json]=8192 [config]=8192 [segmenter_spec]=4096 [sensor_profile]=4096
   [pcd]=4096 [ply]=4096 [pointcloud2]=4096 [kitti_raw]=2048 [rosbag]=16384 [map]=8192
+  [pointcloud2_cdr]=4096 [mcap]=16384 [rosbag2]=32768
 )
 
 build() {

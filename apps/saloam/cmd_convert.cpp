@@ -27,6 +27,8 @@ struct ConvertArgs {
 
 const std::map<std::string, PcdEncoding> kPcdEncodings{
     {"ascii", PcdEncoding::kAscii}, {"binary", PcdEncoding::kBinary}, {"binary_compressed", PcdEncoding::kBinaryCompressed}};
+const std::map<std::string, McapCompression> kMcapEncodings{
+    {"zstd", McapCompression::kZstd}, {"lz4", McapCompression::kLz4}, {"none", McapCompression::kNone}};
 const std::map<std::string, PlyEncoding> kPlyEncodings{{"ascii", PlyEncoding::kAscii},
                                                        {"binary_little_endian", PlyEncoding::kBinaryLittleEndian},
                                                        {"binary_big_endian", PlyEncoding::kBinaryBigEndian}};
@@ -48,7 +50,8 @@ SequenceWriteOptions write_options(const ConvertArgs& args) {
   if (!args.encoding.empty()) {
     if (o.format == ScanFormat::kPcd) o.pcd = encoding_of(kPcdEncodings, args.encoding, "PCD");
     else if (o.format == ScanFormat::kPly) o.ply = encoding_of(kPlyEncodings, args.encoding, "PLY");
-    else throw ConfigError(fmt::format("--encoding: only for --to pcd or ply, not {}", args.to));
+    else if (o.format == ScanFormat::kMcap) o.mcap_compression = encoding_of(kMcapEncodings, args.encoding, "MCAP");
+    else throw ConfigError(fmt::format("--encoding: only for --to pcd, ply or mcap, not {}", args.to));
   }
   o.topic = args.bag_topic;
   return o;
@@ -67,18 +70,18 @@ int run_convert(const ConvertArgs& args) {
 }
 
 const CommandRegistration kRegistration{Command{
-    "convert", "Write a scan source in another layout (SemanticKITTI, KITTI raw, PCD, PLY, ROS bag)", 16,
+    "convert", "Write a scan source in another layout (SemanticKITTI, KITTI raw, PCD, PLY, ROS 1 and 2 bags, MCAP)", 16,
     [](CLI::App& app) {
       auto args = std::make_shared<ConvertArgs>();
       args->source.add_with_no_calib_to(app);
-      app.add_option("--out", args->out, "The new folder (or .bag file); must not exist or be an empty folder")
+      app.add_option("--out", args->out, "The new folder (or .bag / .mcap file); must not exist or be an empty folder")
           ->required();
-      app.add_option("--to", args->to, "Layout to write: semantickitti, kitti-raw, pcd, ply, rosbag")
+      app.add_option("--to", args->to, "Layout to write: semantickitti, kitti-raw, pcd, ply, rosbag, rosbag2, mcap")
           ->required()
-          ->check(CLI::IsMember({"semantickitti", "kitti-raw", "pcd", "ply", "rosbag"}));
+          ->check(CLI::IsMember({"semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "rosbag2", "mcap"}));
       app.add_option("--encoding", args->encoding,
                      "PCD: ascii, binary (default), binary_compressed; PLY: ascii, binary_little_endian (default), "
-                     "binary_big_endian");
+                     "binary_big_endian; MCAP chunks: zstd (default), lz4, none");
       app.add_option("--bag-topic", args->bag_topic, "Topic of the written bag's PointCloud2 messages")
           ->capture_default_str();
       app.add_flag("--no-labels", args->no_labels, "Leave the labels out");

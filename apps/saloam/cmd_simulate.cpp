@@ -175,9 +175,9 @@ const CommandRegistration kRegistration{Command{
                      "Sensor profile to render: hdl64e, hdl32e, vlp16, os1-64, os1-128 (config/sensors/) or a profile "
                      "file; default the HDL-64E (--beams)");
       app.add_option("--format", args->format,
-                     "Layout to write: semantickitti (default), pcd, ply, kitti-raw, rosbag (PCD, PLY and bags keep each "
+                     "Layout to write: semantickitti (default), pcd, ply, kitti-raw, rosbag, rosbag2, mcap (PCD, PLY and bags keep each "
                      "point's ring and time)")
-          ->check(CLI::IsMember({"semantickitti", "pcd", "ply", "kitti-raw", "rosbag"}));
+          ->check(CLI::IsMember({"semantickitti", "pcd", "ply", "kitti-raw", "rosbag", "rosbag2", "mcap"}));
       app.add_option("--azimuth-steps", args->sim.azimuth_steps,
                      "Columns per turn (HDL-64E: about 2083; with --sensor the profile's)")
           ->check(CLI::Range(16, 8000))

@@ -228,13 +228,13 @@ std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig
 }
 
 void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
-  app.add_option("SEQ_DIR", path, path_help + "; or a KITTI raw drive, a folder of .pcd/.ply files, a ROS 1 bag")
+  app.add_option("SEQ_DIR", path, path_help + "; or a KITTI raw drive, a folder of .pcd/.ply files, a ROS 1 bag, a ROS 2 bag (folder or .db3), an .mcap file")
       ->required();
   app.add_option("--format", format,
-                 "Layout of SEQ_DIR: auto (detected), semantickitti, kitti-raw, pcd, ply, rosbag")
+                 "Layout of SEQ_DIR: auto (detected), semantickitti, kitti-raw, pcd, ply, rosbag, rosbag2, mcap")
       ->check(CLI::IsMember(scan_format_names()))
       ->capture_default_str();
-  app.add_option("--topic", topic, "ROS bag topic of sensor_msgs/PointCloud2 (default: the only one)");
+  app.add_option("--topic", topic, "ROS 1/2 bag or MCAP topic of sensor_msgs/PointCloud2 (default: the only one)");
   app.add_option("--sensor", sensor,
                  "Sensor profile: auto (guessed from the first scan), none, a shipped one (hdl64e, hdl32e, vlp16, os1-64, "
                  "os1-128: config/sensors/) or a profile file")

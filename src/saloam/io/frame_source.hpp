@@ -60,7 +60,7 @@ struct SourceInfo {
   /// Frame i is the folder's (or the recording's) frame first_frame + i (after `--frames A:B`: A).
   std::size_t first_frame = 0;
   /// The layout read, as --format names it ("semantickitti", "kitti-raw",
-  /// "pcd", "ply", "rosbag"), or "simulated".
+  /// "pcd", "ply", "rosbag", "rosbag2", "mcap"), or "simulated".
   std::string format;
   /// The point fields of the scans as the source names them ("x y z
   /// intensity ring t"; KITTI .bin scans: "x y z remission"), from the first

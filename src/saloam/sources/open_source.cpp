@@ -6,9 +6,11 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/io/mcap.hpp"
 #include "saloam/io/sequence_source.hpp"
 #include "saloam/sources/kitti_raw_drive.hpp"
 #include "saloam/sources/point_cloud_folder.hpp"
+#include "saloam/sources/ros2_bag_source.hpp"
 #include "saloam/sources/rosbag_source.hpp"
 #include "saloam/sources/scan_files.hpp"
 
@@ -17,30 +19,36 @@ namespace fs = std::filesystem;
 namespace saloam {
 namespace {
 
-constexpr std::array<std::pair<ScanFormat, std::string_view>, 6> kNames{{{ScanFormat::kAuto, "auto"},
+constexpr std::array<std::pair<ScanFormat, std::string_view>, 8> kNames{{{ScanFormat::kAuto, "auto"},
                                                                         {ScanFormat::kSemanticKitti, "semantickitti"},
                                                                         {ScanFormat::kKittiRaw, "kitti-raw"},
                                                                         {ScanFormat::kPcd, "pcd"},
                                                                         {ScanFormat::kPly, "ply"},
-                                                                        {ScanFormat::kRosbag, "rosbag"}}};
+                                                                        {ScanFormat::kRosbag, "rosbag"},
+                                                                        {ScanFormat::kRosbag2, "rosbag2"},
+                                                                        {ScanFormat::kMcap, "mcap"}}};
 
-bool starts_with_bag_magic(const fs::path& file) {
+bool starts_with(const fs::path& file, std::string_view magic) {
   std::ifstream in(file, std::ios::binary);
-  std::string head(kRosbagMagic.size(), '\0');
-  return in.read(head.data(), static_cast<std::streamsize>(head.size())) && head == kRosbagMagic;
+  std::string head(magic.size(), '\0');
+  return in.read(head.data(), static_cast<std::streamsize>(head.size())) && head == magic;
 }
 
 ScanFormat detect_file(const fs::path& file) {
   const auto ext = file.extension();
-  if (starts_with_bag_magic(file) || ext == ".bag") return ScanFormat::kRosbag;
+  if (starts_with(file, kRosbagMagic) || ext == ".bag") return ScanFormat::kRosbag;
+  if (starts_with(file, kMcapMagic) || ext == ".mcap") return ScanFormat::kMcap;
+  if (starts_with(file, kSqliteMagic) || ext == ".db3") return ScanFormat::kRosbag2;
   if (ext == ".pcd") return ScanFormat::kPcd;
   if (ext == ".ply") return ScanFormat::kPly;
-  throw InputError(file, "not a scan source saloam reads: expected a ROS 1 bag (.bag), a .pcd or .ply file, or a folder");
+  throw InputError(file, "not a scan source saloam reads: expected a ROS 1 bag (.bag), an MCAP file (.mcap), a rosbag2 "
+                         "database (.db3), a .pcd or .ply file, or a folder");
 }
 
 ScanFormat detect_folder(const fs::path& folder) {
   std::error_code ec;
   if (fs::is_directory(folder / "velodyne", ec)) return ScanFormat::kSemanticKitti;
+  if (fs::is_regular_file(folder / "metadata.yaml", ec)) return ScanFormat::kRosbag2;
   if (fs::is_directory(folder / "velodyne_points" / "data", ec)) return ScanFormat::kKittiRaw;
   const bool pcd = has_files_with_extension(folder, ".pcd");
   const bool ply = has_files_with_extension(folder, ".ply");
@@ -48,7 +56,7 @@ ScanFormat detect_folder(const fs::path& folder) {
   if (pcd) return ScanFormat::kPcd;
   if (ply) return ScanFormat::kPly;
   throw InputError(folder, "no scans found: expected velodyne/*.bin (SemanticKITTI), velodyne_points/data/*.bin "
-                           "(KITTI raw), *.pcd or *.ply files, or a ROS 1 bag file");
+                           "(KITTI raw), *.pcd or *.ply files, metadata.yaml (rosbag2), or a ROS 1 bag or MCAP file");
 }
 
 std::unique_ptr<FrameSource> open_semantic_kitti(const fs::path& path, const SourceOptions& options) {
@@ -103,6 +111,8 @@ std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptio
     case ScanFormat::kPcd:
     case ScanFormat::kPly: return std::make_unique<PointCloudFolder>(path, format, options);
     case ScanFormat::kRosbag: return std::make_unique<RosbagSource>(path, options);
+    case ScanFormat::kRosbag2:
+    case ScanFormat::kMcap: return std::make_unique<Ros2BagSource>(path, format, options);
     case ScanFormat::kAuto: break;
   }
   throw InputError(path, "no scan format");

@@ -79,6 +79,27 @@ void check_magic(const fs::path& bag) {
 
 }  // namespace
 
+std::string bag_topics_text(const std::vector<BagTopic>& topics) {
+  std::string out;
+  for (const auto& t : topics) out += fmt::format("{} {} ({}, {} messages)", out.empty() ? "" : ";", t.topic, t.type, t.messages);
+  return out.empty() ? " none" : out;
+}
+
+std::string choose_cloud_topic(const std::vector<BagTopic>& topics, const std::string& wanted, std::string_view cloud_type,
+                               const fs::path& bag) {
+  std::vector<BagTopic> clouds;
+  std::copy_if(topics.begin(), topics.end(), std::back_inserter(clouds), [&](const BagTopic& t) { return t.type == cloud_type; });
+  if (!wanted.empty()) {
+    const auto it = std::find_if(topics.begin(), topics.end(), [&](const BagTopic& t) { return t.topic == wanted; });
+    if (it == topics.end()) throw InputError(bag, fmt::format("no topic '{}'; the bag holds:{}", wanted, bag_topics_text(topics)));
+    if (it->type != cloud_type) throw InputError(bag, fmt::format("topic '{}' holds {}, not {}", wanted, it->type, cloud_type));
+    return wanted;
+  }
+  if (clouds.size() == 1) return clouds.front().topic;
+  if (clouds.empty()) throw InputError(bag, fmt::format("no {} topic; the bag holds:{}", cloud_type, bag_topics_text(topics)));
+  throw InputError(bag, fmt::format("{} {} topics: pick one with --topic:{}", clouds.size(), cloud_type, bag_topics_text(clouds)));
+}
+
 bool rosbag_available() {
 #ifdef SALOAM_HAVE_ROSBAG
   return true;
@@ -105,11 +126,6 @@ auto guarded(const fs::path& bag, F&& f) {
   }
 }
 
-std::string topics_text(const std::vector<BagTopic>& topics) {
-  std::string out;
-  for (const auto& t : topics) out += fmt::format("{} {} ({}, {} messages)", out.empty() ? "" : ";", t.topic, t.type, t.messages);
-  return out.empty() ? " none" : out;
-}
 
 /// The message's serialised bytes; InputError when the bag claims more
 /// bytes than it holds (checked before allocating).
@@ -163,25 +179,7 @@ RosbagSource::RosbagSource(fs::path bag, const SourceOptions& options)
   check_rosbag_structure(bag_);  // every length and position, before rosbag trusts them
   guarded(bag_, [&] {
     impl_->bag.open(bag_.string(), rosbag::bagmode::Read);
-    const auto topics = topics_of(impl_->bag);
-    std::vector<BagTopic> clouds;
-    std::copy_if(topics.begin(), topics.end(), std::back_inserter(clouds),
-                 [](const BagTopic& t) { return t.type == kPointCloud2Type; });
-    if (!options.topic.empty()) {
-      const auto it = std::find_if(topics.begin(), topics.end(), [&](const BagTopic& t) { return t.topic == options.topic; });
-      if (it == topics.end()) throw InputError(bag_, fmt::format("no topic '{}'; the bag holds:{}", options.topic, topics_text(topics)));
-      if (it->type != kPointCloud2Type) {
-        throw InputError(bag_, fmt::format("topic '{}' holds {}, not {}", options.topic, it->type, kPointCloud2Type));
-      }
-      impl_->topic = options.topic;
-    } else if (clouds.size() == 1) {
-      impl_->topic = clouds.front().topic;
-    } else if (clouds.empty()) {
-      throw InputError(bag_, fmt::format("no {} topic; the bag holds:{}", kPointCloud2Type, topics_text(topics)));
-    } else {
-      throw InputError(bag_, fmt::format("{} {} topics: pick one with --topic:{}", clouds.size(), kPointCloud2Type,
-                                         topics_text(clouds)));
-    }
+    impl_->topic = choose_cloud_topic(topics_of(impl_->bag), options.topic, kPointCloud2Type, bag_);
     rosbag::View view(impl_->bag, rosbag::TopicQuery(impl_->topic));
     for (const rosbag::MessageInstance& m : view) {
       const auto bytes = message_bytes(m, bag_);

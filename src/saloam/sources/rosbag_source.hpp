@@ -42,6 +42,15 @@ struct BagTopic {
   std::size_t messages = 0;
 };
 
+/// The topic a bag source reads: `wanted` when given (InputError naming
+/// `bag` when it is not among `topics` or is not of `cloud_type`), else the
+/// only topic of `cloud_type` (InputError when there is none, or several:
+/// the message lists them, with their types and message counts).
+std::string choose_cloud_topic(const std::vector<BagTopic>& topics, const std::string& wanted, std::string_view cloud_type,
+                               const std::filesystem::path& bag);
+/// " /a (type, 3 messages); /b (...)", or " none": what a bag holds, for messages.
+std::string bag_topics_text(const std::vector<BagTopic>& topics);
+
 /// The topics of a bag with their types and message counts, by topic name.
 /// InputError naming the bag when it is not a readable ROS 1 bag.
 std::vector<BagTopic> list_bag_topics(const std::filesystem::path& bag);

@@ -7,7 +7,11 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/core/output_file.hpp"
 #include "saloam/io/calibration.hpp"
+#include "saloam/io/db3.hpp"
+#include "saloam/io/pointcloud2.hpp"
+#include "saloam/io/rosbag2_metadata.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
@@ -92,6 +96,38 @@ void write_bag(FrameSource& in, const fs::path& out, const SequenceWriteOptions&
   writer.close();
 }
 
+std::int64_t stamp_ns(double stamp) { return std::llround(stamp * 1e9); }
+
+void write_rosbag2(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
+  // Named after the folder, as rosbag2 names its files ("bag/" has no filename: its parent's name).
+  const fs::path folder = out.has_filename() ? out.filename() : out.parent_path().filename();
+  const std::string stem = folder.empty() || folder == "." || folder == ".." ? std::string("rosbag2") : folder.string();
+  const std::string name = stem + "_0.db3";
+  Db3Writer db(out / name);
+  const std::int64_t topic = db.add_topic(options.topic, std::string(kRos2PointCloud2Type));
+  const auto& times = in.info().times;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    db.write(topic, stamp_ns(times[i]), serialize_pointcloud2_cdr(in.scan(i), times[i], options.frame_id, options.cdr_big_endian));
+  }
+  const StoredTopic stored{options.topic, std::string(kRos2PointCloud2Type), "cdr", in.size()};
+  const Rosbag2FileSummary file{name, in.size() ? stamp_ns(times.front()) : 0, in.size() ? stamp_ns(times.back()) : 0, in.size()};
+  const std::string metadata = rosbag2_metadata_text("sqlite3", {stored}, file);
+  db.close(metadata);
+  write_file_atomically(out / "metadata.yaml", metadata);
+}
+
+void write_mcap(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
+  McapWriter mcap(out, options.mcap_compression, options.mcap_chunk_bytes);
+  const auto schema = mcap.add_schema(std::string(kRos2PointCloud2Type), "ros2msg", kRos2PointCloud2Definition);
+  const auto channel = mcap.add_channel(options.topic, schema, "cdr");
+  const auto& times = in.info().times;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const auto message = serialize_pointcloud2_cdr(in.scan(i), times[i], options.frame_id, options.cdr_big_endian);
+    mcap.write(channel, static_cast<std::uint64_t>(std::max<std::int64_t>(stamp_ns(times[i]), 0)), message);
+  }
+  mcap.close();
+}
+
 }  // namespace
 
 OxtsRecord kitti_raw_origin() {
@@ -112,11 +148,11 @@ Pose kitti_imu_to_velo() {
 }
 
 void write_scan_sequence(FrameSource& in, const fs::path& out, const SequenceWriteOptions& options) {
-  if (options.format == ScanFormat::kRosbag) {
+  if (options.format == ScanFormat::kRosbag || options.format == ScanFormat::kMcap) {
     std::error_code ec;
     if (fs::exists(out, ec)) throw InputError(out, "exists: write a bag into a new file");
     create_parent_folder(out);
-    return write_bag(in, out, options);
+    return options.format == ScanFormat::kMcap ? write_mcap(in, out, options) : write_bag(in, out, options);
   }
   if (options.format == ScanFormat::kAuto) throw InputError(out, "name the layout to write (auto is not one)");
   check_new_folder(in, out);
@@ -125,6 +161,7 @@ void write_scan_sequence(FrameSource& in, const fs::path& out, const SequenceWri
     case ScanFormat::kPcd:
     case ScanFormat::kPly: return write_point_cloud_folder(in, out, options);
     case ScanFormat::kKittiRaw: return write_kitti_raw(in, out);
+    case ScanFormat::kRosbag2: return write_rosbag2(in, out, options);
     default: break;
   }
 }

@@ -11,13 +11,20 @@
 //                  the reference poses in the LiDAR frame through
 //                  kitti_imu_to_velo() and kKittiRawOrigin, calib_imu_to_velo.txt
 //   rosbag         PointCloud2 messages on `topic` stamped with the times
-// Per-point rings and times survive pcd, ply and rosbag; labels survive
+//   rosbag2        a folder: metadata.yaml and NAME_0.db3 (NAME: the
+//                  folder's name) holding sensor_msgs/msg/PointCloud2
+//                  messages (CDR) on `topic`, stamped with the times (log
+//                  time: the stamp in ns)
+//   mcap           one file, the same messages in zstd (or lz4, or
+//                  uncompressed) chunks of about 1 MiB, indexed, with a summary
+// Per-point rings and times survive pcd, ply and the bags; labels survive
 // semantickitti, pcd and ply.
 
 #include <filesystem>
 #include <string>
 
 #include "saloam/io/kitti_raw.hpp"
+#include "saloam/io/mcap.hpp"
 #include "saloam/io/pcd.hpp"
 #include "saloam/io/ply.hpp"
 #include "saloam/io/frame_source.hpp"
@@ -33,6 +40,9 @@ struct SequenceWriteOptions {
   std::string topic = "/points";
   std::string frame_id = "velodyne";
   BagCompression bag_compression = BagCompression::kLz4;
+  McapCompression mcap_compression = McapCompression::kZstd;
+  std::size_t mcap_chunk_bytes = 1u << 20;
+  bool cdr_big_endian = false;  ///< ROS 2 messages in big-endian CDR (as some non-x86 hosts record)
 };
 
 /// 2011-09-26 13:02:25 UTC, the first scan of KITTI raw drive 0005 [s since the epoch].
@@ -45,7 +55,7 @@ Pose kitti_imu_to_velo();
 
 /// Writes every scan of `in` and what goes with it (times, reference poses,
 /// Tr) into `out`, which must not exist yet or be an empty folder (an input
-/// is never overwritten).
+/// is never overwritten; a bag or MCAP file: must not exist).
 /// InputError naming `out` otherwise, or for a layout that cannot hold the
 /// source (kitti-raw needs reference poses; kAuto is no layout).
 void write_scan_sequence(FrameSource& in, const std::filesystem::path& out, const SequenceWriteOptions& options);

@@ -10,6 +10,9 @@
 //   kitti-raw      DRIVE/velodyne_points/data/*.bin + timestamps, oxts/ (GPS/INS reference)
 //   pcd, ply       a folder of .pcd or .ply files (or one file), ordered by name
 //   rosbag         a ROS 1 bag's sensor_msgs/PointCloud2 messages on one topic
+//   rosbag2        a ROS 2 bag's: a folder with metadata.yaml and .db3 (or
+//                  .mcap) files, or one .db3 file
+//   mcap           an MCAP file's (ROS 2 messages, CDR)
 //   auto           detected from the path (detect_scan_format)
 
 #include <filesystem>
@@ -23,9 +26,9 @@
 
 namespace saloam {
 
-enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag };
+enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag, kRosbag2, kMcap };
 
-/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag".
+/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "rosbag2", "mcap".
 [[nodiscard]] std::string_view format_name(ScanFormat format);
 /// The format of a --format value, nullopt for an unknown name.
 [[nodiscard]] std::optional<ScanFormat> scan_format_from_name(std::string_view name);
