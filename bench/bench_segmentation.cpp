@@ -89,9 +89,13 @@ void BM_KnnVote(benchmark::State& state) {
   for (std::size_t p = 0; p < pixel_class.size(); ++p)
     pixel_class[p] = image.shown[p] < 0 ? 0 : static_cast<std::int16_t>(1 + cloud.label[image.shown[p]] % 19);
   const auto ranges = point_ranges(cloud);
-  for (auto _ : state) benchmark::DoNotOptimize(point_classes(image, pixel_class, ranges, 20, KnnOptions{}));
+  KnnOptions options;
+  options.k = static_cast<int>(state.range(0));
+  options.window = static_cast<int>(state.range(1));
+  for (auto _ : state) benchmark::DoNotOptimize(point_classes(image, pixel_class, ranges, 20, options));
 }
-BENCHMARK(BM_KnnVote)->Unit(benchmark::kMillisecond);
+// (k, window): RangeNet++'s 5 x 5 up to the shipped models' 17 of 11 x 11.
+BENCHMARK(BM_KnnVote)->Args({5, 5})->Args({9, 7})->Args({13, 9})->Args({17, 11})->Unit(benchmark::kMillisecond);
 
 // The whole stage (rings, projection, network, vote) on one thread; args:
 // beams, ring field.

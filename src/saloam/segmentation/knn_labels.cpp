@@ -27,7 +27,13 @@ std::vector<float> inverse_gaussian(int window, double sigma) {
 struct Candidate {
   float distance;
   std::int16_t label;
+  std::uint16_t order;  ///< position in the window: among equal distances the earlier ranks first
 };
+
+/// The ranking of the vote: nearer first, then earlier in the window.
+bool nearer(const Candidate& a, const Candidate& b) {
+  return a.distance < b.distance || (a.distance == b.distance && a.order < b.order);
+}
 
 }  // namespace
 
@@ -108,24 +114,6 @@ std::vector<std::uint8_t> uniform_windows(const RangeImage& image, const std::ve
   return out;
 }
 
-/// The k candidates of smallest distance, kept sorted by insertion (k is small).
-class NearestK {
- public:
-  explicit NearestK(std::size_t k) : k_(std::min<std::size_t>(k, kMaxWindow * kMaxWindow)) {}
-  void offer(float distance, std::int16_t label) {
-    if (n_ == k_ && !(distance < best_[n_ - 1].distance)) return;
-    std::size_t j = n_ < k_ ? n_++ : n_ - 1;
-    for (; j > 0 && distance < best_[j - 1].distance; --j) best_[j] = best_[j - 1];
-    best_[j] = {distance, label};
-  }
-  [[nodiscard]] std::size_t size() const { return n_; }
-  [[nodiscard]] const Candidate& operator[](std::size_t j) const { return best_[j]; }
-
- private:
-  std::size_t k_, n_ = 0;
-  std::array<Candidate, kMaxWindow * kMaxWindow> best_;  // [0, n_) is set; left uninitialised (one per point)
-};
-
 /// The pixels of a point's window that can vote: those showing a point within
 /// the cutoff of its range (distance = |range difference| x the offset's
 /// weight; the point's own pixel at distance 0), in window order. Only they
@@ -155,7 +143,8 @@ Voters voters(const RangeImage& image, const std::vector<std::int16_t>& pixel_cl
       const float wt = vw.weight[static_cast<std::size_t>((y - row + vw.half) * vw.side + j)];
       const float distance = self ? 0.0f : std::abs(image.range[p] - range) * wt;
       if (!(distance <= vw.cutoff)) continue;
-      v.near[v.n++] = {distance, pixel_class[p]};
+      v.near[v.n] = {distance, pixel_class[p], static_cast<std::uint16_t>(v.n)};
+      ++v.n;
       v.one_label = v.one_label && pixel_class[p] == v.near[0].label;
     }
   return v;
@@ -163,16 +152,19 @@ Voters voters(const RangeImage& image, const std::vector<std::int16_t>& pixel_cl
 
 /// The class most of the k nearest voters show (the lowest class on a tie;
 /// class 0 and classes beyond the network's do not count), `own` when none
-/// counts. `votes` is scratch space, one per class.
-std::int16_t voted_class(const Voters& v, std::size_t k, int classes, std::int16_t own, std::vector<int>& votes) {
+/// counts. The k nearest are selected in place (their order among
+/// themselves does not matter to the count). `votes` is scratch space, one
+/// per class.
+std::int16_t voted_class(Voters& v, std::size_t k, int classes, std::int16_t own, std::vector<int>& votes) {
   const auto counts = [classes](std::int16_t c) { return c > 0 && c < classes; };
   if (v.n == 0) return own;
   if (v.one_label) return counts(v.near[0].label) ? v.near[0].label : own;
-  NearestK nearest(k);
-  for (std::size_t j = 0; j < v.n; ++j) nearest.offer(v.near[j].distance, v.near[j].label);
+  const auto first = v.near.begin();
+  const std::size_t voting = std::min(k, v.n);
+  if (voting < v.n) std::nth_element(first, first + static_cast<std::ptrdiff_t>(voting), first + static_cast<std::ptrdiff_t>(v.n), nearer);
   std::fill(votes.begin(), votes.end(), 0);
-  for (std::size_t j = 0; j < nearest.size(); ++j)
-    if (counts(nearest[j].label)) ++votes[static_cast<std::size_t>(nearest[j].label)];
+  for (std::size_t j = 0; j < voting; ++j)
+    if (counts(v.near[j].label)) ++votes[static_cast<std::size_t>(v.near[j].label)];
   const auto best = std::max_element(votes.begin() + 1, votes.end());
   return *best > 0 ? static_cast<std::int16_t>(best - votes.begin()) : own;
 }
@@ -191,13 +183,17 @@ std::vector<std::int16_t> point_classes(const RangeImage& image, const std::vect
   std::vector<std::int16_t> out(image.point_pixel.size(), 0);
   std::vector<int> votes(static_cast<std::size_t>(classes));
   const std::vector<std::uint8_t> uniform = uniform_windows(image, pixel_class, vw.half);
+  const auto vote = [&](std::int32_t pixel, std::size_t i, std::int16_t own) {
+    Voters v = voters(image, pixel_class, vw, pixel, point_range[i]);
+    return voted_class(v, k, classes, own, votes);
+  };
   for (std::size_t i = 0; i < image.point_pixel.size(); ++i) {
     const std::int32_t pixel = image.point_pixel[i];
     if (pixel < 0) continue;
     const std::int16_t own = pixel_class[static_cast<std::size_t>(pixel)];
     out[i] = own > 0 && own < classes && uniform[static_cast<std::size_t>(pixel)]
                  ? own
-                 : voted_class(voters(image, pixel_class, vw, pixel, point_range[i]), k, classes, own, votes);
+                 : vote(pixel, i, own);
   }
   return out;
 }
