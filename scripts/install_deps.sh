@@ -13,6 +13,7 @@ packages=(
   libtorch-dev  # saloam sgpr-train (optional: without it the rest builds and the trainer is left out)
   liblzf-dev  # binary_compressed PCD (optional: without it such files are an error that says so)
   librosbag-storage-dev  # ROS 1 bags (optional: without it bags are an error that says so)
+  libpcap-dev  # sensor packet captures (.pcap: Ouster, Velodyne)
 )
 
 missing=()
