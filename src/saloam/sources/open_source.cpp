@@ -7,7 +7,9 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/io/sequence_source.hpp"
+#include "saloam/sensors/pcap_reader.hpp"
 #include "saloam/sources/kitti_raw_drive.hpp"
+#include "saloam/sources/pcap_source.hpp"
 #include "saloam/sources/point_cloud_folder.hpp"
 #include "saloam/sources/rosbag_source.hpp"
 #include "saloam/sources/scan_files.hpp"
@@ -17,12 +19,13 @@ namespace fs = std::filesystem;
 namespace saloam {
 namespace {
 
-constexpr std::array<std::pair<ScanFormat, std::string_view>, 6> kNames{{{ScanFormat::kAuto, "auto"},
+constexpr std::array<std::pair<ScanFormat, std::string_view>, 7> kNames{{{ScanFormat::kAuto, "auto"},
                                                                         {ScanFormat::kSemanticKitti, "semantickitti"},
                                                                         {ScanFormat::kKittiRaw, "kitti-raw"},
                                                                         {ScanFormat::kPcd, "pcd"},
                                                                         {ScanFormat::kPly, "ply"},
-                                                                        {ScanFormat::kRosbag, "rosbag"}}};
+                                                                        {ScanFormat::kRosbag, "rosbag"},
+                                                                        {ScanFormat::kPcap, "pcap"}}};
 
 bool starts_with_bag_magic(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
@@ -33,9 +36,11 @@ bool starts_with_bag_magic(const fs::path& file) {
 ScanFormat detect_file(const fs::path& file) {
   const auto ext = file.extension();
   if (starts_with_bag_magic(file) || ext == ".bag") return ScanFormat::kRosbag;
+  if (has_pcap_magic(file) || ext == ".pcap" || ext == ".pcapng") return ScanFormat::kPcap;
   if (ext == ".pcd") return ScanFormat::kPcd;
   if (ext == ".ply") return ScanFormat::kPly;
-  throw InputError(file, "not a scan source saloam reads: expected a ROS 1 bag (.bag), a .pcd or .ply file, or a folder");
+  throw InputError(file, "not a scan source saloam reads: expected a ROS 1 bag (.bag), a packet capture (.pcap), a .pcd or .ply "
+                           "file, or a folder");
 }
 
 ScanFormat detect_folder(const fs::path& folder) {
@@ -103,6 +108,7 @@ std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptio
     case ScanFormat::kPcd:
     case ScanFormat::kPly: return std::make_unique<PointCloudFolder>(path, format, options);
     case ScanFormat::kRosbag: return std::make_unique<RosbagSource>(path, options);
+    case ScanFormat::kPcap: return std::make_unique<PcapSource>(path, options);
     case ScanFormat::kAuto: break;
   }
   throw InputError(path, "no scan format");

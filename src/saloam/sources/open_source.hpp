@@ -9,6 +9,7 @@
 //              kitti-raw      KittiRawDrive        (sources/kitti_raw_drive.hpp)
 //              pcd, ply       PointCloudFolder     (sources/point_cloud_folder.hpp)
 //              rosbag         RosbagSource         (sources/rosbag_source.hpp)
+//              pcap           PcapSource           (sources/pcap_source.hpp)
 //   stages   the frame range (--frames A:B, FrameRangeSource), then the
 //            segmentation (--segment: labels from a network, SegmentedSource)
 // A new reader is one more case in open_reader() (and in detect_scan_format
@@ -31,7 +32,8 @@
 namespace saloam {
 
 /// The format of `path` by what it holds: a file starting with the bag magic
-/// "#ROSBAG V2.0" or named *.bag: rosbag; a .pcd or .ply file: that format;
+/// "#ROSBAG V2.0" or named *.bag: rosbag; a file starting with a pcap or
+/// pcapng magic number, or named *.pcap / *.pcapng: pcap; a .pcd or .ply file: that format;
 /// a folder with velodyne/: semantickitti; with velodyne_points/data:
 /// kitti-raw; with .pcd or .ply files: that format. InputError naming the
 /// path and listing what was looked for when nothing matches (or both .pcd

@@ -10,6 +10,8 @@
 //   kitti-raw      DRIVE/velodyne_points/data/*.bin + timestamps, oxts/ (GPS/INS reference)
 //   pcd, ply       a folder of .pcd or .ply files (or one file), ordered by name
 //   rosbag         a ROS 1 bag's sensor_msgs/PointCloud2 messages on one topic
+//   pcap           a sensor's packet capture: Ouster (with its metadata JSON)
+//                  or Velodyne VLP-16 / HDL-32E / HDL-64E (sources/pcap_source.hpp)
 //   auto           detected from the path (detect_scan_format)
 
 #include <filesystem>
@@ -23,9 +25,9 @@
 
 namespace saloam {
 
-enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag };
+enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag, kPcap };
 
-/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag".
+/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "pcap".
 [[nodiscard]] std::string_view format_name(ScanFormat format);
 /// The format of a --format value, nullopt for an unknown name.
 [[nodiscard]] std::optional<ScanFormat> scan_format_from_name(std::string_view name);
@@ -36,6 +38,9 @@ struct SourceOptions {
   ScanFormat format = ScanFormat::kAuto;  ///< --format
   /// --topic: the bag topic to read; empty: the only PointCloud2 topic of the bag.
   std::string topic;
+  /// --metadata: an Ouster capture's metadata JSON, or a Velodyne
+  /// calibration YAML; none: looked for beside the capture (pcap_source.hpp).
+  std::optional<std::filesystem::path> metadata;
   /// --labels: .label files from this folder (named like the scans) instead
   /// of the source's own labels/.
   std::optional<std::filesystem::path> labels;
