@@ -46,7 +46,9 @@ TEST(PcapSource, ReadsTheRealOusterCaptures) {
       EXPECT_LE(peak, 1.0F);
       EXPECT_GT(peak, 0.2F);
     }
-    if (frames == 3) EXPECT_NEAR(source->info().times[2] - source->info().times[0], 0.2, 1e-3);
+    if (frames == 3) {
+      EXPECT_NEAR(source->info().times[2] - source->info().times[0], 0.2, 1e-3);
+    }
   }
 }
 
