@@ -71,7 +71,10 @@ TEST(PcapCli, ASimulatedVelodyneCaptureGivesTheFoldersPoses) {
   expect_has(output, "frames:      20");
   expect_has(output, "sensor: Velodyne HDL-64E");
   expect_has(output, "velodyne.yaml");
-  ASSERT_EQ(run_command(saloam_cmd("odom " + quoted(dir / "seq") + " --no-calib --out " + quoted(dir / "a")), &output), 0)
+  // A capture holds no labels: the folder's run leaves its labels out too.
+  ASSERT_EQ(run_command(saloam_cmd("odom " + quoted(dir / "seq") + " --no-calib --no-semantics --out " + quoted(dir / "a")),
+                        &output),
+            0)
       << output;
   ASSERT_EQ(run_command(saloam_cmd("odom " + quoted(capture) + " --out " + quoted(dir / "b")), &output), 0) << output;
   const auto a = read_tum_trajectory(dir / "a" / "poses_tum.txt");
@@ -84,7 +87,8 @@ TEST(PcapCli, ASimulatedVelodyneCaptureGivesTheFoldersPoses) {
     rotation = std::max(rotation, Eigen::AngleAxisd(d.rotation()).angle());
   }
   std::cout << "folder against capture: up to " << translation * 100 << " cm, " << rotation * 180 / 3.14159265 << " deg\n";
-  EXPECT_LT(translation, 0.01);
+  // Measured: 0.9 cm and 0.03 deg at most over the 20 frames (14 m), from the 2 mm and 0.01 deg rounding alone.
+  EXPECT_LT(translation, 0.015);
   EXPECT_LT(rotation, 0.05 * 3.14159265 / 180);
 }
 
