@@ -158,3 +158,28 @@ TEST(VelodyneFrames, SweepsEndBehindTheSensor) {
 
 }  // namespace
 }  // namespace saloam
+
+namespace saloam {
+namespace {
+
+TEST(VelodyneFrames, GapsInTheTimestampsCountAsMissingPackets) {
+  VelodyneCalibration calibration;
+  calibration.lasers.resize(64);
+  for (const bool hdl64e : {false, true}) {
+    SCOPED_TRACE(hdl64e ? "HDL-64E" : "HDL-32E");
+    const VelodyneModel model = hdl64e ? VelodyneModel::kHdl64e : VelodyneModel::kHdl32e;
+    VelodyneFrameAssembler assembler(
+        hdl64e ? VelodyneDecoder(model, calibration) : VelodyneDecoder(model, *nominal_velodyne_calibration(model)));
+    const double period_us = hdl64e ? 6 * 48.0 : 12 * 46.08;  // a packet's span
+    std::vector<VelodyneFrame> frames;
+    for (int p = 0; p < 10; ++p) {
+      if (p == 4 || p == 7 || p == 8) continue;  // three packets lost
+      const auto stamp = static_cast<std::uint32_t>(std::lround(p * period_us));
+      assembler.add(encode_velodyne_packet(model, firings(100 * p, 5, 1000, hdl64e), stamp), frames);
+    }
+    EXPECT_EQ(assembler.missing_packets(), 3U);
+  }
+}
+
+}  // namespace
+}  // namespace saloam

@@ -26,7 +26,7 @@ constexpr std::array<std::pair<OusterProfile, std::string_view>, 6> kProfiles{{
     {OusterProfile::kFusaRng15Rfl8Nir8Dual, "FUSA_RNG15_RFL8_NIR8_DUAL"},
 }};
 
-constexpr std::uint32_t kMaxColumns = 16384;
+constexpr std::uint32_t kMaxColumns = 4096;  // the widest mode is 4096x5
 constexpr std::uint32_t kMaxColumnsPerPacket = 64;
 constexpr std::uint32_t kMaxPixels = 256;
 

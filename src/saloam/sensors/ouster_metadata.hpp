@@ -76,7 +76,7 @@ struct OusterMetadata {
 /// text that is not JSON, a missing or mistyped key the decoder needs,
 /// beam angle or pixel shift lists of another length than
 /// pixels_per_column, an unknown udp_profile_lidar, or sizes out of range
-/// (columns_per_frame 1..16384, a multiple of columns_per_packet 1..64;
+/// (columns_per_frame 1..4096, a multiple of columns_per_packet 1..64;
 /// pixels_per_column 1..256).
 OusterMetadata parse_ouster_metadata(std::string_view json_text, const std::filesystem::path& file);
 

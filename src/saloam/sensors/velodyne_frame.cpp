@@ -25,10 +25,9 @@ double VelodyneFrameAssembler::unwrap_us(std::uint32_t t) {
 }
 
 void VelodyneFrameAssembler::count_gap(double packet_us, bool dual) {
-  const std::size_t firings = dual ? kBlocks / 2 : kBlocks;
-  const double period = velodyne_block_offset_us(decoder_.model(), decoder_.model() == VelodyneModel::kHdl64e
-                                                                         ? 2 * firings
-                                                                         : firings);
+  // A packet's span: 12 blocks (6 upper/lower pairs on the HDL-64E), 6 firings in dual mode.
+  const std::size_t blocks = decoder_.model() == VelodyneModel::kHdl64e ? kBlocks : (dual ? kBlocks / 2 : kBlocks);
+  const double period = velodyne_block_offset_us(decoder_.model(), blocks);
   if (last_packet_us_ && period > 0 && packet_us - *last_packet_us_ > 1.5 * period) {
     missing_packets_ += static_cast<std::size_t>(std::lround((packet_us - *last_packet_us_) / period)) - 1;
   }

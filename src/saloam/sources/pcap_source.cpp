@@ -289,6 +289,10 @@ std::optional<fs::path> find_capture_metadata(const fs::path& capture, const std
 
 PcapSource::PcapSource(fs::path capture, const SourceOptions& options)
     : capture_(std::move(capture)), reader_(std::make_unique<PcapReader>(capture_)) {
+  if (options.labels && !options.ignore_labels) {
+    throw InputError(*options.labels, "labels cannot be paired with the points of a packet capture (which come in "
+                                      "no stored order): label it with --segment");
+  }
   const auto metadata = find_capture_metadata(capture_, options.metadata);
   if (metadata && is_json(*metadata)) {
     decoder_ = std::make_unique<OusterDecoder>(*metadata, read_ouster_metadata(*metadata));

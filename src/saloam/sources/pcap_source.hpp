@@ -80,7 +80,9 @@ class CaptureDecoder {
 class PcapSource final : public FrameSource {
  public:
   /// InputError naming the capture (or the metadata file) when it cannot be
-  /// read, holds no frame, or its sensor cannot be told.
+  /// read, holds no frame, or its sensor cannot be told; naming the labels
+  /// folder when SourceOptions::labels is given (a capture's points have no
+  /// file order to pair labels with).
   PcapSource(std::filesystem::path capture, const SourceOptions& options);
   ~PcapSource() override;
 
