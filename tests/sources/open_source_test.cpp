@@ -83,7 +83,8 @@ TEST(OpenSource, NamesTheFormatAndPicksTheReader) {
   EXPECT_EQ(scan_format_from_name("kitti-raw"), ScanFormat::kKittiRaw);
   EXPECT_FALSE(scan_format_from_name("las").has_value());
   EXPECT_EQ(format_name(ScanFormat::kRosbag), "rosbag");
-  EXPECT_EQ(scan_format_names().size(), 6u);
+  EXPECT_EQ(format_name(ScanFormat::kPcap), "pcap");
+  EXPECT_EQ(scan_format_names().size(), 7u);
 }
 
 }  // namespace

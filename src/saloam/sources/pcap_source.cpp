@@ -30,13 +30,18 @@ class OusterDecoder final : public CaptureDecoder {
       assembler_.add(d.payload, scans_);  // counted as a bad packet
       return;
     }
+    // Where the packets of each open frame lie (one entry per frame being filled).
     const std::uint32_t id = assembler_.format().frame_id(d.payload);
-    if (const auto it = spans_.find(id); it != spans_.end()) {
-      it->second.last = d.offset;
-    } else {
+    const auto it = spans_.find(id);
+    const bool fresh = it == spans_.end();
+    if (fresh) {
       spans_.emplace(id, Span{d.offset, d.offset, d.time});
+    } else {
+      it->second.last = d.offset;
     }
+    const std::size_t dropped = assembler_.dropped_packets();
     assembler_.add(d.payload, scans_);
+    if (fresh && assembler_.dropped_packets() > dropped) spans_.erase(id);  // a late packet opens no frame
     take_indexed(done);
   }
 
@@ -103,7 +108,11 @@ class OusterDecoder final : public CaptureDecoder {
     for (const auto& scan : scans_) {
       const auto span = spans_.find(scan.frame_id);
       const auto t0 = scan.first_valid_timestamp();
-      if (span == spans_.end() || !t0) continue;
+      if (span == spans_.end()) continue;
+      if (!t0) {  // no valid column: no frame
+        spans_.erase(span);
+        continue;
+      }
       ++frames_;
       const std::size_t expected = window_columns();
       if (scan.valid_columns < expected) {
