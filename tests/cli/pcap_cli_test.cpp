@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "cli_fixture.hpp"
+#include "sensors/ouster_pcaps.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/io/trajectory_io.hpp"
 
@@ -19,6 +20,7 @@ using testing::TempDir;
 
 TEST(PcapCli, InfoDescribesAnOusterCapture) {
   SALOAM_REQUIRE_SHARED_DATA();
+  SALOAM_REQUIRE_OUSTER_PCAPS();
   const auto folder = testing::shared_file("data/ouster_pcaps");
   std::string output;
   ASSERT_EQ(run_command(saloam_cmd("info " + quoted(folder / "OS-1-128_v2.3.0_1024x10_lb_n3.pcap")), &output), 0)
@@ -43,6 +45,7 @@ TEST(PcapCli, InfoDescribesAnOusterCapture) {
 
 TEST(PcapCli, OdometryOnTheRealOusterCaptureFollowsItsReference) {
   SALOAM_REQUIRE_SHARED_DATA();
+  SALOAM_REQUIRE_OUSTER_PCAPS();
   const auto folder = testing::shared_file("data/ouster_pcaps");
   TempDir dir;
   std::string output;

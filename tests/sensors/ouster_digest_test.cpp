@@ -20,6 +20,7 @@
 #include "md5.hpp"
 #include "saloam/sensors/ouster_frame.hpp"
 #include "saloam/sensors/pcap_reader.hpp"
+#include "sensors/ouster_pcaps.hpp"
 #include "testing/test_support.hpp"
 
 namespace saloam {
@@ -118,6 +119,7 @@ nlohmann::json read_json(const std::filesystem::path& file) {
 
 TEST(OusterDigest, ReproducesTheManufacturersDigests) {
   SALOAM_REQUIRE_SHARED_DATA();
+  SALOAM_REQUIRE_OUSTER_PCAPS();
   const std::vector<std::string> captures{"OS-0-32-U1_v2.2.0_1024x10", "OS-0-128-U1_v2.3.0_1024x10",
                                           "OS-1-32-G_v2.1.1_1024x10"};
   for (const auto& name : captures) {

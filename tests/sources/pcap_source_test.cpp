@@ -15,6 +15,7 @@
 #include "saloam/sources/open_source.hpp"
 #include "saloam/sources/pcap_source.hpp"
 #include "saloam/sources/velodyne_capture_writer.hpp"
+#include "sensors/ouster_pcaps.hpp"
 #include "testing/test_support.hpp"
 
 namespace saloam {
@@ -24,6 +25,7 @@ constexpr double kDeg = 180.0 / std::numbers::pi;
 
 TEST(PcapSource, ReadsTheRealOusterCaptures) {
   SALOAM_REQUIRE_SHARED_DATA();
+  SALOAM_REQUIRE_OUSTER_PCAPS();
   const auto folder = testing::shared_file("data/ouster_pcaps");
   const std::vector<std::pair<std::string, std::size_t>> captures{
       {"OS-0-32-U1_v2.2.0_1024x10", 1},     {"OS-0-128-U1_v2.3.0_1024x10", 1},
@@ -54,6 +56,7 @@ TEST(PcapSource, ReadsTheRealOusterCaptures) {
 
 TEST(PcapSource, AnOusterCaptureWithoutMetadataSaysWhatItNeeds) {
   SALOAM_REQUIRE_SHARED_DATA();
+  SALOAM_REQUIRE_OUSTER_PCAPS();
   testing::TempDir dir;
   const auto capture = dir / "os.pcap";
   std::filesystem::copy_file(testing::shared_file("data/ouster_pcaps/OS-1-32-G_v2.1.1_1024x10.pcap"), capture);
