@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "fuzz_support.hpp"
 #include "saloam/sensors/ouster_frame.hpp"
@@ -45,7 +47,8 @@ void check_frame(const saloam::OusterScan& scan, const saloam::OusterXyzLut& lut
   const auto cloud = saloam::ouster_cloud(scan, lut, scan.first_valid_timestamp().value_or(0), 255.0F);
   SALOAM_FUZZ_CHECK(cloud.has_rings() || cloud.empty());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    SALOAM_FUZZ_CHECK(cloud.points[i].allFinite() && cloud.points[i].norm() < 600.0F);  // 19-bit ranges: < 524 m
+    // LEGACY's 20-bit ranges reach 1048.575 m (19 bits: 524 m; 15 bits << 3: 262 m).
+    SALOAM_FUZZ_CHECK(cloud.points[i].allFinite() && cloud.points[i].norm() < 1100.0F);
     SALOAM_FUZZ_CHECK(cloud.ring[i] < scan.height && cloud.remission[i] >= 0.0F && cloud.remission[i] <= 1.0F);
   }
 }
@@ -68,14 +71,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     return 0;
   }
-  static OusterMetadata cached[12];
-  static bool made = false;
-  if (!made) {
-    for (std::uint8_t i = 0; i < 12; ++i) cached[i] = metadata(i);
-    made = true;
+  // The 12 formats and their XYZ lookups, made once (a 1024 x 128 lookup takes longer than decoding).
+  static std::vector<std::pair<OusterMetadata, OusterXyzLut>> formats;
+  if (formats.empty()) {
+    for (std::uint8_t i = 0; i < 12; ++i) {
+      OusterMetadata m = metadata(i);
+      OusterXyzLut lut(m);
+      formats.emplace_back(std::move(m), std::move(lut));
+    }
   }
-  const OusterMetadata& m = cached[data[0] % 12];
-  const OusterXyzLut lut(m);
+  const auto& [m, lut] = formats[data[0] % 12];
   OusterFrameAssembler assembler(m);
   std::vector<OusterScan> frames;
   for (std::size_t at = 1; at + 2 <= size;) {
