@@ -22,12 +22,14 @@ BUILD_DIR="${FUZZ_BUILD_DIR:-build-fuzz}"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-malloc_context_size=0:quarantine_size_mb=16}"
 
 # Largest input per harness: a few hundred points, lines or nodes reach every
-# check; .sgw needs room for a whole SGPR model (196426 bytes).
+# check; .sgw needs room for a whole SGPR model (196426 bytes), ouster_packet
+# for two 32-pixel packets or one 128-pixel one (up to 16640 bytes).
 declare -A MAX_LEN=(
   [scan]=4096 [label]=1024 [kitti_poses]=4096 [tum_poses]=4096 [calib]=8192
   [times]=2048 [sgw]=200000 [graph_json]=8192 [config]=8192 [segmenter_spec]=4096 [sensor_profile]=4096
   [pcd]=4096 [ply]=4096 [pointcloud2]=4096 [kitti_raw]=2048 [rosbag]=16384 [map]=8192
   [pointcloud2_cdr]=4096 [mcap]=16384 [rosbag2]=32768
+  [ouster_packet]=20000 [velodyne_packet]=8192
 )
 
 build() {

@@ -14,6 +14,7 @@ packages=(
   liblzf-dev  # binary_compressed PCD (optional: without it such files are an error that says so)
   librosbag-storage-dev  # ROS 1 bags (optional: without it bags are an error that says so)
   libsqlite3-dev libzstd-dev liblz4-dev  # ROS 2 recordings: rosbag2 .db3 (SQLite) and MCAP chunks (zstd, LZ4)
+  libpcap-dev  # sensor packet captures (.pcap: Ouster, Velodyne)
 )
 
 missing=()

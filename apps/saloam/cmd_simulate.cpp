@@ -1,7 +1,8 @@
 // `saloam simulate`: write a synthetic sequence (HDL-64E sweeps, or those of
 // a sensor profile, ray cast in a procedural street world along a preset or
 // KITTI trajectory): a SemanticKITTI folder, or with --format any layout
-// saloam reads (PCD, PLY and bags keep each point's ring and time).
+// saloam reads (PCD, PLY and bags keep each point's ring and time), or a
+// Velodyne packet capture.
 
 #include <cctype>
 #include <iostream>
@@ -20,6 +21,7 @@
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sim/trajectories.hpp"
 #include "saloam/sources/sequence_writer.hpp"
+#include "saloam/sources/velodyne_capture_writer.hpp"
 
 namespace saloam::cli {
 namespace {
@@ -101,6 +103,26 @@ int write_in_layout(const SimulationOptions& options, const SimulateArgs& args) 
   return 0;
 }
 
+/// The simulated frames as a Velodyne packet capture, OUT/velodyne.pcap
+/// with its calibration OUT/velodyne.yaml (sources/velodyne_capture_writer.hpp).
+int write_velodyne_pcap(const SimulationOptions& options, const SimulateArgs& args) {
+  const SimulatedSequence sequence(options);
+  SimulatedSource source(sequence);
+  const LidarModel& lidar = sequence.lidar();
+  const std::filesystem::path folder(args.out);
+  std::error_code ec;
+  if (std::filesystem::exists(folder, ec) && !std::filesystem::is_empty(folder, ec)) {
+    throw InputError(folder, "exists and is not empty: a capture is written into a new or empty folder");
+  }
+  std::filesystem::create_directories(folder);
+  const auto capture = folder / "velodyne.pcap";
+  write_velodyne_capture(source, {lidar.elevation_deg, lidar.azimuth_steps, lidar.sweep_period}, capture);
+  std::cout << fmt::format("wrote {} frames as a Velodyne {} capture to {} (calibration velodyne.yaml beside it)\n",
+                           source.frames_rendered(), velodyne_model_name(velodyne_model_for(lidar.beams())),
+                           capture.string());
+  return 0;
+}
+
 int run_simulate(const SimulateArgs& args) {
   PathRules()
       .input("--trajectory", args.trajectory)
@@ -120,6 +142,7 @@ int run_simulate(const SimulateArgs& args) {
   spdlog::info("simulating {} ({}, seed {}, skew {}, labels {}) into {}", source,
                options.sensor ? options.sensor->title() : fmt::format("{} beams of the HDL-64E", options.beams),
                options.seed, options.skew ? "on" : "off", options.labels == LabelMode::kNoisy ? "noisy" : "gt", args.out);
+  if (args.format == "velodyne-pcap") return write_velodyne_pcap(options, args);
   if (args.format != "semantickitti") return write_in_layout(options, args);
   const SimulationSummary s = simulate_sequence(options, args.out);
   if (args.stats) std::cout << "ground-truth class shares:\n" << format_class_shares(s.shares);
@@ -175,9 +198,10 @@ const CommandRegistration kRegistration{Command{
                      "Sensor profile to render: hdl64e, hdl32e, vlp16, os1-64, os1-128 (config/sensors/) or a profile "
                      "file; default the HDL-64E (--beams)");
       app.add_option("--format", args->format,
-                     "Layout to write: semantickitti (default), pcd, ply, kitti-raw, rosbag, rosbag2, mcap (PCD, PLY and bags keep each "
-                     "point's ring and time)")
-          ->check(CLI::IsMember({"semantickitti", "pcd", "ply", "kitti-raw", "rosbag", "rosbag2", "mcap"}));
+                     "Layout to write: semantickitti (default), pcd, ply, kitti-raw, rosbag, rosbag2, mcap (PCD, PLY and "
+                     "bags keep each point's ring and time), velodyne-pcap (OUT/velodyne.pcap: the sensor's packets, "
+                     "VLP-16, HDL-32E or HDL-64E by the lasers, with OUT/velodyne.yaml, its calibration)")
+          ->check(CLI::IsMember({"semantickitti", "pcd", "ply", "kitti-raw", "rosbag", "rosbag2", "mcap", "velodyne-pcap"}));
       app.add_option("--azimuth-steps", args->sim.azimuth_steps,
                      "Columns per turn (HDL-64E: about 2083; with --sensor the profile's)")
           ->check(CLI::Range(16, 8000))

@@ -228,13 +228,18 @@ std::optional<SegmentationStageOptions> SegmentOptions::stage(const SaloamConfig
 }
 
 void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
-  app.add_option("SEQ_DIR", path, path_help + "; or a KITTI raw drive, a folder of .pcd/.ply files, a ROS 1 bag, a ROS 2 bag (folder or .db3), an .mcap file")
+  app.add_option("SEQ_DIR", path,
+                 path_help + "; or a KITTI raw drive, a folder of .pcd/.ply files, a ROS 1 bag, a ROS 2 bag (folder or "
+                             ".db3), an .mcap file, a sensor's .pcap capture")
       ->required();
   app.add_option("--format", format,
-                 "Layout of SEQ_DIR: auto (detected), semantickitti, kitti-raw, pcd, ply, rosbag, rosbag2, mcap")
+                 "Layout of SEQ_DIR: auto (detected), semantickitti, kitti-raw, pcd, ply, rosbag, rosbag2, mcap, pcap")
       ->check(CLI::IsMember(scan_format_names()))
       ->capture_default_str();
   app.add_option("--topic", topic, "ROS 1/2 bag or MCAP topic of sensor_msgs/PointCloud2 (default: the only one)");
+  app.add_option("--metadata", metadata,
+                 "A capture's sensor metadata: Ouster's metadata JSON, or a Velodyne calibration YAML "
+                 "(velodyne_pointcloud's; default: NAME.json / NAME.yaml beside NAME.pcap)");
   app.add_option("--sensor", sensor,
                  "Sensor profile: auto (guessed from the first scan), none, a shipped one (hdl64e, hdl32e, vlp16, os1-64, "
                  "os1-128: config/sensors/) or a profile file")
@@ -261,6 +266,7 @@ SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
   if (!format) throw ConfigError(fmt::format("--format {}: not one of {}", args.format, fmt::join(scan_format_names(), ", ")));
   options.format = *format;
   options.topic = args.topic;
+  if (!args.metadata.empty()) options.metadata = args.metadata;
   options.intensity_scale = parse_intensity_scale(args.intensity_scale);
   if (!args.labels.empty()) options.labels = args.labels;
   options.ignore_labels = ignore_labels;
@@ -271,7 +277,7 @@ SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
 }  // namespace
 
 PathRules& SourceArgs::add_inputs(PathRules& rules) const {
-  return rules.input("SEQ_DIR", path).input("--labels", labels);
+  return rules.input("SEQ_DIR", path).input("--labels", labels).input("--metadata", metadata);
 }
 
 std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& config, SensorChoice* chosen) const {

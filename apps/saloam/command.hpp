@@ -67,7 +67,7 @@ struct SegmentOptions {
 
 /// The options that choose a run's frames, shared by the commands that read
 /// a source (odom, slam, place-eval, bench, info, convert, segment): SEQ_DIR
-/// (any layout of sources/source_options.hpp), --format, --topic, --sensor,
+/// (any layout of sources/source_options.hpp), --format, --topic, --metadata, --sensor,
 /// --intensity-scale, --labels, --frames and the segmentation's options;
 /// commands where calibration matters add --no-calib (add_no_calib_flag).
 /// Call `open()` after parsing.
@@ -96,6 +96,7 @@ struct SourceArgs {
   std::string format = "auto";
   std::string sensor = "auto";
   std::string topic;
+  std::string metadata;  ///< --metadata: a capture's Ouster JSON or Velodyne calibration YAML
   std::string intensity_scale = "auto";
   std::string labels;
   std::string frames;

@@ -84,7 +84,8 @@ TEST(OpenSource, NamesTheFormatAndPicksTheReader) {
   EXPECT_FALSE(scan_format_from_name("las").has_value());
   EXPECT_EQ(format_name(ScanFormat::kRosbag), "rosbag");
   EXPECT_EQ(format_name(ScanFormat::kMcap), "mcap");
-  EXPECT_EQ(scan_format_names().size(), 8u);
+  EXPECT_EQ(format_name(ScanFormat::kPcap), "pcap");
+  EXPECT_EQ(scan_format_names().size(), 9u);
 }
 
 }  // namespace

@@ -3,7 +3,7 @@
 // evaluation, bench, demo) reads its frames through one FrameSource: a
 // reader of recorded data (SequenceFolderSource here: a SemanticKITTI folder;
 // the other layouts' readers in sources/: KITTI raw drives, PCD and PLY
-// folders, ROS bags), the simulator rendering in memory (SimulatedSource,
+// folders, ROS bags, sensor packet captures), the simulator rendering in memory (SimulatedSource,
 // sim/), or a stage that wraps another source and changes what it serves
 // (FrameRangeSource below).
 // Runs see only this interface; sources/open_source.hpp picks the reader for
@@ -60,7 +60,7 @@ struct SourceInfo {
   /// Frame i is the folder's (or the recording's) frame first_frame + i (after `--frames A:B`: A).
   std::size_t first_frame = 0;
   /// The layout read, as --format names it ("semantickitti", "kitti-raw",
-  /// "pcd", "ply", "rosbag", "rosbag2", "mcap"), or "simulated".
+  /// "pcd", "ply", "rosbag", "rosbag2", "mcap", "pcap"), or "simulated".
   std::string format;
   /// The point fields of the scans as the source names them ("x y z
   /// intensity ring t"; KITTI .bin scans: "x y z remission"), from the first

@@ -143,6 +143,8 @@ class SimulatedSequence {
   [[nodiscard]] SimulatedFrame render(std::size_t k) const;
 
   [[nodiscard]] const Pose& velo_to_cam() const { return velo_to_cam_; }
+  /// The sensor the sweeps are rendered with.
+  [[nodiscard]] const LidarModel& lidar() const { return lidar_; }
   [[nodiscard]] const std::vector<Pose>& camera_poses() const { return camera_poses_; }  ///< poses.txt
   [[nodiscard]] const std::vector<double>& times() const { return times_; }              ///< times.txt [s]
   /// LiDAR pose of the first frame in the world frame (the frame of the

@@ -8,7 +8,9 @@
 #include "saloam/core/error.hpp"
 #include "saloam/io/mcap.hpp"
 #include "saloam/io/sequence_source.hpp"
+#include "saloam/sensors/pcap_reader.hpp"
 #include "saloam/sources/kitti_raw_drive.hpp"
+#include "saloam/sources/pcap_source.hpp"
 #include "saloam/sources/point_cloud_folder.hpp"
 #include "saloam/sources/ros2_bag_source.hpp"
 #include "saloam/sources/rosbag_source.hpp"
@@ -19,14 +21,15 @@ namespace fs = std::filesystem;
 namespace saloam {
 namespace {
 
-constexpr std::array<std::pair<ScanFormat, std::string_view>, 8> kNames{{{ScanFormat::kAuto, "auto"},
+constexpr std::array<std::pair<ScanFormat, std::string_view>, 9> kNames{{{ScanFormat::kAuto, "auto"},
                                                                         {ScanFormat::kSemanticKitti, "semantickitti"},
                                                                         {ScanFormat::kKittiRaw, "kitti-raw"},
                                                                         {ScanFormat::kPcd, "pcd"},
                                                                         {ScanFormat::kPly, "ply"},
                                                                         {ScanFormat::kRosbag, "rosbag"},
                                                                         {ScanFormat::kRosbag2, "rosbag2"},
-                                                                        {ScanFormat::kMcap, "mcap"}}};
+                                                                        {ScanFormat::kMcap, "mcap"},
+                                                                        {ScanFormat::kPcap, "pcap"}}};
 
 bool starts_with(const fs::path& file, std::string_view magic) {
   std::ifstream in(file, std::ios::binary);
@@ -39,10 +42,11 @@ ScanFormat detect_file(const fs::path& file) {
   if (starts_with(file, kRosbagMagic) || ext == ".bag") return ScanFormat::kRosbag;
   if (starts_with(file, kMcapMagic) || ext == ".mcap") return ScanFormat::kMcap;
   if (starts_with(file, kSqliteMagic) || ext == ".db3") return ScanFormat::kRosbag2;
+  if (has_pcap_magic(file) || ext == ".pcap" || ext == ".pcapng") return ScanFormat::kPcap;
   if (ext == ".pcd") return ScanFormat::kPcd;
   if (ext == ".ply") return ScanFormat::kPly;
   throw InputError(file, "not a scan source saloam reads: expected a ROS 1 bag (.bag), an MCAP file (.mcap), a rosbag2 "
-                         "database (.db3), a .pcd or .ply file, or a folder");
+                         "database (.db3), a packet capture (.pcap), a .pcd or .ply file, or a folder");
 }
 
 ScanFormat detect_folder(const fs::path& folder) {
@@ -113,6 +117,7 @@ std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptio
     case ScanFormat::kRosbag: return std::make_unique<RosbagSource>(path, options);
     case ScanFormat::kRosbag2:
     case ScanFormat::kMcap: return std::make_unique<Ros2BagSource>(path, format, options);
+    case ScanFormat::kPcap: return std::make_unique<PcapSource>(path, options);
     case ScanFormat::kAuto: break;
   }
   throw InputError(path, "no scan format");

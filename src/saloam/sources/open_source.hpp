@@ -10,6 +10,7 @@
 //              pcd, ply       PointCloudFolder     (sources/point_cloud_folder.hpp)
 //              rosbag         RosbagSource         (sources/rosbag_source.hpp)
 //              rosbag2, mcap  Ros2BagSource        (sources/ros2_bag_source.hpp)
+//              pcap           PcapSource           (sources/pcap_source.hpp)
 //   stages   the frame range (--frames A:B, FrameRangeSource), then the
 //            segmentation (--segment: labels from a network, SegmentedSource)
 // A new reader is one more case in open_reader() (and in detect_scan_format
@@ -33,9 +34,10 @@ namespace saloam {
 
 /// The format of `path` by what it holds: a file starting with the bag magic
 /// "#ROSBAG V2.0" or named *.bag: rosbag; starting with the MCAP magic or
-/// named *.mcap: mcap; an SQLite file or *.db3: rosbag2; a .pcd or .ply file:
-/// that format; a folder with velodyne/: semantickitti; with metadata.yaml:
-/// rosbag2; with velodyne_points/data:
+/// named *.mcap: mcap; an SQLite file or *.db3: rosbag2; a file starting
+/// with a pcap or pcapng magic number, or named *.pcap / *.pcapng: pcap; a
+/// .pcd or .ply file: that format; a folder with velodyne/: semantickitti;
+/// with metadata.yaml: rosbag2; with velodyne_points/data:
 /// kitti-raw; with .pcd or .ply files: that format. InputError naming the
 /// path and listing what was looked for when nothing matches (or both .pcd
 /// and .ply files lie in one folder).

@@ -13,6 +13,8 @@
 //   rosbag2        a ROS 2 bag's: a folder with metadata.yaml and .db3 (or
 //                  .mcap) files, or one .db3 file
 //   mcap           an MCAP file's (ROS 2 messages, CDR)
+//   pcap           a sensor's packet capture: Ouster (with its metadata JSON)
+//                  or Velodyne VLP-16 / HDL-32E / HDL-64E (sources/pcap_source.hpp)
 //   auto           detected from the path (detect_scan_format)
 
 #include <filesystem>
@@ -26,9 +28,9 @@
 
 namespace saloam {
 
-enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag, kRosbag2, kMcap };
+enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag, kRosbag2, kMcap, kPcap };
 
-/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "rosbag2", "mcap".
+/// "auto", "semantickitti", "kitti-raw", "pcd", "ply", "rosbag", "rosbag2", "mcap", "pcap".
 [[nodiscard]] std::string_view format_name(ScanFormat format);
 /// The format of a --format value, nullopt for an unknown name.
 [[nodiscard]] std::optional<ScanFormat> scan_format_from_name(std::string_view name);
@@ -39,6 +41,9 @@ struct SourceOptions {
   ScanFormat format = ScanFormat::kAuto;  ///< --format
   /// --topic: the bag topic to read; empty: the only PointCloud2 topic of the bag.
   std::string topic;
+  /// --metadata: an Ouster capture's metadata JSON, or a Velodyne
+  /// calibration YAML; none: looked for beside the capture (pcap_source.hpp).
+  std::optional<std::filesystem::path> metadata;
   /// --labels: .label files from this folder (named like the scans) instead
   /// of the source's own labels/.
   std::optional<std::filesystem::path> labels;
