@@ -13,6 +13,8 @@ packages=(
   libtorch-dev  # saloam sgpr-train (optional: without it the rest builds and the trainer is left out)
   liblzf-dev  # binary_compressed PCD (optional: without it such files are an error that says so)
   librosbag-storage-dev  # ROS 1 bags (optional: without it bags are an error that says so)
+  pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module `import saloam` and its tests (python/)
+  python3-dask python3-distributed  # saloam fleet: fleet mapping on Dask (docs/fleet.md)
 )
 
 missing=()
