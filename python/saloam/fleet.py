@@ -21,6 +21,7 @@ import argparse
 import ctypes
 import json
 import os
+import resource
 import shutil
 import signal
 import subprocess
@@ -39,10 +40,19 @@ def _die_with_parent():
         pass
 
 
+def _cpu_seconds():
+    """CPU time of this process's finished children (a worker runs one task at a time: its task's)."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
 def run_saloam(args, program=None):
     """Runs `saloam ARGS...` and returns its output; RuntimeError with it when it fails."""
     command = [program or cli_path(), "-q", *[str(a) for a in args]]
-    done = subprocess.run(command, capture_output=True, text=True, preexec_fn=_die_with_parent)
+    # Dask's workers set MALLOC_TRIM_THRESHOLD_ for their own heap; in the
+    # program it made the SLAM 30-60 % slower (docs/fleet.md).
+    env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+    done = subprocess.run(command, capture_output=True, text=True, preexec_fn=_die_with_parent, env=env)
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} failed ({done.returncode}):\n{done.stderr}{done.stdout}")
     return done.stdout
@@ -60,7 +70,7 @@ def _put_in_place(attempt, final):
 
 def slam_drive(index, drive, work, program=None, options=()):
     """Task: `saloam slam DRIVE --save-map`; returns what the summary needs."""
-    start = time.time()
+    start, cpu = time.time(), _cpu_seconds()
     final_out, final_map = os.path.join(work, f"slam_{index:03d}"), os.path.join(work, f"map_{index:03d}")
     if not os.path.isdir(final_map):
         token = uuid.uuid4().hex[:8]
@@ -72,18 +82,19 @@ def slam_drive(index, drive, work, program=None, options=()):
         summary = json.load(f)
     return {"drive": os.path.abspath(drive), "map": final_map, "drives": [index], "start": start, "end": time.time(),
             "frames": summary.get("frames"), "keyframes": summary.get("keyframes"),
-            "loops_accepted": summary.get("loops_accepted"), "host": os.uname().nodename}
+            "loops_accepted": summary.get("loops_accepted"), "host": os.uname().nodename,
+            "cpu_s": round(_cpu_seconds() - cpu, 3)}
 
 
 def merge_pair(a, b, out, program=None, options=()):
     """Task: `saloam merge A B --out OUT` (A's frame); returns the merged map and its drives."""
-    start = time.time()
+    start, cpu = time.time(), _cpu_seconds()
     if not os.path.isdir(out):
         attempt = f"{out}.{uuid.uuid4().hex[:8]}.part"
         run_saloam(["merge", a["map"], b["map"], "--out", attempt, *options], program)
         _put_in_place(attempt, out)
     return {"map": out, "drives": a["drives"] + b["drives"], "start": start, "end": time.time(),
-            "merged": [a["map"], b["map"]]}
+            "merged": [a["map"], b["map"]], "cpu_s": round(_cpu_seconds() - cpu, 3)}
 
 
 def simulate_drive(index, out, preset, passes, beams, seed, program=None):
@@ -201,13 +212,14 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
               for d, s in zip(final["drives"], sessions)]
     summary = {
         "map": out,
-        "drives": [{k: r[k] for k in ("drive", "map", "frames", "keyframes", "loops_accepted", "host")} |
+        "drives": [{k: r[k] for k in ("drive", "map", "frames", "keyframes", "loops_accepted", "host", "cpu_s")} |
                    {"seconds": round(r["end"] - r["start"], 3)} for r in slam_results],
         "joined": joined,
         "linked_drives": sum(j["linked"] for j in joined),
         "cross_drive_loops": manifest.get("cross_session_loops", 0),
         "keyframes": manifest.get("keyframes"),
-        "merges": [{"maps": m["merged"], "seconds": round(m["end"] - m["start"], 3)} for m in merge_results],
+        "merges": [{"maps": m["merged"], "seconds": round(m["end"] - m["start"], 3), "cpu_s": m["cpu_s"]}
+                   for m in merge_results],
         "workers": None if scheduler else workers,
         "scheduler": scheduler or "LocalCluster",
     }
