@@ -1,6 +1,9 @@
 """The Python module against the command line: the same poses to the byte,
 the same configuration, the same errors; array checks."""
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -199,3 +202,25 @@ def test_docstrings():
     for item in (saloam.Odometry.register, saloam.open_source, saloam.Slam, saloam.eval, saloam.merge, saloam.config,
                  saloam.Map.localize, saloam.Segmenter):
         assert item.__doc__ and len(item.__doc__) > 40, item
+
+
+@pytest.mark.skipif("SALOAM_CMAKE" not in os.environ, reason="run by CTest (needs the build's cmake and folder)")
+def test_installed_package_finds_its_data_and_program(tmp_path):
+    prefix = tmp_path / "prefix"
+    # what `cmake --install` does for the program (and its data) and the package
+    for folder in ("apps/saloam", "python"):
+        subprocess.run([os.environ["SALOAM_CMAKE"], f"-DCMAKE_INSTALL_PREFIX={prefix}", "-P",
+                        os.path.join(os.environ["SALOAM_BUILD_DIR"], folder, "cmake_install.cmake")],
+                       check=True, capture_output=True)
+    package = prefix / os.environ["SALOAM_INSTALL_PYTHON_DIR"]
+    env = {k: v for k, v in os.environ.items() if k not in ("SALOAM_DATA_DIR", "SALOAM_PLUGIN_DIR", "SALOAM_CLI")}
+    env["PYTHONPATH"] = str(package)
+    code = ("import saloam, os; print(saloam.__file__); print(saloam.config('real_kitti')['odometry']['features']"
+            "['pose_time_in_sweep']); print(os.environ['SALOAM_DATA_DIR']); print(saloam.cli_path())")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[0].startswith(str(package))
+    assert lines[2] == str(prefix / "share" / "saloam") and lines[3] == str(prefix / "bin" / "saloam")
+    fleet = subprocess.run([prefix / "bin" / "saloam", "fleet", "--help"], capture_output=True, text=True, env=env)
+    assert fleet.returncode == 0 and "--scheduler" in fleet.stdout, fleet.stderr
