@@ -198,6 +198,12 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
         if cluster is not None:
             cluster.close()
 
+    # Attempts of dead workers left their partial outputs (*.part): every
+    # task is done and their subprocesses died with them.
+    for folder, prefix in ((work, ""), (os.path.dirname(out), os.path.basename(out) + ".")):
+        for name in os.listdir(folder):
+            if name.startswith(prefix) and name.endswith(".part") and os.path.join(folder, name) != final["map"]:
+                shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
     # The final map in place (a lone drive's map is copied).
     if os.path.isdir(out):
         shutil.rmtree(out)
