@@ -86,7 +86,6 @@ def test_scheduler_and_a_worker_killed_mid_run(drives, local_run, tmp_path):
     env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
     port = free_port()
     address = f"tcp://127.0.0.1:{port}"
-    bin_dir = os.path.dirname(sys.executable)
     processes = [start([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port",
                         str(port), "--dashboard-address", ":0", "--no-show"], env)]
     workers = [start([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
