@@ -15,6 +15,8 @@ packages=(
   librosbag-storage-dev  # ROS 1 bags (optional: without it bags are an error that says so)
   libsqlite3-dev libzstd-dev liblz4-dev  # ROS 2 recordings: rosbag2 .db3 (SQLite) and MCAP chunks (zstd, LZ4)
   libpcap-dev  # sensor packet captures (.pcap: Ouster, Velodyne)
+  pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module `import saloam` and its tests (python/)
+  python3-dask python3-distributed  # saloam fleet: fleet mapping on Dask (docs/fleet.md)
 )
 
 missing=()

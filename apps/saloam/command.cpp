@@ -130,6 +130,10 @@ void refuse_unused_model(const std::string& given, const std::string& detector) 
 }
 
 std::filesystem::path segmentation_plugin_path() {
+  // The Python module runs inside python3: it names the folder it found.
+  if (const char* env = std::getenv("SALOAM_PLUGIN_DIR"); env && *env) {
+    return std::filesystem::path(env) / kSegmentationPlugin;
+  }
   const auto bin = program_dir();
   if (!bin) return kSegmentationPlugin;
   std::error_code error;

@@ -143,8 +143,8 @@ void use_model_option(const std::string& given, SaloamConfig& config);
 /// which has no model: an option is used or refused, never ignored.
 void refuse_unused_model(const std::string& given, const std::string& detector);
 /// The network plugin of the segmentation (beside the program in a build
-/// tree, in <prefix>/lib/saloam when installed); it exists only in builds
-/// with libtorch.
+/// tree, in <prefix>/lib/saloam when installed; in $SALOAM_PLUGIN_DIR when
+/// set, as the Python module sets it); it exists only in builds with libtorch.
 std::filesystem::path segmentation_plugin_path();
 
 /// The segmentation model to load: `given` (--segmenter), else the config's

@@ -84,6 +84,13 @@ class NeighbourGrid {
   [[nodiscard]] double max_radius() const { return 0.5 * cell_size_; }
   [[nodiscard]] std::size_t size() const { return size_; }
   [[nodiscard]] std::size_t size(ClassIndex c) const { return class_size_[c]; }
+  /// Calls f(point, class) for every point, in no particular order.
+  template <class F>
+  void for_each(F&& f) const {
+    for (const auto& [key, points] : cells_) {
+      for (const Eigen::Vector3d& p : points) f(p, static_cast<ClassIndex>(key.c));
+    }
+  }
 
  private:
   double cell_size_;

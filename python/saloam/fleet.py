@@ -1,0 +1,297 @@
+"""Fleet mapping on Dask: `saloam fleet DRIVES... --out MAP` (docs/fleet.md).
+
+Each drive's SLAM is one Dask task that saves the drive's map; the maps are
+then merged by a tree of pairwise merges, each merge a task of its own
+(`saloam merge`: cross-session loop closure and one pose graph, in the first
+map's frame; a drive that overlaps none of the others stays a separate,
+unlinked session). The tasks run the `saloam` program in the worker (one
+subprocess per task), not the Python module: a crash or an out-of-memory
+kill of the C++ takes down that subprocess only, the worker reports it and
+the task is retried; workers need only dask and the program, the memory of a
+drive goes back to the system when its task ends, and every task's outputs
+(poses, loops, evaluations, summary.json) are exactly the command line's.
+
+Nothing is lost when a worker dies: the scheduler runs its tasks again on
+another worker, every output is written under a name of its own per attempt
+and put in place by one rename (a map already in place is the same map: the
+SLAM does not depend on timing), and a task's subprocess dies with its
+worker (PR_SET_PDEATHSIG).
+"""
+import argparse
+import ctypes
+import json
+import os
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import uuid
+
+from . import cli_path
+
+
+def _die_with_parent():
+    """In the child: SIGKILL when the worker that started it dies (Linux)."""
+    try:
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
+
+
+def _cpu_seconds():
+    """CPU time of this process's finished children (a worker runs one task at a time: its task's)."""
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+def run_saloam(args, program=None):
+    """Runs `saloam ARGS...` and returns its output; RuntimeError with it when it fails."""
+    command = [program or cli_path(), "-q", *[str(a) for a in args]]
+    # Dask's workers set MALLOC_TRIM_THRESHOLD_ for their own heap; in the
+    # program it made the SLAM 30-60 % slower (docs/fleet.md).
+    env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+    done = subprocess.run(command, capture_output=True, text=True, preexec_fn=_die_with_parent, env=env)
+    if done.returncode != 0:
+        raise RuntimeError(f"{' '.join(command)} failed ({done.returncode}):\n{done.stderr}{done.stdout}")
+    return done.stdout
+
+
+def _put_in_place(attempt, final):
+    """Renames the folder `attempt` to `final` unless an earlier attempt is there already."""
+    try:
+        os.rename(attempt, final)
+    except OSError:
+        if not os.path.isdir(final):
+            raise
+        shutil.rmtree(attempt, ignore_errors=True)
+
+
+def slam_drive(index, drive, work, program=None, options=()):
+    """Task: `saloam slam DRIVE --save-map`; returns what the summary needs."""
+    start, cpu = time.time(), _cpu_seconds()
+    final_out, final_map = os.path.join(work, f"slam_{index:03d}"), os.path.join(work, f"map_{index:03d}")
+    if not os.path.isdir(final_map):
+        token = uuid.uuid4().hex[:8]
+        out, saved = f"{final_out}.{token}.part", f"{final_map}.{token}.part"
+        run_saloam(["slam", drive, "--out", out, "--no-map", "--save-map", saved, *options], program)
+        _put_in_place(out, final_out)
+        _put_in_place(saved, final_map)
+    with open(os.path.join(final_out, "summary.json")) as f:
+        summary = json.load(f)
+    return {"drive": os.path.abspath(drive), "map": final_map, "drives": [index], "start": start, "end": time.time(),
+            "frames": summary.get("frames"), "keyframes": summary.get("keyframes"),
+            "loops_accepted": summary.get("loops_accepted"), "host": os.uname().nodename,
+            "cpu_s": round(_cpu_seconds() - cpu, 3)}
+
+
+def merge_pair(a, b, out, program=None, options=()):
+    """Task: `saloam merge A B --out OUT` (A's frame); returns the merged map and its drives."""
+    start, cpu = time.time(), _cpu_seconds()
+    if not os.path.isdir(out):
+        attempt = f"{out}.{uuid.uuid4().hex[:8]}.part"
+        run_saloam(["merge", a["map"], b["map"], "--out", attempt, *options], program)
+        _put_in_place(attempt, out)
+    return {"map": out, "drives": a["drives"] + b["drives"], "start": start, "end": time.time(),
+            "merged": [a["map"], b["map"]], "cpu_s": round(_cpu_seconds() - cpu, 3)}
+
+
+def simulate_drive(index, out, preset, passes, beams, seed, program=None):
+    """Task: `saloam simulate --passes ... --pass INDEX`: drive INDEX of a simulated fleet."""
+    if not os.path.isdir(out):
+        attempt = f"{out}.{uuid.uuid4().hex[:8]}.part"
+        run_saloam(["simulate", "--preset", preset, "--passes", passes, "--pass", index, "--beams", beams,
+                    "--seed", seed, "--labels", "noisy", "--out", attempt], program)
+        _put_in_place(attempt, out)
+    return out
+
+
+def fleet_passes(drives, frames, reverse=False):
+    """--passes for `drives` drives of `frames` frames along one route: each starts two thirds of a drive
+    after the previous one (a third overlaps); with `reverse` every second one drives the opposite lane."""
+    step = max(1, (2 * frames) // 3)
+    passes = []
+    for k in range(drives):
+        a = k * step
+        passes.append(f"{a}:{a + frames}" + (":reverse" if reverse and k % 2 == 1 else ""))
+    return ",".join(passes)
+
+
+def _client(scheduler, workers):
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler:
+        return Client(scheduler), None
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+    return Client(cluster), cluster
+
+
+def _span(records):
+    return round(max(r["end"] for r in records) - min(r["start"] for r in records), 3) if records else 0.0
+
+
+def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, slam_options=(), merge_options=(),
+              simulate=None, summary_file=None, log=print):
+    """Maps `drives` (sequence folders) into one map at `out`; returns the summary (also written as JSON).
+
+    simulate: {"drives": N, "frames": F, "preset": P, "beams": B, "seed": S, "reverse": bool} makes the
+    drives first (tasks as well), in `work`/drives.
+    """
+    from dask.distributed import wait
+
+    program = os.path.abspath(program or cli_path())
+    out = os.path.abspath(out)
+    if os.path.exists(out) and not os.path.isfile(os.path.join(out, "map.json")):
+        raise RuntimeError(f"{out}: exists and is not a saloam map (the fleet's map replaces only a map)")
+    work = os.path.abspath(work or out + ".fleet")
+    os.makedirs(work, exist_ok=True)
+    summary_file = summary_file or out + ".fleet.json"
+    begin = time.time()
+    client, cluster = _client(scheduler, workers)
+    try:
+        stages = {}
+        if simulate:
+            passes = fleet_passes(simulate["drives"], simulate["frames"], simulate.get("reverse", False))
+            folder = os.path.join(work, "drives")
+            os.makedirs(folder, exist_ok=True)
+            t = time.time()
+            futures = [client.submit(simulate_drive, k, os.path.join(folder, f"drive_{k:03d}"), simulate["preset"],
+                                     passes, simulate["beams"], simulate["seed"], program, pure=False, retries=2,
+                                     key=f"simulate-{k}-{uuid.uuid4().hex[:8]}")
+                       for k in range(simulate["drives"])]
+            drives = client.gather(futures)
+            stages["simulate_s"] = round(time.time() - t, 3)
+            log(f"simulated {len(drives)} drives ({passes}) in {stages['simulate_s']:.1f} s")
+        if not drives:
+            raise RuntimeError("no drives given")
+        drives = [os.path.abspath(d) for d in drives]
+        t = time.time()
+        slams = [client.submit(slam_drive, k, d, work, program, tuple(slam_options), pure=False, retries=2,
+                               key=f"slam-{k}-{uuid.uuid4().hex[:8]}")
+                 for k, d in enumerate(drives)]
+        # The merge tree: pairs of neighbours, level by level; each merge
+        # starts as soon as its two inputs are there.
+        level, merges, depth = slams, [], 0
+        while len(level) > 1:
+            depth += 1
+            nxt = []
+            for i in range(0, len(level) - 1, 2):
+                target = out + f".{uuid.uuid4().hex[:8]}.part" if len(level) == 2 else \
+                    os.path.join(work, f"merge_{depth}_{i // 2:03d}")
+                merges.append(client.submit(merge_pair, level[i], level[i + 1], target, program,
+                                            tuple(merge_options), pure=False, retries=2,
+                                            key=f"merge-{depth}-{i // 2}-{uuid.uuid4().hex[:8]}"))
+                nxt.append(merges[-1])
+            if len(level) % 2:
+                nxt.append(level[-1])
+            level = nxt
+        wait(level)
+        slam_results = client.gather(slams)
+        merge_results = client.gather(merges)
+        final = client.gather(level[0])
+        stages["slam_s"] = _span(slam_results)
+        stages["merge_s"] = _span(merge_results)
+        stages["mapping_s"] = round(time.time() - t, 3)
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+    # Attempts of dead workers left their partial outputs (*.part): every
+    # task is done and their subprocesses died with them.
+    for folder, prefix in ((work, ""), (os.path.dirname(out), os.path.basename(out) + ".")):
+        for name in os.listdir(folder):
+            if name.startswith(prefix) and name.endswith(".part") and os.path.join(folder, name) != final["map"]:
+                shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
+    # The final map in place (a lone drive's map is copied).
+    if os.path.isdir(out):
+        shutil.rmtree(out)
+    if merge_results:
+        os.rename(final["map"], out)
+    else:
+        shutil.copytree(final["map"], out)
+    with open(os.path.join(out, "map.json")) as f:
+        manifest = json.load(f)
+    sessions = manifest.get("sessions", [])
+    joined = [{"drive": drives[d], "linked": bool(s.get("linked", True)), "keyframes": s.get("keyframes")}
+              for d, s in zip(final["drives"], sessions)]
+    summary = {
+        "map": out,
+        "drives": [{k: r[k] for k in ("drive", "map", "frames", "keyframes", "loops_accepted", "host", "cpu_s")} |
+                   {"seconds": round(r["end"] - r["start"], 3)} for r in slam_results],
+        "joined": joined,
+        "linked_drives": sum(j["linked"] for j in joined),
+        "cross_drive_loops": manifest.get("cross_session_loops", 0),
+        "keyframes": manifest.get("keyframes"),
+        "merges": [{"maps": m["merged"], "seconds": round(m["end"] - m["start"], 3), "cpu_s": m["cpu_s"]}
+                   for m in merge_results],
+        "workers": None if scheduler else workers,
+        "scheduler": scheduler or "LocalCluster",
+    }
+    # The merged map's error per drive, when every drive has reference poses.
+    if all(os.path.isfile(os.path.join(d, "poses.txt")) for d in drives):
+        t = time.time()
+        report = os.path.join(work, "eval_map.json")
+        gts = [a for d in final["drives"] for a in ("--gt", drives[d])]
+        try:
+            run_saloam(["eval", "--map", out, *gts, "--json", report], program)
+            with open(report) as f:
+                summary["error_per_drive"] = json.load(f)
+        except RuntimeError as e:
+            summary["error_per_drive"] = {"error": str(e)}
+        stages["eval_s"] = round(time.time() - t, 3)
+    stages["total_s"] = round(time.time() - begin, 3)
+    summary["stages"] = stages
+    with open(summary_file + ".part", "w") as f:
+        json.dump(summary, f, indent=2)
+        f.write("\n")
+    os.replace(summary_file + ".part", summary_file)
+    log(f"{len(drives)} drives -> {out}: {summary['linked_drives']} of {len(joined)} sessions linked, "
+        f"{summary['cross_drive_loops']} cross-drive loops; SLAM {stages['slam_s']:.1f} s, merges "
+        f"{stages['merge_s']:.1f} s, total {stages['total_s']:.1f} s; summary {summary_file}")
+    return summary
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(
+        prog="saloam fleet",
+        description="Fleet mapping on Dask: each drive's SLAM a task, the maps merged by a tree of pairwise merges "
+                    "(docs/fleet.md).")
+    parser.add_argument("drives", nargs="*", metavar="DRIVE", help="sequence folders (any layout saloam slam reads)")
+    parser.add_argument("--out", required=True, help="the merged map's folder")
+    parser.add_argument("--scheduler", help="a running Dask scheduler (tcp://HOST:8786); default a LocalCluster")
+    parser.add_argument("--workers", type=int, default=2, help="LocalCluster workers, one thread each (default 2)")
+    parser.add_argument("--work", help="intermediate results (per-drive runs and maps, merges); default OUT.fleet, "
+                                       "on a file system every worker sees")
+    parser.add_argument("--summary", help="the summary JSON (default OUT.fleet.json)")
+    parser.add_argument("--simulate", type=int, metavar="N", help="simulate N drives through one world first")
+    parser.add_argument("--drive-frames", type=int, default=150, help="frames per simulated drive (default 150)")
+    parser.add_argument("--preset", default="urban-loop", help="simulated route (default urban-loop)")
+    parser.add_argument("--beams", type=int, default=16, choices=(16, 32, 64), help="simulated beams (default 16)")
+    parser.add_argument("--seed", type=int, default=1, help="simulated world's seed")
+    parser.add_argument("--reverse", action="store_true", help="every second simulated drive in the opposite lane")
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="configuration overrides for every drive's SLAM")
+    parser.add_argument("--config", help="configuration file or shipped name for every drive's SLAM")
+    args = parser.parse_args(argv)
+    if bool(args.drives) == bool(args.simulate):
+        parser.error("give DRIVE folders or --simulate N (one of them)")
+    if args.workers < 1:
+        parser.error("--workers must be at least 1")
+    slam_options = [a for s in args.set for a in ("--set", s)] + (["--config", args.config] if args.config else [])
+    simulate = None
+    if args.simulate:
+        simulate = {"drives": args.simulate, "frames": args.drive_frames, "preset": args.preset, "beams": args.beams,
+                    "seed": args.seed, "reverse": args.reverse}
+    try:
+        map_fleet(args.drives, args.out, work=args.work, scheduler=args.scheduler, workers=args.workers,
+                  slam_options=slam_options, simulate=simulate, summary_file=args.summary)
+    except (RuntimeError, OSError) as e:
+        print(f"[error] {e}", file=sys.stderr)
+        return 2
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

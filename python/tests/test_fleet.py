@@ -1,0 +1,129 @@
+"""`saloam fleet` on a LocalCluster and on a scheduler started here, with a
+worker killed in the middle of the run."""
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+
+import saloam
+from conftest import run_cli, saloam_cli
+
+from saloam.fleet import fleet_passes
+
+DRIVES = 3
+FRAMES = 60
+
+
+@pytest.fixture(scope="module")
+def drives(tmp_path_factory):
+    """Three short drives through one world, each overlapping the next by a third."""
+    folder = tmp_path_factory.mktemp("fleet")
+    passes = fleet_passes(DRIVES, FRAMES)
+    out = []
+    for k in range(DRIVES):
+        run_cli("-q", "simulate", "--preset", "straight", "--passes", passes, "--pass", k, "--beams", "16",
+                "--labels", "noisy", "--out", folder / f"drive{k}")
+        out.append(folder / f"drive{k}")
+    return out
+
+
+def fleet(*args, **kwargs):
+    return subprocess.Popen([saloam_cli(), "fleet", *map(str, args)], stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT, text=True, **kwargs)
+
+
+def keyframe_poses(folder):
+    return saloam.Map(folder).poses()
+
+
+@pytest.fixture(scope="module")
+def local_run(drives, tmp_path_factory):
+    out = tmp_path_factory.mktemp("local") / "map"
+    process = fleet(*drives, "--out", out, "--workers", 2)
+    output, _ = process.communicate(timeout=120)
+    assert process.returncode == 0, output
+    return out, json.loads((out.parent / "map.fleet.json").read_text()), output
+
+
+def test_local_cluster_maps_and_merges_every_drive(drives, local_run):
+    out, summary, output = local_run
+    assert "3 drives ->" in output
+    info = saloam.Map(out).info()
+    assert len(info["sessions"]) == DRIVES
+    assert [d["drive"] for d in summary["drives"]] == [str(d) for d in drives]
+    assert [j["drive"] for j in summary["joined"]] == [str(d) for d in drives]
+    assert summary["linked_drives"] == sum(s["linked"] for s in info["sessions"]) == DRIVES
+    assert summary["cross_drive_loops"] == info["cross_session_loops"] > 0
+    assert len(summary["merges"]) == DRIVES - 1
+    assert set(summary["stages"]) >= {"slam_s", "merge_s", "eval_s", "total_s"}
+    errors = summary["error_per_drive"]
+    assert len(errors["sessions"]) == DRIVES, errors
+    # each drive's map is the one `saloam slam --save-map` makes
+    run_cli("-q", "slam", drives[1], "--out", out.parent / "slam1", "--no-map", "--save-map", out.parent / "map1")
+    np.testing.assert_array_equal(keyframe_poses(out.parent / "map1"),
+                                  keyframe_poses(out.parent / "map.fleet" / "map_001"))
+
+
+def free_port():
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def start(command, env):
+    return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
+                            start_new_session=True)
+
+
+def test_scheduler_and_a_worker_killed_mid_run(drives, local_run, tmp_path):
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
+    port = free_port()
+    address = f"tcp://127.0.0.1:{port}"
+    processes = [start([sys.executable, "-m", "distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port",
+                        str(port), "--dashboard-address", ":0", "--no-show"], env)]
+    workers = [start([sys.executable, "-m", "distributed.cli.dask_worker", address, "--nthreads", "1", "--no-nanny",
+                      "--host", "127.0.0.1", "--dashboard-address", ":0", "--death-timeout", "30"], env)
+               for _ in range(2)]
+    processes += workers
+    try:
+        out = tmp_path / "map"
+        run = fleet(*drives, "--out", out, "--scheduler", address, env=env)
+        # Kill the first worker as soon as a drive's SLAM is under way.
+        deadline = time.time() + 60
+        while time.time() < deadline and not any(
+                name.startswith("slam_") for name in os.listdir(tmp_path) + (
+                    os.listdir(tmp_path / "map.fleet") if (tmp_path / "map.fleet").exists() else [])):
+            time.sleep(0.05)
+        os.killpg(workers[0].pid, signal.SIGKILL)
+        output, _ = run.communicate(timeout=120)
+        assert run.returncode == 0, output
+        assert workers[0].wait(timeout=10) == -signal.SIGKILL
+        summary = json.loads((tmp_path / "map.fleet.json").read_text())
+        assert summary["scheduler"] == address
+        # the same map as the LocalCluster's
+        np.testing.assert_array_equal(keyframe_poses(out), keyframe_poses(local_run[0]))
+        assert summary["cross_drive_loops"] == local_run[1]["cross_drive_loops"]
+        assert not [n for n in os.listdir(tmp_path / "map.fleet") if n.endswith(".part")]
+    finally:
+        for p in processes:
+            if p.poll() is None:
+                os.killpg(p.pid, signal.SIGTERM)
+        for p in processes:
+            try:
+                p.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
+
+
+def test_fleet_refuses_what_it_cannot_do(tmp_path):
+    done = subprocess.run([saloam_cli(), "fleet", "--out", tmp_path / "m"], capture_output=True, text=True)
+    assert done.returncode == 2 and "DRIVE folders or --simulate" in done.stderr
+    help_text = subprocess.run([saloam_cli(), "fleet", "--help"], capture_output=True, text=True).stdout
+    assert "--scheduler" in help_text and "--workers" in help_text
