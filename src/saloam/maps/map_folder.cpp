@@ -8,6 +8,7 @@
 #include <span>
 #include <cstring>
 #include <random>
+#include <utility>
 
 #include <fmt/format.h>
 #include <yaml-cpp/yaml.h>
@@ -15,6 +16,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/folder_replace.hpp"
+#include "saloam/core/lie.hpp"
 #include "saloam/core/digest.hpp"
 #include "saloam/core/output_file.hpp"
 #include "saloam/maps/map_format.hpp"
@@ -187,7 +189,25 @@ constexpr double kMaxEdgeRotationCorrection = 0.2;  // [rad]
 constexpr double kOdometryEdgeTolerance = 1e-3;          // [m]
 constexpr double kOdometryEdgeRotationTolerance = 1e-5;  // [rad]
 
-double rotation_angle(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).angle(); }
+// The loop edges of a map, and those of them between two sessions (the
+// manifest's loop_edges and cross_session_loops).
+struct LoopCounts {
+  std::uint64_t loops = 0, cross_session = 0;
+};
+LoopCounts loop_counts(const SavedMap& map) {
+  LoopCounts counts;
+  for (const PoseGraphEdge& e : map.edges) {
+    if (e.kind != EdgeKind::kLoop) continue;
+    ++counts.loops;
+    counts.cross_session += map.keyframes[e.from].session != map.keyframes[e.to].session;
+  }
+  return counts;
+}
+
+// How far the motion `a` is from `b`: translation [m] and rotation [rad].
+std::pair<double, double> motion_difference(const Pose& a, const Pose& b) {
+  return {(a.translation() - b.translation()).norm(), rotation_angle(a.inverse() * b)};
+}
 
 // The edges agree with the keyframes and the manifest (issue #39: a map whose
 // digests were fitted to an edit is still refused): odometry edges join
@@ -195,33 +215,24 @@ double rotation_angle(const Eigen::Matrix3d& r) { return Eigen::AngleAxisd(r).an
 // odometry poses; the optimised poses are within a loop correction of every
 // odometry edge; the loop counts are the manifest's.
 void check_graph(const SavedMap& map, const fs::path& edges_file) {
-  std::uint64_t loops = 0, cross_session = 0;
   for (std::size_t i = 0; i < map.edges.size(); ++i) {
     const PoseGraphEdge& e = map.edges[i];
+    if (e.kind == EdgeKind::kLoop) continue;
     const MapKeyframe& from = map.keyframes[e.from];
     const MapKeyframe& to = map.keyframes[e.to];
-    if (e.kind == EdgeKind::kLoop) {
-      ++loops;
-      if (from.session != to.session) ++cross_session;
-      continue;
-    }
     if (e.to != e.from + 1 || from.session != to.session) {
       throw InputError(edges_file, fmt::format("odometry edge {}: keyframes {} -> {} are not consecutive keyframes of "
                                                "one session",
                                                i, e.from, e.to));
     }
-    const Pose odometry = from.odometry_pose.inverse() * to.odometry_pose;
-    const double offset = (odometry.translation() - e.measured.translation()).norm();
-    const double turn = rotation_angle(odometry.linear().transpose() * e.measured.linear());
+    const auto [offset, turn] = motion_difference(from.odometry_pose.inverse() * to.odometry_pose, e.measured);
     if (offset > kOdometryEdgeTolerance || turn > kOdometryEdgeRotationTolerance) {
       throw InputError(edges_file, fmt::format("odometry edge {}: measures {:.3f} m and {:.5f} rad away from the motion "
                                                "between the odometry poses of keyframes {} and {}",
                                                i, offset, turn, e.from, e.to));
     }
-    const Pose optimised = from.pose.inverse() * to.pose;
-    const double correction = (optimised.translation() - e.measured.translation()).norm();
+    const auto [correction, rotation] = motion_difference(from.pose.inverse() * to.pose, e.measured);
     const double allowed = kMaxEdgeCorrection + kMaxEdgeCorrectionFraction * e.measured.translation().norm();
-    const double rotation = rotation_angle(optimised.linear().transpose() * e.measured.linear());
     if (correction > allowed || rotation > kMaxEdgeRotationCorrection) {
       throw InputError(edges_file.parent_path() / "keyframes.bin",
                        fmt::format("keyframes {} and {}: their poses are {:.3f} m and {:.3f} rad from their odometry "
@@ -230,9 +241,10 @@ void check_graph(const SavedMap& map, const fs::path& edges_file) {
                                    kMaxEdgeRotationCorrection));
     }
   }
-  if (loops != map.manifest.loop_edges || cross_session != map.manifest.cross_session_loops) {
-    throw InputError(edges_file, fmt::format("{} loop edges ({} between sessions), map.json says {} ({})", loops,
-                                             cross_session, map.manifest.loop_edges,
+  const LoopCounts counts = loop_counts(map);
+  if (counts.loops != map.manifest.loop_edges || counts.cross_session != map.manifest.cross_session_loops) {
+    throw InputError(edges_file, fmt::format("{} loop edges ({} between sessions), map.json says {} ({})", counts.loops,
+                                             counts.cross_session, map.manifest.loop_edges,
                                              map.manifest.cross_session_loops));
   }
 }
@@ -253,14 +265,11 @@ MapManifest manifest_to_write(const SavedMap& map) {
   manifest.version = kMapFormatVersion;
   manifest.keyframes = map.keyframes.size();
   manifest.edges = map.edges.size();
-  manifest.loop_edges = static_cast<std::uint64_t>(
-      std::count_if(map.edges.begin(), map.edges.end(), [](const PoseGraphEdge& e) { return e.kind == EdgeKind::kLoop; }));
+  const LoopCounts loops = loop_counts(map);
+  manifest.loop_edges = loops.loops;
   manifest.detector = map.config.loop.detector;
   manifest.sessions = counted_sessions(map);
-  manifest.cross_session_loops = static_cast<std::uint64_t>(
-      std::count_if(map.edges.begin(), map.edges.end(), [&](const PoseGraphEdge& e) {
-        return e.kind == EdgeKind::kLoop && map.keyframes[e.from].session != map.keyframes[e.to].session;
-      }));
+  manifest.cross_session_loops = loops.cross_session;
   return manifest;
 }
 
