@@ -8,7 +8,6 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -135,15 +134,32 @@ std::shared_ptr<Source> open_source_py(const py::object& path, const std::string
 
 // ---------------------------------------------------------------- odometry
 
-double next_stamp(const std::vector<double>& stamps, const py::object& stamp) {
-  if (!stamp.is_none()) {
-    const double t = stamp.cast<double>();
+// The scan's stamp: `t` when `given`, else 0.1 s after the previous one.
+double next_stamp(const std::vector<double>& stamps, bool given, double t) {
+  if (given) {
     if (!std::isfinite(t)) throw py::value_error("stamp must be finite");
     if (!stamps.empty() && !(t > stamps.back()))
       throw py::value_error(fmt::format("stamp {} does not follow the previous scan's {}", t, stamps.back()));
     return t;
   }
   return stamps.empty() ? 0.0 : stamps.back() + 0.1;  // a 10 Hz sensor
+}
+
+// One scan through `step(cloud, stamp)` of `system` (an odometry or a SLAM):
+// the stamp read while the GIL is held, the work done without it, one call
+// at a time per object.
+template <class System, class Step>
+py::array_t<double> register_with(System& system, std::mutex& mutex, const LabelledCloud& cloud,
+                                  const py::object& stamp, Step&& step) {
+  const bool given = !stamp.is_none();
+  const double t = given ? stamp.cast<double>() : 0.0;
+  Pose pose;
+  {
+    py::gil_scoped_release release;
+    std::lock_guard lock(mutex);
+    pose = step(cloud, next_stamp(system.timestamps(), given, t));
+  }
+  return pose_to_array(pose);
 }
 
 struct Odometry {
@@ -157,15 +173,8 @@ struct Odometry {
 
   py::array_t<double> register_scan(const py::object& points, const py::object& labels, const py::object& times,
                                     const py::object& stamp, const py::object& rings) {
-    const LabelledCloud cloud = cloud_from_arrays(points, labels, times, rings);
-    Pose pose;
-    {
-      py::gil_scoped_release release;
-      std::lock_guard lock(mutex);
-      const double t = next_stamp(odometry->timestamps(), stamp);
-      pose = odometry->register_frame(cloud, t);
-    }
-    return pose_to_array(pose);
+    return register_with(*odometry, mutex, cloud_from_arrays(points, labels, times, rings), stamp,
+                         [this](const LabelledCloud& cloud, double t) { return odometry->register_frame(cloud, t); });
   }
 
   py::dict local_map() {
@@ -218,15 +227,8 @@ struct Slam {
 
   py::array_t<double> register_scan(const py::object& points, const py::object& labels, const py::object& times,
                                     const py::object& stamp, const py::object& rings) {
-    const LabelledCloud cloud = cloud_from_arrays(points, labels, times, rings);
-    Pose pose;
-    {
-      py::gil_scoped_release release;
-      std::lock_guard lock(mutex);
-      const double t = next_stamp(slam->timestamps(), stamp);
-      pose = slam->process(cloud, t);
-    }
-    return pose_to_array(pose);
+    return register_with(*slam, mutex, cloud_from_arrays(points, labels, times, rings), stamp,
+                         [this](const LabelledCloud& cloud, double t) { return slam->process(cloud, t); });
   }
 
   py::list loops() {
