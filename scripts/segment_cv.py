@@ -84,9 +84,29 @@ def pooled(scores):
     return iou, points
 
 
+def sure_teacher(teacher, min_confidence, out_dir):
+    """A copy of the `teacher` description in `out_dir` that leaves the points it is less sure of than
+    `min_confidence` unlabeled (decision.min_confidence; the loss ignores them)."""
+    lines = []
+    with open(teacher) as f:
+        for line in f:
+            if line.startswith("  file: "):  # the weights stay where they are
+                line = "  file: " + os.path.join(os.path.dirname(os.path.abspath(teacher)), line.split(":", 1)[1].strip()) + "\n"
+            if line.startswith("decision:"):
+                sys.exit(f"{teacher}: a teacher with its own decision: is not supported")
+            lines.append(line)
+    lines.append(f"decision: {{min_confidence: {min_confidence}}}\n")
+    copy = os.path.join(out_dir, "teacher.yaml")
+    with open(copy, "w") as f:
+        f.writelines(lines)
+    return copy
+
+
 def pseudo_source(args, teacher, out_dir, log):
     """The --pseudo drive labelled by `teacher`, as a recipe source."""
     labels = os.path.join(out_dir, "pseudo_labels")
+    if args.pseudo_min_confidence > 0:
+        teacher = sure_teacher(teacher, args.pseudo_min_confidence, out_dir)
     if not os.path.isdir(labels):  # a rerun of the fold reuses the labels
         run([args.saloam, "segment", args.pseudo, "--segmenter", teacher, "--out", labels, "--no-score"], log)
     return {"folder": args.pseudo, "labels": labels, "frame_step": 1, "weight": args.pseudo_weight}
@@ -173,6 +193,8 @@ def main():
     p.add_argument("--teacher", help="with --pseudo: the cross-validation folder whose fold models label it (with "
                                      "--final: a model)")
     p.add_argument("--pseudo-weight", type=float, default=1.0, help="the recipe weight of each pseudo-labelled scan")
+    p.add_argument("--pseudo-min-confidence", type=float, default=0.0,
+                   help="with --pseudo: points the teacher gives a lower probability stay unlabeled (0: label all)")
     p.add_argument("--segment-args", default="", help="further segment options")
     p.add_argument("--jobs", type=int, default=1, help="folds run at once")
     p.add_argument("--final", action="store_true",

@@ -112,6 +112,16 @@ TEST(SegmenterSpec, TheDynamicBiasOffsetsTheDynamicClassesOnly) {
             std::string::npos);
 }
 
+TEST(SegmenterSpec, TheMinimumConfidenceIsAProbabilityAndWrittenBack) {
+  EXPECT_EQ(parse_segmenter_spec(kRangeNet, "/models/m.yaml").min_confidence, 0.0) << "every point labelled";
+  const SegmenterSpec sure = parse_segmenter_spec(std::string(kRangeNet) + "decision: {min_confidence: 0.7}\n", "/models/m.yaml");
+  EXPECT_DOUBLE_EQ(sure.min_confidence, 0.7);
+  EXPECT_TRUE(decision_offsets(sure).empty()) << "it moves no logit";
+  EXPECT_DOUBLE_EQ(parse_segmenter_spec(segmenter_spec_yaml(sure, "/models"), "/models/m.yaml").min_confidence, 0.7);
+  EXPECT_NE(error_of(std::string(kRangeNet) + "decision: {min_confidence: 1.5}\n").find("decision.min_confidence: 1.5 is outside"),
+            std::string::npos);
+}
+
 TEST(SegmenterSpec, ClassBiasesOffsetTheirClassesOnTopOfTheDynamicBias) {
   const SegmenterSpec spec = parse_segmenter_spec(
       std::string(kRangeNet) + "decision: {dynamic_bias: 2, class_bias: {building: 0.5, person: -0.25}}\n",

@@ -7,6 +7,7 @@
 #include <torch/script.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -189,6 +190,44 @@ TEST(SegmenterPlugin, TheDynamicBiasTipsOnlyCloseCallsToDynamicClasses) {
   };
   EXPECT_EQ(share_of_persons("decision: {dynamic_bias: 0.5}\n"), 0.0) << "a margin of 1 is not a close call at 0.5";
   EXPECT_EQ(share_of_persons("decision: {dynamic_bias: 2}\n"), 1.0) << "person is the first dynamic class";
+}
+
+TEST(SegmenterPlugin, TheConfidenceIsTheNetworksProbabilityOfThePointsClass) {
+  testing::TempDir dir;
+  write_torchscript_rule(dir / "rule.pt", 20);  // logits 1 for car or road, 0 for the 18 other classes
+  const LabelledCloud& cloud = scans().front();
+  // The softmax at a pixel: the rule's class e / (e + 19) = 0.125, another 1 / (e + 19) = 0.046 (a point
+  // the vote moved across the 10 m boundary, whose pixel shows the other class).
+  const double sure = std::exp(1.0) / (std::exp(1.0) + 19.0), other = 1.0 / (std::exp(1.0) + 19.0);
+  auto segment = [&](const std::string& decision) {
+    write_rangenet_description(dir / "rule.yaml", "rule.pt");
+    std::ofstream(dir / "rule.yaml", std::ios::app) << decision;
+    return Segmenter(read_segmenter_spec(dir / "rule.yaml"), kPlugin).segment(cloud, true);
+  };
+  const Segmentation all = segment("");
+  ASSERT_EQ(all.confidence.size(), cloud.size());
+  std::size_t as_sure = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    as_sure += std::abs(all.confidence[i] - sure) < 1e-6;
+    EXPECT_TRUE(std::abs(all.confidence[i] - sure) < 1e-6 || std::abs(all.confidence[i] - other) < 1e-6)
+        << "point " << i << ": " << all.confidence[i];
+  }
+  EXPECT_GE(static_cast<double>(as_sure), 0.98 * static_cast<double>(cloud.size()));
+  EXPECT_EQ(all.labels, Segmenter(read_segmenter_spec(dir / "rule.yaml"), kPlugin).labels(cloud))
+      << "asking for the confidence changes no label";
+
+  const Segmentation below = segment("decision: {min_confidence: 0.12}\n");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(below.labels.begin(), below.labels.end(), cls::kUnlabeled)),
+            cloud.size() - as_sure)
+      << "the points the vote moved are left unlabeled, the others keep their class";
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (below.labels[i] != cls::kUnlabeled) {
+      EXPECT_EQ(below.labels[i], all.labels[i]) << "point " << i;
+    }
+  }
+  const Segmentation above = segment("decision: {min_confidence: 0.13}\n");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(above.labels.begin(), above.labels.end(), cls::kUnlabeled)), cloud.size())
+      << "no point is sure enough";
 }
 
 TEST(SegmenterPlugin, BrokenModelsAreErrorsNamingTheFile) {

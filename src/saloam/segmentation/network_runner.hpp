@@ -48,18 +48,30 @@ struct NetworkSpec {
   std::vector<float> logit_offsets;
 };
 
+/// What a network says about the pixels of a range image.
+struct PixelClasses {
+  /// Class of each pixel, row-major: the argmax of the logits plus the
+  /// spec's offsets over classes 1..K-1 (class 0, unlabeled, is never
+  /// predicted).
+  std::vector<std::int16_t> classes;
+  /// Empty unless asked for: the softmax probability of every class at every
+  /// pixel, pixel-major (K numbers per pixel, row-major pixels), of the
+  /// logits without the offsets (the offsets are a decision, not evidence).
+  std::vector<float> probabilities;
+};
+
 /// One loaded network. classify() is called from one thread at a time per
 /// runner; a runner computes on the calling thread only (one intra-op
 /// thread), so its output does not depend on how many runners work at once.
 class NetworkRunner {
  public:
   virtual ~NetworkRunner() = default;
-  /// Class of each pixel (argmax of the logits plus the spec's offsets over
-  /// classes 1..K-1: class 0, unlabeled, is never predicted) of a C x rows x cols image (channel-major
-  /// floats). Throws std::runtime_error with a short reason (shapes that do
-  /// not fit, a network that fails).
-  virtual std::vector<std::int16_t> classify(const std::vector<float>& image, int channels, int rows,
-                                             int cols) = 0;
+  /// The classes (and with `probabilities` the class probabilities) of every
+  /// pixel of a C x rows x cols image (channel-major floats). Throws
+  /// std::runtime_error with a short reason (shapes that do not fit, a
+  /// network that fails).
+  virtual PixelClasses classify(const std::vector<float>& image, int channels, int rows, int cols,
+                                bool probabilities = false) = 0;
 };
 
 }  // namespace saloam

@@ -12,6 +12,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
+#include "saloam/core/semantic_classes.hpp"
 #include "saloam/odometry/features.hpp"
 
 namespace saloam {
@@ -156,31 +157,69 @@ void Segmenter::check_beams(int beams) const {
                                              beam_list(spec_.beams), beams));
 }
 
-std::vector<std::uint16_t> Segmenter::labels(const LabelledCloud& cloud) const {
-  std::vector<std::uint16_t> out(cloud.size(), 0);
-  if (cloud.empty()) return out;
+std::vector<std::uint16_t> Segmenter::labels(const LabelledCloud& cloud) const { return segment(cloud, false).labels; }
+
+Segmentation Segmenter::segment(const LabelledCloud& cloud, bool confidence) const {
+  Segmentation out;
+  out.labels.assign(cloud.size(), cls::kUnlabeled);
+  if (cloud.empty()) {
+    if (confidence) out.confidence.assign(cloud.size(), 0.0f);
+    return out;
+  }
   PointRings rings;
   if (spec_.projection.row_mode == RowMode::kRing) rings = point_rings(cloud, ring_config_);
-  const std::vector<std::int16_t> point_class = output_classes(cloud, rings.ring, rings.beams);
+  const bool thresholded = spec_.min_confidence > 0.0;
+  PointClasses points = point_output(cloud, rings.ring, rings.beams, confidence || thresholded);
   const auto classes = static_cast<int>(spec_.classes.size());
-  for (std::size_t i = 0; i < cloud.size(); ++i)
-    if (point_class[i] > 0 && point_class[i] < classes) out[i] = spec_.classes[static_cast<std::size_t>(point_class[i])];
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const bool sure = !thresholded || points.confidence[i] >= spec_.min_confidence;
+    if (points.classes[i] > 0 && points.classes[i] < classes && sure)
+      out.labels[i] = spec_.classes[static_cast<std::size_t>(points.classes[i])];
+  }
+  if (confidence) out.confidence = std::move(points.confidence);
   return out;
 }
 
 std::vector<std::int16_t> Segmenter::output_classes(const LabelledCloud& cloud, const std::vector<std::int16_t>& rings,
                                                     int beams) const {
+  return point_output(cloud, rings, beams, false).classes;
+}
+
+namespace {
+
+/// The probability of each point's class at its own pixel (`probabilities`:
+/// pixel-major, `classes` per pixel); 0 for points without a pixel or class.
+std::vector<float> point_confidence(const RangeImage& image, const std::vector<float>& probabilities, int classes,
+                                    const std::vector<std::int16_t>& point_class) {
+  std::vector<float> confidence(point_class.size(), 0.0f);
+  for (std::size_t i = 0; i < point_class.size(); ++i) {
+    const std::int32_t pixel = image.point_pixel[i];
+    if (pixel < 0 || point_class[i] <= 0 || point_class[i] >= classes) continue;
+    confidence[i] = probabilities[static_cast<std::size_t>(pixel) * static_cast<std::size_t>(classes) +
+                                  static_cast<std::size_t>(point_class[i])];
+  }
+  return confidence;
+}
+
+}  // namespace
+
+Segmenter::PointClasses Segmenter::point_output(const LabelledCloud& cloud, const std::vector<std::int16_t>& rings,
+                                                int beams, bool confidence) const {
   check_beams(beams);
   const RangeImage image = project_scan(cloud, rings, beams, spec_.projection);
-  std::vector<std::int16_t> pixel_class;
+  PixelClasses pixels;
   try {
-    pixel_class = runner_->classify(image.data, image.channels, image.rows, image.cols);
+    pixels = runner_->classify(image.data, image.channels, image.rows, image.cols, confidence);
   } catch (const std::exception& e) {
     throw InputError(spec_.network.weights,
                      fmt::format("the network rejects a {}x{}x{} range image (made for another projection? see {}): {}",
                                  image.channels, image.rows, image.cols, spec_.file.string(), e.what()));
   }
-  return point_classes(image, pixel_class, point_ranges(cloud), static_cast<int>(spec_.classes.size()), spec_.knn);
+  const auto classes = static_cast<int>(spec_.classes.size());
+  PointClasses out;
+  out.classes = point_classes(image, pixels.classes, point_ranges(cloud), classes, spec_.knn);
+  if (confidence) out.confidence = point_confidence(image, pixels.probabilities, classes, out.classes);
+  return out;
 }
 
 }  // namespace saloam

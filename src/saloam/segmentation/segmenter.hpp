@@ -25,6 +25,19 @@ inline constexpr const char* kSegmentationPlugin = "libsaloam_segment_torch.so";
 /// without libtorch) or cannot be loaded.
 void load_segmentation_plugin(const std::filesystem::path& plugin);
 
+/// A segmented scan, one entry per point.
+struct Segmentation {
+  /// Raw SemanticKITTI class id; 0 (unlabeled) where the model's
+  /// decision.min_confidence is not reached.
+  std::vector<std::uint16_t> labels;
+  /// Empty unless asked for: how sure the network is of each point's class,
+  /// its softmax probability at the point's own pixel (0 for points without
+  /// a class). The kNN vote can give a point another class than its pixel's
+  /// (at boundaries): the probability of that class there is low, as it
+  /// should be.
+  std::vector<float> confidence;
+};
+
 class Segmenter {
  public:
   /// Opens the network of `spec` in the plugin at `plugin`. `rings` says how
@@ -43,6 +56,9 @@ class Segmenter {
   /// once. InputError naming the model when the scan does not fit it (beam
   /// count, or a network that rejects the image).
   [[nodiscard]] std::vector<std::uint16_t> labels(const LabelledCloud& cloud) const;
+  /// The labels and, with `confidence`, each point's confidence (the same
+  /// labels as labels()).
+  [[nodiscard]] Segmentation segment(const LabelledCloud& cloud, bool confidence) const;
   /// The network's class index (0 .. classes - 1, spec().classes names
   /// them) of every point, with the rings already known (ring projections).
   [[nodiscard]] std::vector<std::int16_t> output_classes(const LabelledCloud& cloud, const std::vector<std::int16_t>& rings,
@@ -52,6 +68,12 @@ class Segmenter {
 
  private:
   void check_beams(int beams) const;
+  struct PointClasses {
+    std::vector<std::int16_t> classes;  ///< the network's class index per point
+    std::vector<float> confidence;      ///< empty unless asked for
+  };
+  [[nodiscard]] PointClasses point_output(const LabelledCloud& cloud, const std::vector<std::int16_t>& rings, int beams,
+                                          bool confidence) const;
 
   SegmenterSpec spec_;
   FeatureConfig ring_config_;

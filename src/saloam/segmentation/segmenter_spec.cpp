@@ -187,8 +187,9 @@ std::string read_limited(const fs::path& file) {
 /// `decision:` of `spec`, whose classes are read: every key optional;
 /// class_bias names classes of the model's output (unlabeled excluded).
 void read_decision(const YAML::Node& node, const fs::path& file, SegmenterSpec& spec) {
-  const MapReader d(node, "decision", file, {"dynamic_bias", "class_bias"});
+  const MapReader d(node, "decision", file, {"dynamic_bias", "class_bias", "min_confidence"});
   if (d.has("dynamic_bias")) spec.dynamic_bias = d.number("dynamic_bias", 0.0, 20.0);
+  if (d.has("min_confidence")) spec.min_confidence = d.number("min_confidence", 0.0, 1.0);
   if (!d.has("class_bias")) return;
   std::set<std::string> names;
   for (const auto id : spec.classes) {
@@ -282,9 +283,10 @@ std::string segmenter_spec_yaml(const SegmenterSpec& spec, const fs::path& folde
   out << YAML::Key << "k" << YAML::Value << spec.knn.k << YAML::Key << "window" << YAML::Value << spec.knn.window;
   out << YAML::Key << "cutoff" << YAML::Value << spec.knn.cutoff << YAML::Key << "sigma" << YAML::Value << spec.knn.sigma;
   out << YAML::EndMap;
-  if (spec.dynamic_bias != 0.0 || !spec.class_bias.empty()) {
+  if (spec.dynamic_bias != 0.0 || !spec.class_bias.empty() || spec.min_confidence != 0.0) {
     out << YAML::Key << "decision" << YAML::Value << YAML::Flow << YAML::BeginMap;
     if (spec.dynamic_bias != 0.0) out << YAML::Key << "dynamic_bias" << YAML::Value << spec.dynamic_bias;
+    if (spec.min_confidence != 0.0) out << YAML::Key << "min_confidence" << YAML::Value << spec.min_confidence;
     if (!spec.class_bias.empty()) {
       out << YAML::Key << "class_bias" << YAML::Value << YAML::BeginMap;
       for (const auto& [id, bias] : spec.class_bias) out << YAML::Key << std::string(class_name(id)) << YAML::Value << bias;

@@ -19,7 +19,7 @@
 //     stds: [...]               # one per channel, > 0
 //   classes: semantickitti | [unlabeled, car, ...]   # output index -> class name
 //   knn: {k: 5, window: 5, cutoff: 1.0, sigma: 1.0}
-//   decision: {dynamic_bias: 0.0, class_bias: {building: 0.5}}   # optional, each key too
+//   decision: {dynamic_bias: 0.0, class_bias: {building: 0.5}, min_confidence: 0.0}   # optional, each key too
 //
 // Every value is range-checked; an error names the file and the key.
 
@@ -58,6 +58,10 @@ struct SegmenterSpec {
   /// while vegetation called building is mostly refused by the plane's
   /// orientation check (docs/segmentation.md, "The decision").
   std::vector<std::pair<std::uint16_t, double>> class_bias;
+  /// A point whose class the network gives a lower probability than this
+  /// (Segmentation::confidence) is left unlabeled (raw id 0): 0 labels every
+  /// point; self-training's teachers label only what they are sure of.
+  double min_confidence = 0.0;
 };
 
 /// One offset per output class of `spec` (the dynamic ones get

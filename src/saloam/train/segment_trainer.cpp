@@ -76,10 +76,10 @@ torch::Tensor lovasz_softmax(const torch::Tensor& logits, const torch::Tensor& t
 class TrainerRunner final : public NetworkRunner {
  public:
   explicit TrainerRunner(SegNet net) : net_(std::move(net)) {}
-  std::vector<std::int16_t> classify(const std::vector<float>& image, int channels, int rows, int cols) override {
+  PixelClasses classify(const std::vector<float>& image, int channels, int rows, int cols, bool probabilities) override {
     torch::NoGradGuard no_grad;
     net_->eval();
-    return best_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)));
+    return pixel_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)), {}, probabilities);
   }
 
  private:

@@ -148,8 +148,13 @@ torch::Tensor offsets_tensor(const std::vector<float>& offsets) {
   return offsets.empty() ? torch::Tensor() : torch::tensor(offsets, torch::kFloat32);
 }
 
-std::vector<std::int16_t> best_classes(torch::Tensor pixel_logits, const torch::Tensor& offsets) {
+PixelClasses pixel_classes(torch::Tensor pixel_logits, const torch::Tensor& offsets, bool probabilities) {
   torch::Tensor logits = pixel_logits.squeeze(0);
+  PixelClasses out;
+  if (probabilities) {
+    const auto p = torch::softmax(logits, 2).contiguous();
+    out.probabilities.assign(p.data_ptr<float>(), p.data_ptr<float>() + p.numel());
+  }
   if (offsets.defined()) {
     if (offsets.numel() != logits.size(2))
       throw std::runtime_error("logit offsets for " + std::to_string(offsets.numel()) + " classes, the network has " +
@@ -157,8 +162,8 @@ std::vector<std::int16_t> best_classes(torch::Tensor pixel_logits, const torch::
     logits.add_(offsets);
   }
   const auto best = (logits.slice(2, 1).argmax(2) + 1).to(torch::kInt16).contiguous();
-  const auto* p = best.data_ptr<std::int16_t>();
-  return {p, p + best.numel()};
+  out.classes.assign(best.data_ptr<std::int16_t>(), best.data_ptr<std::int16_t>() + best.numel());
+  return out;
 }
 
 std::string segnet_size_problem(const SegNetShape& shape, int64_t rows, int64_t cols) {

@@ -80,13 +80,15 @@ void load_segnet(SegNet& net, const std::string& file);
 /// tensor in channels-last layout (the fast one for CPU convolutions).
 torch::Tensor image_tensor(const std::vector<float>& image, int channels, int rows, int cols);
 /// The logit offsets of a model description (NetworkSpec::logit_offsets) as
-/// a tensor that best_classes adds; undefined when there are none.
+/// a tensor that pixel_classes adds; undefined when there are none.
 torch::Tensor offsets_tensor(const std::vector<float>& offsets);
-/// Class of every pixel, row-major, of logits [1, H, W, K]: the argmax of
-/// the logits plus `offsets` (undefined, or one per class) over classes
-/// 1..K-1 (class 0, unlabeled, is never predicted). The offsets are added
-/// in place: the logits are a network's output, used once.
-std::vector<std::int16_t> best_classes(torch::Tensor pixel_logits, const torch::Tensor& offsets = {});
+/// What logits [1, H, W, K] say of every pixel (row-major): the class, the
+/// argmax of the logits plus `offsets` (undefined, or one per class) over
+/// classes 1..K-1 (class 0, unlabeled, is never predicted), and with
+/// `probabilities` the softmax of the logits without the offsets. The
+/// offsets are added in place: the logits are a network's output, used once.
+PixelClasses pixel_classes(torch::Tensor pixel_logits, const torch::Tensor& offsets = {},
+                           bool probabilities = false);
 
 /// "rows must be a multiple of 4 ..." when an image of rows x cols does not
 /// fit `shape`; empty when it does.

@@ -65,7 +65,7 @@ class SegNetRunner final : public NetworkRunner {
     net_->fold_batch_norm();
   }
 
-  std::vector<std::int16_t> classify(const std::vector<float>& image, int channels, int rows, int cols) override {
+  PixelClasses classify(const std::vector<float>& image, int channels, int rows, int cols, bool probabilities) override {
     use_one_thread();
     const auto& shape = net_->shape();
     if (channels != shape.in_channels)
@@ -73,7 +73,7 @@ class SegNetRunner final : public NetworkRunner {
                                std::to_string(channels));
     if (const auto problem = segnet_size_problem(shape, rows, cols); !problem.empty()) throw std::runtime_error(problem);
     torch::NoGradGuard no_grad;
-    return best_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)), offsets_);
+    return pixel_classes(net_->pixel_logits(image_tensor(image, channels, rows, cols)), offsets_, probabilities);
   }
 
  private:
@@ -88,7 +88,7 @@ class TorchScriptRunner final : public NetworkRunner {
     module_.eval();
   }
 
-  std::vector<std::int16_t> classify(const std::vector<float>& image, int channels, int rows, int cols) override {
+  PixelClasses classify(const std::vector<float>& image, int channels, int rows, int cols, bool probabilities) override {
     use_one_thread();
     torch::NoGradGuard no_grad;
     torch::jit::IValue out = module_.forward({image_tensor(image, channels, rows, cols).contiguous()});
@@ -96,7 +96,7 @@ class TorchScriptRunner final : public NetworkRunner {
     if (!out.isTensor()) throw std::runtime_error("the network's forward() returns no tensor");
     const torch::Tensor logits = out.toTensor().to(torch::kFloat32);
     check_output(logits, classes_, rows, cols);
-    return best_classes(logits.permute({0, 2, 3, 1}), offsets_);
+    return pixel_classes(logits.permute({0, 2, 3, 1}), offsets_, probabilities);
   }
 
  private:
