@@ -13,8 +13,8 @@
 
 
 #include "saloam/core/semantic_classes.hpp"
-#include "saloam/odometry/parallel.hpp"
-#include "saloam/odometry/rings.hpp"
+#include "saloam/core/parallel.hpp"
+#include "saloam/scan/rings.hpp"
 
 namespace saloam {
 

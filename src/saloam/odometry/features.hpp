@@ -1,6 +1,6 @@
 #pragma once
-// LOAM feature extraction (paper Sec. III-B): ring assignment, azimuth
-// ordering, roughness (Eq. 1), rejection of unreliable points and the
+// LOAM feature extraction (paper Sec. III-B): on the rings of scan/rings.hpp,
+// azimuth ordering, roughness (Eq. 1), rejection of unreliable points and the
 // per-sector selection of edge and planar features. Each feature keeps its
 // semantic class so that matching can stay within a class.
 
@@ -13,6 +13,7 @@
 #include "saloam/core/config.hpp"
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/core/types.hpp"
+#include "saloam/scan/rings.hpp"
 
 namespace saloam {
 
@@ -49,24 +50,6 @@ struct ScanFeatures {
   FeatureCloud planars;
 };
 
-/// Vertical layout of a spinning LiDAR, used to assign rings from elevation.
-enum class BeamLayout { kHdl64, kHdl32, kVlp16 };
-
-/// Number of rings of a layout (64, 32, 16).
-int ring_count(BeamLayout layout);
-/// Layout from `num_beams` (64/32/16), or detected from the elevation range
-/// of the scan when num_beams is 0.
-BeamLayout detect_beam_layout(const std::vector<Eigen::Vector3f>& points, int num_beams);
-/// Ring of a point with elevation `elevation_deg`, or -1 outside the layout's
-/// field of view. The HDL-64E has two blocks with different spacing: upper
-/// +2.0..-8.33 deg at ~1/3 deg, lower -8.83..-24.9 deg at ~1/2 deg.
-int ring_from_elevation(double elevation_deg, BeamLayout layout);
-
-/// Time of a return within the sweep [s] from its azimuth, for a sensor that
-/// starts the sweep at `start_azimuth_deg` and turns clockwise seen from above
-/// (decreasing azimuth, as the Velodyne HDL-64E in KITTI) or counter-clockwise.
-double sweep_time_from_azimuth(double azimuth_rad, const FeatureConfig& config);
-
 /// Roughness of Eq. 1 for every point of one azimuth-ordered ring:
 /// c_i = || sum_{j in S} (X_j - X_i) ||^2 over `half_window` neighbours on each
 /// side, NOT normalised by |S| ||X_i||: this is the form of A-LOAM / F-LOAM,
@@ -98,26 +81,6 @@ RingSelection select_ring_features(const std::vector<Eigen::Vector3d>& ring,
                                    const std::vector<double>& roughness,
                                    const PointMask& unreliable, const FeatureConfig& config,
                                    const PointMask& not_edge = {});
-
-/// Rings from the storage order. The simulator writes a scan ring by ring in
-/// firing order (a ring ends where the sweep time jumps back); real KITTI
-/// stores each ring counter-clockwise from azimuth 0 whatever the firing
-/// order: when the sweep's own order does not split the scan into rings, the
-/// sense is read from the steps between consecutive points and the seam from
-/// the first point. Returns point indices per ring, or
-/// nothing when the order does not look like rings (then rings come from the
-/// elevation). expected_rings <= 0: unknown.
-std::vector<std::vector<std::uint32_t>> rings_from_point_order(const LabelledCloud& cloud,
-                                                              const FeatureConfig& config, int expected_rings);
-
-/// Point indices per ring (top ring first), each ring in azimuth order, as
-/// extract_features() finds them: from the ring field when the cloud has one
-/// (rings ordered by elevation), else from the storage order when the scan is
-/// stored ring by ring (and config.ring_from_point_order), else from the
-/// elevation angle: the nearest of config.beam_elevations_deg (the sensor
-/// profile's lasers) when given, else the layout of config.num_beams. Points
-/// in no ring (outside the field of view, invalid) are left out.
-std::vector<std::vector<std::uint32_t>> scan_rings(const LabelledCloud& cloud, const FeatureConfig& config);
 
 /// Poles and tree trunks: objects whose cross-section is a small disc.
 bool is_thin_round(std::uint16_t static_class_id);

@@ -9,7 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "saloam/core/semantic_classes.hpp"
-#include "saloam/odometry/parallel.hpp"
+#include "saloam/core/parallel.hpp"
 
 namespace saloam {
 

@@ -13,6 +13,7 @@
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
+#include "saloam/scan/rings.hpp"
 #include "saloam/segmentation/segmenter_spec.hpp"
 
 namespace saloam {
@@ -79,17 +80,5 @@ class Segmenter {
   FeatureConfig ring_config_;
   std::unique_ptr<NetworkRunner> runner_;
 };
-
-/// Ring of every point (-1 for none) and the sensor's number of rings: rings
-/// recovered as the odometry recovers them (odometry/features.hpp:
-/// scan_rings), numbered from the top; when fewer rings returned points than
-/// the sensor has (config.num_beams, else the smallest of 16, 32, 64, 128
-/// that holds them), the empty ones are placed by the elevation gaps between
-/// the rings found, or above the top one.
-struct PointRings {
-  std::vector<std::int16_t> ring;
-  int beams = 0;
-};
-PointRings point_rings(const LabelledCloud& cloud, const FeatureConfig& config);
 
 }  // namespace saloam

@@ -1,6 +1,7 @@
 #pragma once
-// The odometry's parallel loop shapes: independent indices, and sums whose
-// rounding does not depend on the number of threads.
+// Parallel loop shapes (TBB) whose output does not depend on the number of
+// threads: independent indices, and sums whose rounding is fixed. Header
+// only; a module that includes it links TBB (scan, odometry).
 
 #include <algorithm>
 #include <cstddef>

@@ -1,7 +1,6 @@
-// Rings from what a sensor says about its points (odometry/rings.hpp) and how
-// scan_rings()/extract_features() use them: the ring field first, a sensor
-// profile's laser elevations for scans not stored ring by ring, and the
-// points' own times for de-skewing.
+// Rings from what a sensor says about its points (scan/rings.hpp) and how
+// scan_rings() uses them: the ring field first, a sensor profile's laser
+// elevations for scans not stored ring by ring.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,8 +8,7 @@
 #include <random>
 
 #include "saloam/core/config.hpp"
-#include "saloam/odometry/features.hpp"
-#include "saloam/odometry/rings.hpp"
+#include "saloam/scan/rings.hpp"
 
 namespace saloam {
 namespace {
@@ -90,26 +88,6 @@ TEST(Rings, WithoutARingFieldTheProfilesLasersSortThePoints) {
   std::size_t kept = 0;
   for (const auto& r : rings) kept += r.size();
   EXPECT_EQ(kept, 4u);  // 17.5 and -20 are outside
-}
-
-TEST(Rings, PerPointTimesAreTheFeaturesSweepTimes) {
-  LabelledCloud cloud = shuffled_vlp16();
-  FeatureConfig config;
-  config.min_range = 1.0;
-  // The cloud's own times, shifted: the sweep model (azimuth) would say otherwise.
-  for (float& t : cloud.time) t -= 0.1f;
-  const ScanFeatures with_times = extract_features(cloud, config, false);
-  ASSERT_GT(with_times.planars.size(), 10u);
-  for (std::size_t i = 0; i < with_times.planars.size(); ++i) {
-    ASSERT_LE(with_times.planars.sweep_time[i], 0.0f);
-    ASSERT_GE(with_times.planars.sweep_time[i], -0.1f);
-  }
-  cloud.time.clear();
-  const ScanFeatures from_azimuth = extract_features(cloud, config, false);
-  ASSERT_EQ(from_azimuth.planars.size(), with_times.planars.size());
-  for (std::size_t i = 0; i < from_azimuth.planars.size(); ++i) {
-    ASSERT_NEAR(from_azimuth.planars.sweep_time[i], with_times.planars.sweep_time[i] + 0.1f, 1e-4) << i;
-  }
 }
 
 }  // namespace

@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include "saloam/segmentation/segmenter.hpp"
+#include "saloam/scan/rings.hpp"
 #include "saloam/sim/simulator.hpp"
 
 namespace saloam {

@@ -1,13 +1,12 @@
-// Rings of a scan (features.hpp: scan_rings, rings_from_point_order, the
-// beam layouts) and each point's time in the sweep.
+// Rings of a scan (rings.hpp: scan_rings, rings_from_point_order, the beam
+// layouts) and each point's time in the sweep.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
-#include "saloam/odometry/features.hpp"
-#include "saloam/odometry/parallel.hpp"
-#include "saloam/odometry/rings.hpp"
+#include "saloam/core/parallel.hpp"
+#include "saloam/scan/rings.hpp"
 
 namespace saloam {
 

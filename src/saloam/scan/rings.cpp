@@ -1,4 +1,4 @@
-#include "saloam/odometry/rings.hpp"
+#include "saloam/scan/rings.hpp"
 
 #include <algorithm>
 #include <cmath>
