@@ -56,9 +56,12 @@ class Segmenter:
     def __init__(self, model=None, projection=None, config=None):
         self._segmenter = _Segmenter(model or "", projection or "", config, _paths.PLUGIN_DIR + "/libsaloam_segment_torch.so")
 
-    def label(self, points, rings=None):
-        """Raw SemanticKITTI class id (uint32) of every point of points ((N, 3) or (N, 4))."""
-        return self._segmenter.label(points, rings)
+    def label(self, points, rings=None, confidence=False):
+        """Raw SemanticKITTI class id (uint32) of every point of points ((N, 3) or (N, 4)), as saloam segment
+        labels it. With confidence=True: (labels, confidence), confidence (float32) being the network's
+        probability of each point's class at its pixel of the range image (0 where a point has none); a
+        model's decision.min_confidence leaves the points below it unlabeled (0)."""
+        return self._segmenter.label(points, rings, confidence)
 
 
 def cli_path():

@@ -410,18 +410,21 @@ struct PySegmenter {
     segmenter = std::make_unique<Segmenter>(std::move(spec), plugin_path, config.odometry.features);
   }
 
-  py::array_t<std::uint32_t> label(const py::object& points, const py::object& rings) {
+  /// The labels, or (labels, confidence) with `confidence`.
+  py::object label(const py::object& points, const py::object& rings, bool confidence) {
     const LabelledCloud cloud = cloud_from_arrays(points, py::none(), py::none(), rings);
-    std::vector<std::uint16_t> labels;
+    Segmentation segmented;
     {
       py::gil_scoped_release release;
       std::lock_guard lock(mutex);
-      labels = segmenter->labels(cloud);
+      segmented = segmenter->segment(cloud, confidence);
     }
-    py::array_t<std::uint32_t> out(static_cast<py::ssize_t>(labels.size()));
-    auto m = out.mutable_unchecked<1>();
-    for (std::size_t i = 0; i < labels.size(); ++i) m(static_cast<py::ssize_t>(i)) = labels[i];
-    return out;
+    py::array_t<std::uint32_t> labels(static_cast<py::ssize_t>(segmented.labels.size()));
+    std::copy(segmented.labels.begin(), segmented.labels.end(), labels.mutable_data());
+    if (!confidence) return labels;
+    py::array_t<float> sure(static_cast<py::ssize_t>(segmented.confidence.size()));
+    std::copy(segmented.confidence.begin(), segmented.confidence.end(), sure.mutable_data());
+    return py::make_tuple(labels, sure);
   }
 };
 
@@ -622,7 +625,7 @@ paired by index. align: "se3", "sim3" or "none".)");
   py::class_<PySegmenter>(m, "_Segmenter")
       .def(py::init<const std::string&, const std::string&, const py::object&, const py::object&>(), "model"_a,
            "projection"_a, "config"_a, "plugin"_a)
-      .def("label", &PySegmenter::label, "points"_a, "rings"_a = py::none());
+      .def("label", &PySegmenter::label, "points"_a, "rings"_a = py::none(), "confidence"_a = false);
 
   m.def("write_trajectory",
         [](const py::object& path, const py::object& poses, const py::object& stamps, const std::string& format) {

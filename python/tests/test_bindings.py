@@ -198,6 +198,21 @@ def test_source_frames_and_options(sequence):
         saloam.open_source(sequence, frames="100:200")
 
 
+def test_segmenter_labels_as_saloam_segment_and_says_how_sure_it_is(sequence, tmp_path):
+    run_cli("-q", "segment", sequence, "--frames", "0:2", "--segment", "--out", tmp_path / "cli", "--no-score")
+    segmenter = saloam.Segmenter()
+    frame = saloam.open_source(sequence, semantics=False)[1]
+    labels = segmenter.label(frame.points)
+    cli = np.fromfile(tmp_path / "cli" / "000001.label", dtype=np.uint32)
+    np.testing.assert_array_equal(labels, cli)
+    again, confidence = segmenter.label(frame.points, confidence=True)
+    np.testing.assert_array_equal(again, labels)
+    assert confidence.dtype == np.float32 and confidence.shape == labels.shape
+    assert np.all((confidence >= 0) & (confidence <= 1))
+    # a probability among 19 classes: above 1/19 where the point keeps its pixel's class, and spread out
+    assert np.median(confidence) > 0.3 and np.percentile(confidence, 10) < np.percentile(confidence, 90)
+
+
 def test_docstrings():
     for item in (saloam.Odometry.register, saloam.open_source, saloam.Slam, saloam.eval, saloam.merge, saloam.config,
                  saloam.Map.localize, saloam.Segmenter):
