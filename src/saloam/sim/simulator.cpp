@@ -195,6 +195,7 @@ World world_for(const std::vector<Pose>& trajectory, const SimulationOptions& op
   WorldOptions world_options = options.world;
   world_options.frame_period = options.frame_period;
   world_options.sensor_height = sensor_mount_height(options);
+  if (options.camera_poses.empty() && preset_on_hillside(options.preset)) world_options.hillside = true;
   return build_world(trajectory, options.seed, world_options);
 }
 

@@ -1,8 +1,10 @@
 #include "saloam/sim/trajectories.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -78,8 +80,25 @@ double terrain_height(const Eigen::Vector2d& p) {
   return 1.6 * std::sin(p.x() / 95.0 + 0.4) + 1.1 * std::cos(p.y() / 70.0 - 0.3) + 0.4 * std::sin((p.x() + p.y()) / 40.0);
 }
 
-// Times the route with a curvature-limited speed profile and samples poses.
-std::vector<Pose> drive(const Route& route, double v_max, double frame_period) {
+// The road surface under a place of the route: its height, and how much it
+// rises per metre forward (the grade) and to the left (the cross-slope).
+struct Surface {
+  double height, grade, cross;
+};
+// The road surface at position p, heading dir, arc length s along the route.
+using Relief = std::function<Surface(const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double s)>;
+
+// The rolling hills as a road surface: slopes from the height a metre either side.
+Surface on_rolling_hills(const Eigen::Vector2d& p, const Eigen::Vector2d& dir, double) {
+  const Eigen::Vector2d left(-dir.y(), dir.x());
+  return {terrain_height(p), (terrain_height(p + dir) - terrain_height(p - dir)) / 2.0,
+          (terrain_height(p + left) - terrain_height(p - left)) / 2.0};
+}
+
+// Times the route with a curvature-limited speed profile and samples poses:
+// the LiDAR sensor_height above the road, pitched with its grade and rolled
+// with its cross-slope.
+std::vector<Pose> drive(const Route& route, double v_max, double frame_period, const Relief& relief = on_rolling_hills) {
   const std::size_t n = route.size();
   std::vector<double> s(n, 0.0), kappa(n, 0.0), v(n, v_max);
   for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (route[i] - route[i - 1]).norm();
@@ -113,14 +132,12 @@ std::vector<Pose> drive(const Route& route, double v_max, double frame_period) {
     Eigen::Vector2d dir = route[i1] - route[i0];
     dir.normalize();
     const double yaw = std::atan2(dir.y(), dir.x());
-    const Eigen::Vector2d left(-dir.y(), dir.x());
-    const double slope = (terrain_height(p + dir) - terrain_height(p - dir)) / 2.0;
-    const double cross = (terrain_height(p + left) - terrain_height(p - left)) / 2.0;
+    const Surface road = relief(p, dir, s[j] + a * (s[k] - s[j]));
     Pose T = Pose::Identity();
-    T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-std::atan(slope), Eigen::Vector3d::UnitY()) *
-                  Eigen::AngleAxisd(std::atan(cross), Eigen::Vector3d::UnitX()))
+    T.linear() = (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(-std::atan(road.grade), Eigen::Vector3d::UnitY()) *
+                  Eigen::AngleAxisd(std::atan(road.cross), Eigen::Vector3d::UnitX()))
                      .toRotationMatrix();
-    T.translation() = Eigen::Vector3d(p.x(), p.y(), terrain_height(p) + sensor_height);
+    T.translation() = Eigen::Vector3d(p.x(), p.y(), road.height + sensor_height);
     poses.push_back(orthonormalized(T));
   }
   // World = first LiDAR frame.
@@ -211,15 +228,130 @@ Route straight_road() {
   return smooth(route, 30);
 }
 
+// A mountain road (the "hill-climb" preset): 2.7 km that climbs about
+// 165 m in 1.6 km, over a crest down 80 m, through a sag and over a
+// second, lower crest down 15 m. Its plan has open curves and three hairpins whose legs
+// part at 30-40 degrees (a switchback's legs traverse the hillside).
+Route hill_climb_plan() {
+  Route r;
+  Turtle t{{0.0, 0.0}, 0.0};
+  r.push_back(t.pos);
+  t.straight(r, 180);
+  t.arc(r, 150, -0.6);
+  t.straight(r, 160);
+  t.arc(r, 90, 0.9);
+  t.straight(r, 120);
+  t.arc(r, 15, 2.6);  // left hairpin, 149 degrees
+  t.straight(r, 200);
+  t.arc(r, 15, -2.6);  // right hairpin
+  t.straight(r, 180);
+  t.arc(r, 120, 0.7);
+  t.straight(r, 200);
+  t.arc(r, 200, -0.5);
+  t.straight(r, 150);
+  t.arc(r, 16, -2.7);  // right hairpin, going down
+  t.straight(r, 220);
+  t.arc(r, 100, 0.8);
+  t.straight(r, 200);
+  t.arc(r, 140, -0.6);
+  t.straight(r, 420);
+  return wander(smooth(r, 30), 0.2, 150.0);
+}
+
+// The road of a route with a mountain road's profile, as a function of arc
+// length. Grades: constant stretches of 8-15 % (breakpoint, grade) joined by
+// vertical curves along which the grade changes linearly, 6 m per % of
+// change (40-160 m: a crest from +12 % to -11 % takes 138 m, a radius of
+// 600 m). Real mountain roads climb so: AASHTO's Green Book allows local
+// roads in mountainous terrain 14-18 % at low design speeds, and Alpine
+// passes hold 8-12 % for kilometres with ramps beyond (the Mortirolo
+// averages about 10.5 % over 12 km). Cross-slope: 2.5 % falling to the
+// right on straights (a one-way cross-fall for drainage), banked into the
+// curves up to 6 % (a common maximum superelevation, e_max, on roads with
+// snow and ice), the change spread over +-40 m of the curve's ends (the
+// superelevation runoff); the first 60 m are level so that the first
+// LiDAR frame, the world's frame, is level too.
+class MountainProfile {
+ public:
+  explicit MountainProfile(const Route& route) : s_(route.size(), 0.0), z_(route.size(), 0.0), cross_(route.size(), 0.0) {
+    const std::size_t n = route.size();
+    for (std::size_t i = 1; i < n; ++i) s_[i] = s_[i - 1] + (route[i] - route[i - 1]).norm();
+    for (std::size_t i = 1; i < n; ++i) z_[i] = z_[i - 1] + grade(0.5 * (s_[i] + s_[i - 1])) * (s_[i] - s_[i - 1]);
+    // Signed curvature (left positive) from points 3 m apart, then averaged
+    // over +-40 m.
+    const std::size_t w = 30, run = 400;
+    std::vector<double> kappa(n, 0.0), sum(n + 1, 0.0);
+    for (std::size_t i = w; i + w < n; ++i) {
+      const Eigen::Vector2d a = route[i] - route[i - w], b = route[i + w] - route[i];
+      const double cross = a.x() * b.y() - a.y() * b.x();
+      kappa[i] = 2.0 * cross / (a.norm() * b.norm() * (route[i + w] - route[i - w]).norm() + 1e-9);
+    }
+    for (std::size_t i = 0; i < n; ++i) sum[i + 1] = sum[i] + kappa[i];
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t a = i >= run ? i - run : 0, b = std::min(n, i + run + 1);
+      const double mean_kappa = (sum[b] - sum[a]) / static_cast<double>(b - a);
+      const double level = std::clamp((s_[i] - 30.0) / 30.0, 0.0, 1.0);  // level start, then in over 30 m
+      cross_[i] = level * std::clamp(0.025 - 7.0 * mean_kappa, -0.06, 0.06);
+    }
+  }
+
+  Surface operator()(const Eigen::Vector2d&, const Eigen::Vector2d&, double s) const {
+    return {at(z_, s), (at(z_, s + 1.0) - at(z_, s - 1.0)) / 2.0, at(cross_, s)};
+  }
+
+ private:
+  static double grade(double s) {
+    static constexpr std::array<std::pair<double, double>, 13> kGrades{{{0, 0.0},
+                                                                        {50, 0.09},
+                                                                        {380, 0.13},
+                                                                        {700, 0.15},
+                                                                        {900, 0.10},
+                                                                        {1080, 0.03},
+                                                                        {1180, 0.12},
+                                                                        {1560, -0.11},
+                                                                        {1900, -0.14},
+                                                                        {2150, -0.05},
+                                                                        {2300, 0.08},
+                                                                        {2480, -0.09},
+                                                                        {1e9, -0.09}}};
+    double g = kGrades.front().second;
+    for (std::size_t k = 1; k < kGrades.size(); ++k) {
+      const double change = kGrades[k].second - kGrades[k - 1].second;
+      const double length = std::clamp(600.0 * std::abs(change), 40.0, 160.0);
+      g += change * std::clamp((s - kGrades[k].first) / length + 0.5, 0.0, 1.0);
+    }
+    return g;
+  }
+  // Linear in arc length between route samples, clamped at the ends.
+  double at(const std::vector<double>& f, double s) const {
+    if (s <= s_.front()) return f.front();
+    if (s >= s_.back()) return f.back();
+    const std::size_t k = static_cast<std::size_t>(std::upper_bound(s_.begin(), s_.end(), s) - s_.begin());
+    const double a = (s - s_[k - 1]) / std::max(s_[k] - s_[k - 1], 1e-12);
+    return f[k - 1] + a * (f[k] - f[k - 1]);
+  }
+
+  std::vector<double> s_, z_, cross_;
+};
+
+std::vector<Pose> hill_climb(double frame_period) {
+  const Route route = hill_climb_plan();
+  const MountainProfile profile(route);
+  return drive(route, 12.0, frame_period, profile);
+}
+
 }  // namespace
 
-std::vector<std::string> preset_names() { return {"urban-loop", "figure-eight", "straight"}; }
+std::vector<std::string> preset_names() { return {"urban-loop", "figure-eight", "straight", "hill-climb"}; }
+
+bool preset_on_hillside(const std::string& name) { return name == "hill-climb"; }
 
 std::vector<Pose> preset_trajectory(const std::string& name, double frame_period) {
   if (frame_period <= 0) throw ConfigError("frame period must be positive");
   if (name == "urban-loop") return drive(urban_loop(), 11.0, frame_period);
   if (name == "figure-eight") return drive(figure_eight(), 11.5, frame_period);
   if (name == "straight") return drive(straight_road(), 10.0, frame_period);
+  if (name == "hill-climb") return hill_climb(frame_period);
   throw ConfigError(fmt::format("unknown preset '{}' (choose one of: {})", name, fmt::join(preset_names(), ", ")));
 }
 

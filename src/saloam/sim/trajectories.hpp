@@ -16,7 +16,16 @@ namespace saloam {
 ///  - "figure-eight": a figure eight with a crossing in the middle, a U-turn
 ///    and part of the route driven back in the opposite lane (reverse revisit).
 ///  - "straight": 400 m of gently curving road, no revisit (quick tests).
+///  - "hill-climb": 2.7 km of mountain road, no revisit: grades of 8-15 %,
+///    about 170 m of height range, two crests and a sag, three hairpins,
+///    cross-slopes of 2.5-6 % (issue #43).
 std::vector<std::string> preset_names();
+
+/// Whether the preset's road lies on a hillside whose ground the simulated
+/// world shapes from the poses (WorldOptions::hillside): true for
+/// "hill-climb". The other presets' roll comes from rolling hills that their
+/// worlds, built before, do not follow across the road.
+bool preset_on_hillside(const std::string& name);
 
 /// LiDAR poses of a preset at the given frame period. Throws ConfigError for
 /// an unknown name (the message lists the valid ones).

@@ -88,6 +88,18 @@ struct WorldOptions {
   double margin = 140.0;        ///< world extent beyond the path [m]
   double frame_period = 0.1;    ///< time between trajectory poses [s]
   bool dynamic_objects = true;
+  /// A road on a hillside (the "hill-climb" preset, preset_on_hillside):
+  /// across the road the ground tilts with each pose's roll (the road's
+  /// cross-slope, up to kHillsideBankWidth either side of the path), and
+  /// away from it, beyond kHillsideNear, it blends into the broad relief
+  /// (the heights averaged over some +-50 m) by kHillsideFar: between two
+  /// legs of a switchback at different heights the ground then slopes
+  /// instead of stepping where the nearer leg changes. Off, the ground
+  /// takes the height of the nearest path point everywhere, level across
+  /// the road (KITTI trajectories and the other presets: their worlds stay
+  /// as measured).
+  bool hillside = false;
+  static constexpr double kHillsideBankWidth = 12.0, kHillsideNear = 15.0, kHillsideFar = 45.0;  ///< [m]
 };
 
 /// Ground layout at one place, derived from the distance to the driven path.
@@ -104,6 +116,9 @@ struct WorldPath {
   std::vector<Eigen::Vector3d> points;
   std::vector<double> s;      ///< arc length of points[i] [m]
   std::vector<double> ego_s;  ///< arc length of trajectory pose i [m]
+  /// How much the ground rises per metre to the left of the path at
+  /// points[i], from the roll of the poses about it (WorldOptions::hillside).
+  std::vector<double> cross_slope;
 
   [[nodiscard]] double length() const { return s.empty() ? 0.0 : s.back(); }
   /// The point on the path at arc length `at` (clamped to the path): position

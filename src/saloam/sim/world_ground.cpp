@@ -14,16 +14,31 @@ namespace saloam {
 
 using namespace world_building;
 
+namespace {
+// How much the plane of a pose's x and y axes (the car's, seated on the
+// road) rises per metre horizontally to the left of its heading.
+double cross_slope_of(const Pose& pose) {
+  const Eigen::Vector3d up = pose.linear().col(2);
+  const Eigen::Vector3d forward = pose.linear().col(0);
+  const Eigen::Vector2d heading = forward.head<2>().norm() > 1e-9 ? Eigen::Vector2d(forward.head<2>().normalized()) : Eigen::Vector2d(1, 0);
+  const Eigen::Vector3d left(-heading.y(), heading.x(), 0.0);
+  return up.z() > 1e-3 ? -up.dot(left) / up.z() : 0.0;
+}
+}  // namespace
+
 void WorldBuilder::build_path(const std::vector<Pose>& trajectory) {
   const double h = options_.sensor_height;
   path_.ego_s.reserve(trajectory.size());
   double s = 0;
   Eigen::Vector3d prev = trajectory.front().translation() - Eigen::Vector3d(0, 0, h);
+  double prev_cross = cross_slope_of(trajectory.front());
   path_.points.push_back(prev);
   path_.s.push_back(0);
   path_.ego_s.push_back(0);
+  path_.cross_slope.push_back(prev_cross);
   for (std::size_t i = 1; i < trajectory.size(); ++i) {
     const Eigen::Vector3d p = trajectory[i].translation() - Eigen::Vector3d(0, 0, h);
+    const double cross = cross_slope_of(trajectory[i]);
     const double len = (p - prev).norm();
     if (len > kPassJump) {
       // The jump from one pass to the next (SimulationOptions::passes):
@@ -31,7 +46,9 @@ void WorldBuilder::build_path(const std::vector<Pose>& trajectory) {
       path_.points.push_back(p);
       path_.s.push_back(s);
       path_.ego_s.push_back(s);
+      path_.cross_slope.push_back(cross);
       prev = p;
+      prev_cross = cross;
       continue;
     }
     const int pieces = std::max(1, static_cast<int>(std::ceil(len / 0.5)));
@@ -40,11 +57,13 @@ void WorldBuilder::build_path(const std::vector<Pose>& trajectory) {
         const double a = static_cast<double>(k) / pieces;
         path_.points.push_back(prev + a * (p - prev));
         path_.s.push_back(s + a * len);
+        path_.cross_slope.push_back(prev_cross + a * (cross - prev_cross));
       }
     }
     s += len;
     path_.ego_s.push_back(s);
     prev = p;
+    prev_cross = cross;
   }
 }
 
@@ -163,12 +182,38 @@ void WorldBuilder::side_of_path(const std::vector<std::int32_t>& source, const s
 // level car, and passes its start again 6 m higher): no single ground lies
 // 1.73 m under every pose there, so the sensor keeps a physical clearance
 // above this ground (World::sensor_origin).
+//
+// On a hillside (WorldOptions::hillside) the road tilts across with the
+// poses' roll, and away from it the ground turns into the broad relief (see
+// there); the blurs are linear, so a steady grade or cross-slope passes
+// through them unchanged and the ground under the path stays the path's.
 void WorldBuilder::ground_heights(const std::vector<std::int32_t>& source, const std::vector<Eigen::Vector3d>& centres) {
   const std::size_t n = source.size();
+  const bool hillside = options_.hillside;
   ground_.height.resize(n);
-  for (std::size_t i = 0; i < n; ++i) ground_.height[i] = static_cast<float>(centres[static_cast<std::size_t>(source[i])].z());
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto k = static_cast<std::size_t>(source[i]);
+    double z = centres[k].z();
+    if (hillside && k < path_.cross_slope.size()) {  // a side street's centre lies beyond the path's points: level
+      const double bank = WorldOptions::kHillsideBankWidth;
+      z += std::clamp(static_cast<double>(ground_.lateral[i]), -bank, bank) * path_.cross_slope[k];
+    }
+    ground_.height[i] = static_cast<float>(z);
+  }
   box_blur(ground_.height, 4);
   box_blur(ground_.height, 4);
+  if (!hillside) return;
+  // Two boxes of +-25 cells: a triangle-like average over +-50 m.
+  std::vector<float> relief = ground_.height;
+  const int radius = static_cast<int>(std::lround(25.0 / options_.ground_cell));
+  box_blur(relief, radius);
+  box_blur(relief, radius);
+  const double near = WorldOptions::kHillsideNear, far = WorldOptions::kHillsideFar;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double u = std::clamp((ground_.distance[i] - near) / (far - near), 0.0, 1.0);
+    const double blend = u * u * (3.0 - 2.0 * u);
+    ground_.height[i] = static_cast<float>(ground_.height[i] + blend * (relief[i] - ground_.height[i]));
+  }
 }
 
 World::Zone WorldBuilder::street_layout(const Eigen::Vector2d& c) const {
