@@ -9,6 +9,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/sensor_profile.hpp"
 #include "saloam/sim/simulated_source.hpp"
+#include "saloam/sensors/pcap_reader.hpp"
 #include "saloam/sim/simulator.hpp"
 #include "saloam/sources/capture_replay.hpp"
 #include "saloam/sources/frame_queue.hpp"
@@ -151,6 +152,34 @@ TEST(LiveUdpSource, AReplayedCaptureGivesTheCapturesFramesPointForPoint) {
   EXPECT_EQ(stats.frames_served, recorded->size());
   EXPECT_EQ(stats.frames_dropped, 0U);
   EXPECT_EQ(stats.latency_ms.size(), recorded->size());
+}
+
+TEST(LiveUdpSource, AFrameThatLostAPacketIsDroppedWhole) {
+  testing::TempDir dir;
+  const auto capture = simulate_vlp16_capture(dir, 4);
+  SourceOptions options = vlp16_options(0.5);
+  options.metadata = dir / "vlp16.yaml";
+  LiveUdpSource live("udp://127.0.0.1:0", options);
+  {
+    // Every datagram but one in the second sweep (a VLP-16 sends 75 a sweep), at once: the receive buffer holds them.
+    PcapReader reader(capture);
+    const UdpSender sender(live.address());
+    UdpDatagram d;
+    for (std::size_t k = 0; reader.next(d); ++k) {
+      if (k != 110) sender.send(d.payload);
+    }
+  }
+  const auto recorded = open_source(capture, {});
+  std::vector<double> times;
+  while (auto frame = live.next_frame(times.size())) times.push_back(frame->time);
+  const StreamStats stats = *live.stream_stats();
+  EXPECT_EQ(stats.frames_made, recorded->size());
+  EXPECT_EQ(stats.frames_incomplete, 1U);
+  EXPECT_EQ(stats.frames_served, recorded->size() - 1);
+  EXPECT_NE(stats.packet_counts.find("about 1 missing"), std::string::npos) << stats.packet_counts;
+  // The frame left out is the second; the others are the capture's.
+  const std::vector<double>& all = recorded->info().times;
+  EXPECT_EQ(times, (std::vector<double>{all[0], all[2], all[3]}));
 }
 
 }  // namespace

@@ -103,10 +103,13 @@ struct StreamStats {
   std::size_t frames_served = 0;   ///< handed to the run
   std::size_t frames_dropped = 0;  ///< whole frames dropped because the run fell behind (queue full)
   std::size_t frames_out_of_order = 0;  ///< dropped because their time was not after the last one's
+  std::size_t frames_incomplete = 0;    ///< dropped whole because packets of theirs never arrived
   std::size_t frames_unread = 0;   ///< still queued when the run ended (Ctrl-C, frame limit)
   std::string ended_by;            ///< "idle for 2 s", "interrupted", "" while running
   /// [ms] from the packet that completed a frame to the run asking for the
-  /// next frame (its pose written), per served frame whose next was asked for.
+  /// next frame (its pose written; with --segment, the segmentation stage
+  /// asking, which it does ahead of the run), per served frame whose next
+  /// was asked for.
   std::vector<double> latency_ms;
 };
 

@@ -17,6 +17,7 @@ nlohmann::json stream_json(const StreamStats& s) {
                    {"frames_served", s.frames_served},
                    {"frames_dropped", s.frames_dropped},
                    {"frames_out_of_order", s.frames_out_of_order},
+                   {"frames_incomplete", s.frames_incomplete},
                    {"frames_unread", s.frames_unread},
                    {"ended_by", s.ended_by}};
   if (!s.latency_ms.empty()) {
@@ -47,9 +48,10 @@ void report_stream(const FrameSource& source, nlohmann::json& summary) {
   const std::optional<StreamStats> stats = source.stream_stats();
   if (!stats) return;
   const StreamStats& s = *stats;
-  spdlog::info("{}: {} frames made, {} run, {} dropped (the run fell behind), {} out of order, {} left unread; "
-               "ended by {}; {} datagrams ({}){}",
-               s.address, s.frames_made, s.frames_served, s.frames_dropped, s.frames_out_of_order, s.frames_unread,
+  spdlog::info("{}: {} frames made, {} run, {} dropped (the run fell behind), {} incomplete (packets lost), {} out "
+               "of order, {} left unread; ended by {}; {} datagrams ({}){}",
+               s.address, s.frames_made, s.frames_served, s.frames_dropped, s.frames_incomplete,
+               s.frames_out_of_order, s.frames_unread,
                s.ended_by.empty() ? "the run" : s.ended_by, s.packets, s.packet_counts, latency_text(s.latency_ms));
   summary["live"] = stream_json(s);
 }

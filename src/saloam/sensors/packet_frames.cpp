@@ -29,7 +29,9 @@ void OusterPacketFramer::emit(std::vector<PacketFrame>& done) {
   for (const OusterScan& scan : scans_) {
     const auto t0 = scan.first_valid_timestamp();
     if (!t0) continue;  // no valid column: no time, no point
-    done.push_back({ouster_cloud(scan, lut_, *t0, 1.0F), static_cast<double>(*t0) * 1e-9, scan.packets});
+    const std::size_t expected = metadata_.packets_per_frame();
+    done.push_back({ouster_cloud(scan, lut_, *t0, 1.0F), static_cast<double>(*t0) * 1e-9, scan.packets,
+                    expected > scan.packets ? expected - scan.packets : 0});
   }
   scans_.clear();
 }
@@ -71,7 +73,7 @@ void VelodynePacketFramer::finish(std::vector<PacketFrame>& done) {
 void VelodynePacketFramer::emit(std::vector<PacketFrame>& done) {
   for (VelodyneFrame& frame : frames_) {
     if (frame.cloud.empty()) continue;
-    done.push_back({std::move(frame.cloud), frame.time, frame.packets});
+    done.push_back({std::move(frame.cloud), frame.time, frame.packets, frame.missing_packets});
   }
   frames_.clear();
 }

@@ -30,6 +30,10 @@ struct PacketFrame {
   LabelledCloud cloud;  ///< sensor frame [m]; ring, per-point time [s] since `time`; remission 0..255
   double time = 0.0;    ///< [s] the sensor's clock
   std::size_t packets = 0;
+  /// Packets it lacks, as far as they tell: Velodyne, gaps in the packet
+  /// timestamps while it was filled; Ouster, the column window's packets
+  /// that did not come. Lost on the way, or in a receive buffer that overflowed.
+  std::size_t missing_packets = 0;
 };
 
 class PacketFramer {

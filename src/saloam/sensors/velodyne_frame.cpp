@@ -29,7 +29,9 @@ void VelodyneFrameAssembler::count_gap(double packet_us, bool dual) {
   const std::size_t blocks = decoder_.model() == VelodyneModel::kHdl64e ? kBlocks : (dual ? kBlocks / 2 : kBlocks);
   const double period = velodyne_block_offset_us(decoder_.model(), blocks);
   if (last_packet_us_ && period > 0 && packet_us - *last_packet_us_ > 1.5 * period) {
-    missing_packets_ += static_cast<std::size_t>(std::lround((packet_us - *last_packet_us_) / period)) - 1;
+    const auto missing = static_cast<std::size_t>(std::lround((packet_us - *last_packet_us_) / period)) - 1;
+    missing_packets_ += missing;
+    if (current_) current_->missing_packets += missing;  // the frame the gap fell in (or ended)
   }
   last_packet_us_ = packet_us;
 }

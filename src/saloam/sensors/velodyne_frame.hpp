@@ -26,6 +26,7 @@ struct VelodyneFrame {
   LabelledCloud cloud;  ///< remission 0..255 as sent, ring, time
   double time = 0.0;    ///< [s] the sensor's clock, unwrapped
   std::size_t packets = 0;
+  std::size_t missing_packets = 0;  ///< gaps in the packet timestamps while it was filled (see missing_packets())
 };
 
 class VelodyneFrameAssembler {

@@ -149,6 +149,7 @@ std::optional<StreamStats> LiveUdpSource::stream_stats() const {
     s.packet_counts = framer_->packet_counts();
     s.frames_made = frames_made_;
     s.frames_out_of_order = out_of_order_;
+    s.frames_incomplete = incomplete_;
   }
   s.frames_unread = queue_.queued();
   s.frames_dropped = queue_.dropped();
@@ -201,6 +202,10 @@ void LiveUdpSource::queue(std::vector<PacketFrame>& made) {
     {
       const std::lock_guard lock(stats_mutex_);
       ++frames_made_;
+      if (frame.missing_packets > 0) {  // never a partial frame: dropped whole
+        ++incomplete_;
+        continue;
+      }
       if (last_time_ && frame.time <= *last_time_) {
         ++out_of_order_;
         continue;

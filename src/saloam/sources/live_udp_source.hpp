@@ -14,7 +14,11 @@
 // through a bounded queue (sources/frame_queue.hpp) that drops the oldest
 // whole frame when the run falls behind, and counts it. A frame whose time
 // is not after the last queued one's (a sensor clock reset) is dropped and
-// counted too: the runs need increasing times.
+// counted too: the runs need increasing times; so is a frame that lacks
+// packets (PacketFrame::missing_packets: lost on the network, or in the
+// receive buffer when the receiver fell behind the sensor): a run never
+// gets part of a sweep. The first and last frames of a stream may still be
+// part sweeps, begun or ended mid-turn, as a capture's are.
 // The stream ends when no packet arrived for LiveOptions::idle_timeout_s
 // (the frame being filled is then finished and served), or on Ctrl-C (the
 // stop flag: queued frames are left unread). Times: the sensor's clock, as
@@ -91,6 +95,7 @@ class LiveUdpSource final : public FrameSource {
   std::size_t packets_ = 0;
   std::size_t frames_made_ = 0;
   std::size_t out_of_order_ = 0;
+  std::size_t incomplete_ = 0;
   std::optional<double> last_time_;
   // The run's side (a segmentation stage's workers ask from their threads).
   mutable std::mutex run_mutex_;
