@@ -84,7 +84,7 @@ std::optional<SourceFrame> SegmentedSource::take(std::size_t i) {
 
 LabelledCloud SegmentedSource::scan(std::size_t i) {
   std::optional<SourceFrame> frame = take(i);
-  if (!frame) throw std::out_of_range(fmt::format("{}: frame {} of {}", info_.name, i, *end_));
+  if (!frame) throw std::out_of_range(fmt::format("{}: frame {} is past the last frame", info_.name, i));
   return std::move(frame->cloud);
 }
 

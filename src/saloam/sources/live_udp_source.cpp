@@ -87,23 +87,27 @@ LiveUdpSource::LiveUdpSource(const std::string& url, const SourceOptions& option
   framer_ = live_packet_framer(url, options, notes);
   intensity_ = choose_intensity_scale(options.intensity_scale, ScalarType::kUint8, {});
   if (!options.intensity_scale) intensity_.how = framer_->intensity_field();
-  const std::string address = receiver_.address().url();
-  info_.name = address;
+  describe(std::move(notes));
+  spdlog::info("listening on {} (receive buffer {:.1f} MiB, as the kernel reports it)", info_.name,
+               receiver_.buffer_bytes() / 1048576.0);
+  thread_ = std::thread([this] { receive_loop(); });
+}
+
+void LiveUdpSource::describe(std::vector<std::string> notes) {
+  info_.name = receiver_.address().url();
   info_.format = "udp";
   info_.live = true;
   info_.rereadable = false;
   info_.point_fields = framer_->point_fields();
-  info_.notes = notes;
-  info_.notes.push_back(fmt::format("listening: {}, receive buffer {:.1f} MiB (granted), idle timeout {}, queue of {} "
-                                    "frames (the oldest dropped when the run falls behind)",
-                                    address, receiver_.buffer_bytes() / 1048576.0,
+  info_.notes = std::move(notes);
+  info_.notes.push_back(fmt::format("listening: {}, receive buffer {:.1f} MiB (as the kernel reports it), idle "
+                                    "timeout {}, queue of {} frames (the oldest dropped when the run falls behind)",
+                                    info_.name, receiver_.buffer_bytes() / 1048576.0,
                                     options_.idle_timeout_s > 0 ? fmt::format("{:g} s", options_.idle_timeout_s)
                                                                 : std::string("none"),
                                     options_.queue_frames));
   info_.notes.push_back(intensity_.note());
   info_.notes.emplace_back("extrinsics: none (a live source runs in the LiDAR frame)");
-  spdlog::info("listening on {} (receive buffer {:.1f} MiB)", address, receiver_.buffer_bytes() / 1048576.0);
-  thread_ = std::thread([this] { receive_loop(); });
 }
 
 LiveUdpSource::~LiveUdpSource() { close_stream(); }

@@ -32,6 +32,7 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "saloam/io/frame_source.hpp"
 #include "saloam/io/intensity_scale.hpp"
@@ -71,6 +72,8 @@ class LiveUdpSource final : public FrameSource {
   [[nodiscard]] const UdpAddress& address() const { return receiver_.address(); }
 
  private:
+  /// info_: the address, the sensor's `notes`, the fields, what the receiver and queue are.
+  void describe(std::vector<std::string> notes);
   void receive_loop();
   /// The datagrams waiting (up to kDrainLimit) through the framer, each
   /// frame queued as soon as made; true when any came.
