@@ -170,7 +170,8 @@ TEST_F(LiveCli, AtTenXWholeFramesAreDroppedAndCountedAndTheKeptOnesFollowTheCapt
   const auto [translation, rotation] =
       kept_frames_difference(kept, read_tum_trajectory(file_run() / "poses_tum.txt"));
   std::cout << fmt::format("kept frames against the file run's: up to {:.3f} m, {:.3f} deg\n", translation, rotation);
-  // Measured: 3-5 cm and under 0.3 deg over the 21 m, the gaps' motion predicted from the frame times.
+  // Measured over four runs: 6-8 of 30 dropped, kept frames 4.9-5.1 cm and 0.11-0.20 deg from the file run's
+  // over the 21 m (the gaps' motion predicted from the frame times).
   EXPECT_LT(translation, 0.10);
   EXPECT_LT(rotation, 0.5);
 }
