@@ -110,6 +110,7 @@ const CommandRegistration kRegistration{Command{
       app.add_option("--model", options->model, "SGPR weights (.sgw) when the map's detector uses SGPR")
           ->check(CLI::ExistingFile);
       add_no_calib_flag(app, options->source.no_calib);
+      options->source.add_live_to(app);
       options->config.add_to(app);
       return [options] { return run_localize_command(*options); };
     }}};

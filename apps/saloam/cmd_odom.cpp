@@ -52,6 +52,7 @@ const CommandRegistration kRegistration{Command{
       app.add_flag("--no-semantics", options->no_semantics,
                    "Label-agnostic run with plain voxel grid (FLOAM-like baseline)");
       add_no_calib_flag(app, options->source.no_calib);
+      options->source.add_live_to(app);
       options->config.add_to(app);
       return [options] { return run_odom(*options); };
     }}};

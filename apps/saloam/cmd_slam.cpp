@@ -141,6 +141,7 @@ const CommandRegistration kRegistration{Command{
                      "runs with the map's configuration")
           ->check(CLI::ExistingDirectory);
       add_no_calib_flag(app, options->source.no_calib);
+      options->source.add_live_to(app);
       options->config.add_to(app);
       return [options] { return run_slam_command(*options); };
     }}};

@@ -20,6 +20,7 @@
 #include "saloam/io/intensity_scale.hpp"
 #include "saloam/place/place_recognizer.hpp"
 #include "saloam/sources/open_source.hpp"
+#include "saloam/sources/udp_socket.hpp"
 #include "saloam/sources/sensor_guess.hpp"
 
 namespace saloam::cli {
@@ -258,6 +259,24 @@ void SourceArgs::add_to(CLI::App& app, const std::string& path_help) {
   segment.add_to(app);
 }
 
+void SourceArgs::add_live_to(CLI::App& app) {
+  accepts_live = true;
+  CLI::Option* source = app.get_option("SEQ_DIR");
+  source->description(source->get_description() +
+                      "; or udp://[ADDRESS]:PORT: a sensor's packets as they arrive (--sensor vlp16|hdl32e|hdl64e, "
+                      "or an Ouster's --metadata META.json)");
+  app.add_option("--idle-timeout", idle_timeout_s,
+                 "A live source (SEQ_DIR udp://[ADDRESS]:PORT): end when no packet arrived for this many seconds "
+                 "(from the start too; 0: only Ctrl-C or --frames end it)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--queue", queue_frames,
+                 "A live source: frames held for a run that falls behind; beyond, the oldest whole frame is dropped "
+                 "and counted")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1000}))
+      ->capture_default_str();
+}
+
 void SourceArgs::add_with_no_calib_to(CLI::App& app) {
   add_to(app, "A SemanticKITTI sequence folder");
   add_no_calib_flag(app, no_calib);
@@ -276,12 +295,16 @@ SourceOptions source_options(const SourceArgs& args, bool ignore_labels) {
   options.ignore_labels = ignore_labels;
   options.ignore_calib = args.no_calib;
   options.frames = FrameRange::parse(args.frames);
+  options.live.sensor = args.sensor;
+  options.live.idle_timeout_s = args.idle_timeout_s;
+  options.live.queue_frames = args.queue_frames;
   return options;
 }
 }  // namespace
 
 PathRules& SourceArgs::add_inputs(PathRules& rules) const {
-  return rules.input("SEQ_DIR", path).input("--labels", labels).input("--metadata", metadata);
+  if (!is_udp_url(path)) rules.input("SEQ_DIR", path);  // an address: no file an output could replace
+  return rules.input("--labels", labels).input("--metadata", metadata);
 }
 
 std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& config, SensorChoice* chosen) const {
@@ -289,6 +312,11 @@ std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& 
     throw ConfigError("--segment labels the scans, but this run does not use labels (--no-semantics, or a label-free "
                       "method): leave out one of them");
   if (segment.enabled() && !labels.empty()) throw ConfigError("give --labels DIR or --segment, not both");
+  if (is_udp_url(path) && !accepts_live) {
+    throw ConfigError(fmt::format("{}: a live source is run by odom, slam and localize; record it to read it here "
+                                  "(tcpdump -w CAPTURE.pcap udp port PORT)",
+                                  path));
+  }
   SourceOptions options = source_options(*this, ignore_labels);
   options.segmentation = segment.stage(config);  // checks the model before anything is read
   auto reader = open_reader(path, options);

@@ -17,6 +17,7 @@
 #include "saloam/core/sensor_profile.hpp"
 #include "saloam/segmentation/segmented_source.hpp"
 #include "saloam/io/frame_source.hpp"
+#include "saloam/sources/source_options.hpp"
 
 namespace saloam::cli {
 
@@ -102,7 +103,14 @@ struct SourceArgs {
   std::string frames;
   bool no_calib = false;
   SegmentOptions segment;  ///< --segment, --segmenter, --projection
+  /// A live source (SEQ_DIR udp://[ADDRESS]:PORT) is taken: set by add_live_to().
+  bool accepts_live = false;
+  double idle_timeout_s = LiveOptions{}.idle_timeout_s;  ///< --idle-timeout
+  std::size_t queue_frames = LiveOptions{}.queue_frames;  ///< --queue
   void add_to(CLI::App& app, const std::string& path_help);
+  /// The live source's options (--idle-timeout, --queue) of the commands
+  /// that run on one as it comes (odom, slam, localize); others refuse udp://.
+  void add_live_to(CLI::App& app);
   /// add_to() and --no-calib for the commands that take a source as it is
   /// (info, convert): SEQ_DIR is "A SemanticKITTI sequence folder" or any
   /// other layout.

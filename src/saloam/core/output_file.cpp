@@ -156,6 +156,24 @@ void AtomicFile::commit() {
   record_output(file_);
 }
 
+GrowingFile::GrowingFile(std::filesystem::path file) : file_(std::move(file)) {
+  create_parent_folder(file_);
+  const int fd = ::open(file_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw InputError(file_, "cannot create: " + reason(errno));
+  out_ = std::make_unique<CheckedFileStream>(fd, file_);
+}
+
+std::ostream& GrowingFile::stream() { return out_->stream(); }
+
+void GrowingFile::flush() { out_->flush(); }
+
+void GrowingFile::commit() {
+  if (committed_) return;
+  out_->close();
+  committed_ = true;
+  record_output(file_);
+}
+
 void write_file_atomically(const std::filesystem::path& file, std::string_view bytes) {
   AtomicFile out(file);
   out.stream().write(bytes.data(), static_cast<std::streamsize>(bytes.size()));

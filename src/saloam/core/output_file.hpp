@@ -40,10 +40,23 @@ class CheckedFileStream {
   std::unique_ptr<Impl> impl_;
 };
 
+/// A file a run writes as it goes: AtomicFile (in place once complete) or
+/// GrowingFile (in place from the start, for a reader that follows it).
+class OutputFile {
+ public:
+  virtual ~OutputFile() = default;
+  virtual std::ostream& stream() = 0;
+  /// Writes what is buffered into the file; InputError on a failed write.
+  virtual void flush() = 0;
+  /// The file finished: closed, in place and recorded with the output
+  /// folder that holds it (output_folder.hpp); InputError naming it on any failure.
+  virtual void commit() = 0;
+};
+
 /// A file written under a temporary name and renamed into place by commit().
 /// Destroyed without commit() (an exception, a failed run), the temporary is
 /// removed and the final name is untouched.
-class AtomicFile {
+class AtomicFile final : public OutputFile {
  public:
   /// Creates the parent folder and the temporary file; InputError naming
   /// `file` when either cannot be created.
@@ -52,16 +65,16 @@ class AtomicFile {
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
 
-  std::ostream& stream();
+  std::ostream& stream() override;
   /// Writes what is buffered into the temporary file (a file written as a run
   /// goes, e.g. pose lines, so that a crash leaves them under the temporary
   /// name); InputError on a failed write.
-  void flush();
+  void flush() override;
   /// Flushes, closes and renames the temporary file to the final name;
   /// InputError naming the final file on any failure (the temporary is then
   /// removed). Records the file with the output folder that holds it
   /// (output_folder.hpp).
-  void commit();
+  void commit() override;
 
   [[nodiscard]] const std::filesystem::path& file() const { return file_; }
   [[nodiscard]] const std::filesystem::path& temporary() const { return temporary_; }
@@ -69,6 +82,25 @@ class AtomicFile {
 
  private:
   std::filesystem::path file_, temporary_;
+  std::unique_ptr<CheckedFileStream> out_;
+  bool committed_ = false;
+};
+
+/// A file written under its final name from the start, each flush() putting
+/// the lines written so far there: what another process can follow as it
+/// grows (a live run's poses, `tail -f`). Unlike AtomicFile it is not
+/// removed when the run fails: a live run's frames cannot be read again, so
+/// what it made is kept. Replaces an earlier file of that name.
+class GrowingFile final : public OutputFile {
+ public:
+  /// Creates (or empties) `file` and its parent folder; InputError naming it when it cannot.
+  explicit GrowingFile(std::filesystem::path file);
+  std::ostream& stream() override;
+  void flush() override;
+  void commit() override;
+
+ private:
+  std::filesystem::path file_;
   std::unique_ptr<CheckedFileStream> out_;
   bool committed_ = false;
 };

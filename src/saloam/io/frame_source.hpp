@@ -18,6 +18,12 @@
 //  - a rereadable source serves any frame, any number of times, in any
 //    order; a stream (rereadable false) serves frames 0, 1, 2, ... once
 //    each, in that order (std::logic_error otherwise);
+//  - a live source (info().live: frames made as a sensor's packets arrive)
+//    knows neither its frames nor their times beforehand: info().times is
+//    empty, and it serves its frames only through next_frame(), which waits
+//    for the next one and says when the stream ended; stream_stats() counts
+//    what it received, served and dropped. Runs read every source through
+//    next_frame(), so that they take both kinds;
 //  - velo_to_cam, camera_poses and sensor_camera_poses are there when known;
 //    pose lists hold one pose per frame, not re-based: in the KITTI camera
 //    convention of poses.txt (P_i = Tr Q_i Tr^-1) when velo_to_cam is known,
@@ -48,6 +54,7 @@ struct SourceInfo {
   std::vector<double> times;   ///< [s] one per frame, increasing
   bool has_labels = false;     ///< scans carry per-point classes
   bool rereadable = true;      ///< false: a stream (see above)
+  bool live = false;           ///< frames arrive as the run goes (see above): times empty, size() 0
   std::optional<Pose> velo_to_cam;                ///< Tr, velodyne to camera 0, when known
   /// Reference poses (poses.txt; a KITTI raw drive's GPS/INS), when known; frame as said above.
   std::optional<std::vector<Pose>> camera_poses;
@@ -81,6 +88,31 @@ struct SourceStageTimes {
   std::vector<StageTime> per_frame;
 };
 
+/// A frame with its time, as next_frame() serves it.
+struct SourceFrame {
+  LabelledCloud cloud;
+  double time = 0.0;  ///< [s]
+};
+
+/// What a live source received and did with it, for the run's log and summary.
+struct StreamStats {
+  std::string address;             ///< where it listened: "udp://0.0.0.0:7502"
+  std::size_t packets = 0;         ///< datagrams received
+  std::string packet_counts;       ///< the decoder's: "1234 data packets, 0 malformed, ..."
+  std::size_t frames_made = 0;     ///< whole frames assembled from the packets
+  std::size_t frames_served = 0;   ///< handed to the run
+  std::size_t frames_dropped = 0;  ///< whole frames dropped because the run fell behind (queue full)
+  std::size_t frames_out_of_order = 0;  ///< dropped because their time was not after the last one's
+  std::size_t frames_incomplete = 0;    ///< dropped whole because packets of theirs never arrived
+  std::size_t frames_unread = 0;   ///< still queued when the run ended (Ctrl-C, frame limit)
+  std::string ended_by;            ///< "idle for 2 s", "interrupted", "" while running
+  /// [ms] from the packet that completed a frame to the run asking for the
+  /// next frame (its pose written; with --segment, the segmentation stage
+  /// asking, which it does ahead of the run), per served frame whose next
+  /// was asked for.
+  std::vector<double> latency_ms;
+};
+
 class FrameSource {
  public:
   virtual ~FrameSource() = default;
@@ -90,6 +122,17 @@ class FrameSource {
   /// The times of the stages that prepared the frames served so far (a
   /// stage adds its own to those of the source it wraps); none for a reader.
   [[nodiscard]] virtual std::vector<SourceStageTimes> stage_times() const { return {}; }
+  /// Frame i with its time, i being the number of frames read so far
+  /// through it; none when the source has no frame i: i >= size() for a
+  /// recorded source, the stream ended for a live one (no packet within its
+  /// idle timeout, or Ctrl-C). The default serves scan(i) and info().times[i].
+  virtual std::optional<SourceFrame> next_frame(std::size_t i);
+  /// A live source's counts (a stage passes its source's on); none otherwise.
+  [[nodiscard]] virtual std::optional<StreamStats> stream_stats() const { return std::nullopt; }
+  /// No frame will be asked for any more (a frame limit reached): a live
+  /// source stops receiving, so that its counts are final (frames after the
+  /// limit are not counted as dropped). Nothing for other sources.
+  virtual void close_stream() {}
 
   [[nodiscard]] std::size_t size() const { return info().size(); }
 };
@@ -104,11 +147,18 @@ class FrameRangeSource final : public FrameSource {
 
   [[nodiscard]] const SourceInfo& info() const override { return info_; }
   LabelledCloud scan(std::size_t i) override;
+  /// Over a live source: its frames first .. end-1 as they come (the
+  /// frames before `first` read and dropped), then none: `--frames 0:N` is
+  /// a live run's frame limit.
+  std::optional<SourceFrame> next_frame(std::size_t i) override;
   [[nodiscard]] std::vector<SourceStageTimes> stage_times() const override { return inner_->stage_times(); }
+  [[nodiscard]] std::optional<StreamStats> stream_stats() const override { return inner_->stream_stats(); }
+  void close_stream() override { inner_->close_stream(); }
 
  private:
   std::unique_ptr<FrameSource> inner_;
   std::size_t first_ = 0;
+  std::size_t end_ = 0;  ///< exclusive
   std::size_t dropped_ = 0;  ///< a stream's frames before first_ read so far
   SourceInfo info_;
 };

@@ -19,6 +19,7 @@
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
+#include "saloam/runs/stream_report.hpp"
 #include "saloam/runs/session_eval.hpp"
 #include "saloam/runs/timing_report.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
@@ -119,16 +120,18 @@ namespace {
 // frames' poses written as they come; returns the loop's wall time [s].
 double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWriter& writer, bool show_progress) {
   const SourceInfo& info = source.info();
-  ProgressBar progress(info.size(), "localize", show_progress);
+  ProgressBar progress(info.size(), "localize", show_progress && !info.live);
   const StageTimer timer;
-  for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
-    const LabelledCloud scan = source.scan(i);
-    const LocalizedFrame& f = localizer.process(scan, info.times.at(i));
+  for (std::size_t i = 0; !stop_requested(); ++i) {
+    const std::optional<SourceFrame> frame = source.next_frame(i);
+    if (!frame) break;
+    const LocalizedFrame& f = localizer.process(frame->cloud, frame->time);
     if (f.status != LocalizationStatus::kUnplaced) writer.write(f.timestamp, f.pose);
     progress.set_status(fmt::format("{}, {:.0f} ms", localization_status_name(f.status), f.timing.total_ms()));
     progress.advance();
   }
   progress.finish();
+  end_live_stream(info);
   return timer.elapsed_s();
 }
 
@@ -272,7 +275,7 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
   if (config.odometry.use_semantics && !info.has_labels) warn_no_labels(info);
   OutputFolder folder = open_run_folder(out_dir, info.folder, "localize", kLocalizeOutputs);
   const std::optional<Pose> tr = output_velo_to_cam(info);
-  TrajectoryWriter writer(folder / "poses.txt", folder / "poses_tum.txt", tr);
+  TrajectoryWriter writer(folder / "poses.txt", folder / "poses_tum.txt", tr, info.live);
 
   Localizer localizer(config, map, std::move(network));
   LocalizeRunResult result;
@@ -302,7 +305,9 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
   write_relocalizations_csv(folder / "relocalizations.csv", localizer, truth_ptr, options);
   write_file_atomically(folder / "timing.json",
                         localize_timing_json(frames, total, frame_summary, result, map).dump(2) + '\n');
-  write_run_summary(folder, localize_summary_json(info, map, result));
+  nlohmann::json summary = localize_summary_json(info, map, result);
+  report_stream(source, summary);
+  write_run_summary(folder, summary);
   result.interrupted = stop_requested();
   result.files = folder.files();
   return result;

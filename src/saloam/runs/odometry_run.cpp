@@ -9,6 +9,7 @@
 #include "saloam/core/output_file.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/runs/output_folder.hpp"
+#include "saloam/runs/stream_report.hpp"
 #include "saloam/runs/timing_report.hpp"
 
 namespace saloam {
@@ -44,8 +45,8 @@ void warn_no_labels(const SourceInfo& info) {
 }
 
 OdometryRun::OdometryRun(const OdometryConfig& config, const std::filesystem::path& out_dir,
-                         std::optional<Pose> velo_to_cam)
-    : odometry_(config), writer_(out_dir / "poses.txt", out_dir / "poses_tum.txt", velo_to_cam) {
+                         std::optional<Pose> velo_to_cam, bool growing)
+    : odometry_(config), writer_(out_dir / "poses.txt", out_dir / "poses_tum.txt", velo_to_cam, growing) {
   result_.camera_frame = velo_to_cam.has_value();
 }
 
@@ -112,20 +113,25 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
   if (config.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
   OutputFolder folder = open_run_folder(out_dir, info.folder, "odom", kOdometryOutputs);
-  OdometryRun run(config, out_dir, tr);
-  ProgressBar progress(info.size(), options.progress_label, options.show_progress);
-  for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
-    run.add(source.scan(i), info.times.at(i), info.first_frame + i);
+  OdometryRun run(config, out_dir, tr, info.live);
+  ProgressBar progress(info.size(), options.progress_label, options.show_progress && !info.live);
+  for (std::size_t i = 0; !stop_requested(); ++i) {
+    std::optional<SourceFrame> frame = source.next_frame(i);
+    if (!frame) break;
+    run.add(frame->cloud, frame->time, info.first_frame + i);
     progress.set_status(fmt::format("{:.0f} ms", run.odometry().timings().back().total_ms()));
     progress.advance();
   }
   progress.finish();
+  end_live_stream(info);
   run.commit();
   OdometryRunResult result = run.result();
   result.timings = run.odometry().timings();
   result.interrupted = stop_requested();
   write_timing_json(out_dir / "timing.json", result.timings, source.stage_times());
-  write_run_summary(folder, odometry_summary(info, config, result));
+  nlohmann::json summary = odometry_summary(info, config, result);
+  report_stream(source, summary);
+  write_run_summary(folder, summary);
   result.files = folder.files();
   return result;
 }

@@ -69,7 +69,9 @@ struct OdometryRunResult {
 /// feeds it the same scans (the demo's label-agnostic baseline beside its SLAM).
 class OdometryRun {
  public:
-  OdometryRun(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> velo_to_cam);
+  /// `growing`: pose files written in place as they grow (a live source's run, TrajectoryWriter).
+  OdometryRun(const OdometryConfig& config, const std::filesystem::path& out_dir, std::optional<Pose> velo_to_cam,
+              bool growing = false);
   /// Registers the next scan and writes its pose; false when the
   /// registration failed (too few correspondences: the prediction was kept).
   /// Failures and degenerate frames are counted and warned about, named by

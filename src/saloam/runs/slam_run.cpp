@@ -22,6 +22,7 @@
 #include "saloam/runs/map_building.hpp"
 #include "saloam/runs/odometry_run.hpp"
 #include "saloam/runs/output_folder.hpp"
+#include "saloam/runs/stream_report.hpp"
 #include "saloam/runs/timing_report.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/viz/canvas.hpp"
@@ -282,11 +283,13 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
                       std::optional<MapScanStore>& map_scans, const SlamRunOptions& options,
                       RegistrationHealth& health) {
   const SourceInfo& info = source.info();
-  ProgressBar progress(info.size(), "slam", options.show_progress);
+  ProgressBar progress(info.size(), "slam", options.show_progress && !info.live);
   const StageTimer timer;
-  for (std::size_t i = 0; i < info.size() && !stop_requested(); ++i) {
-    const LabelledCloud scan = source.scan(i);
-    const double t = info.times.at(i);
+  for (std::size_t i = 0; !stop_requested(); ++i) {
+    std::optional<SourceFrame> frame = source.next_frame(i);
+    if (!frame) break;
+    const LabelledCloud& scan = frame->cloud;
+    const double t = frame->time;
     odometry_writer.write(t, slam.process(scan, t));
     health.note(slam.odometry(), info.first_frame + i);
     if (options.on_scan) options.on_scan(i, scan, t);
@@ -295,6 +298,7 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
     progress.advance();
   }
   progress.finish();
+  end_live_stream(info);
   return timer.elapsed_s();
 }
 
@@ -401,7 +405,8 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   if (options.write_map && !info.rereadable) map_scans.emplace(map_options, map_step);
 
   SlamSystem slam(config, std::move(network));
-  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr);
+  // A live run's odometry poses grow in place, for a process that follows them.
+  TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr, info.live);
   TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);
   RegistrationHealth health;
   SlamRunResult result = summarize_run(slam, process_frames(source, slam, odometry_writer, map_scans, options, health));
@@ -428,6 +433,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
                                                              options.show_progress);
     if (!stop_requested()) write_map_outputs(slam, map, optimized, out_dir);
   }
+  report_stream(source, summary);
   write_run_summary(folder, std::move(summary));
   result.interrupted = stop_requested();
   result.files = folder.files();

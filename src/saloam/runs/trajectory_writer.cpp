@@ -12,12 +12,22 @@ Pose output_pose(const Pose& lidar_pose, const std::optional<Pose>& tr) {
 }  // namespace
 
 TrajectoryWriter::TrajectoryWriter(std::filesystem::path kitti_file, std::filesystem::path tum_file,
-                                   std::optional<Pose> velo_to_cam)
-    : kitti_file_(std::move(kitti_file)), tum_file_(std::move(tum_file)), velo_to_cam_(std::move(velo_to_cam)) {}
+                                   std::optional<Pose> velo_to_cam, bool growing)
+    : kitti_file_(std::move(kitti_file)),
+      tum_file_(std::move(tum_file)),
+      velo_to_cam_(std::move(velo_to_cam)),
+      growing_(growing) {}
+
+namespace {
+std::unique_ptr<OutputFile> open_pose_file(const std::filesystem::path& file, bool growing) {
+  if (growing) return std::make_unique<GrowingFile>(file);
+  return std::make_unique<AtomicFile>(file);
+}
+}  // namespace
 
 void TrajectoryWriter::open() {
-  kitti_ = std::make_unique<AtomicFile>(kitti_file_);
-  tum_ = std::make_unique<AtomicFile>(tum_file_);
+  kitti_ = open_pose_file(kitti_file_, growing_);
+  tum_ = open_pose_file(tum_file_, growing_);
   tum_->stream() << "# timestamp x y z qx qy qz qw (LiDAR frame, world = first scan)\n";
 }
 

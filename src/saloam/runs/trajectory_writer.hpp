@@ -8,7 +8,9 @@
 // line flushed as it is written, and put in place by commit() when the run's
 // frames are done (an interrupted run commits the frames it finished). A run
 // that fails, or stops before its first frame, leaves no pose file that could
-// be taken for a result.
+// be taken for a result. A live run's writer (`growing`) writes under the
+// final names from the first pose on, so that another process can follow
+// them as they grow; what it wrote stays (its frames cannot be read again).
 
 #include <filesystem>
 #include <memory>
@@ -22,8 +24,9 @@ namespace saloam {
 
 class TrajectoryWriter {
  public:
-  /// Nothing is created yet.
-  TrajectoryWriter(std::filesystem::path kitti_file, std::filesystem::path tum_file, std::optional<Pose> velo_to_cam);
+  /// Nothing is created yet. `growing`: written in place (GrowingFile), else through AtomicFiles.
+  TrajectoryWriter(std::filesystem::path kitti_file, std::filesystem::path tum_file, std::optional<Pose> velo_to_cam,
+                   bool growing = false);
   /// Appends one pose (LiDAR frame) and returns the pose written to the KITTI
   /// file; the first call creates the temporary files (InputError when it
   /// cannot), every call checks its writes.
@@ -37,7 +40,8 @@ class TrajectoryWriter {
 
   std::filesystem::path kitti_file_, tum_file_;
   std::optional<Pose> velo_to_cam_;
-  std::unique_ptr<AtomicFile> kitti_, tum_;
+  bool growing_ = false;
+  std::unique_ptr<OutputFile> kitti_, tum_;
 };
 
 /// The KITTI-file poses of LiDAR-frame poses (camera convention when Tr is given).

@@ -24,14 +24,18 @@ double VelodyneFrameAssembler::unwrap_us(std::uint32_t t) {
   return hours_us_ + static_cast<double>(t);
 }
 
-void VelodyneFrameAssembler::count_gap(double packet_us, bool dual) {
+std::size_t VelodyneFrameAssembler::count_gap(double packet_us, bool dual) {
   // A packet's span: 12 blocks (6 upper/lower pairs on the HDL-64E), 6 firings in dual mode.
   const std::size_t blocks = decoder_.model() == VelodyneModel::kHdl64e ? kBlocks : (dual ? kBlocks / 2 : kBlocks);
   const double period = velodyne_block_offset_us(decoder_.model(), blocks);
+  std::size_t missing = 0;
   if (last_packet_us_ && period > 0 && packet_us - *last_packet_us_ > 1.5 * period) {
-    missing_packets_ += static_cast<std::size_t>(std::lround((packet_us - *last_packet_us_) / period)) - 1;
+    missing = static_cast<std::size_t>(std::lround((packet_us - *last_packet_us_) / period)) - 1;
+    missing_packets_ += missing;
+    if (current_) current_->missing_packets += missing;  // the frame the gap fell in (or ended)
   }
   last_packet_us_ = packet_us;
+  return missing;
 }
 
 void VelodyneFrameAssembler::begin(double time_s, std::size_t block, std::vector<VelodyneFrame>& done) {
@@ -50,7 +54,7 @@ void VelodyneFrameAssembler::add(std::span<const std::uint8_t> packet, std::vect
   }
   const bool dual = decoder_.dual(packet);
   const double packet_us = unwrap_us(velodyne_tail(packet).timestamp_us);
-  count_gap(packet_us, dual);
+  const std::size_t gap = count_gap(packet_us, dual);
   returns_.clear();
   decoder_.decode(packet, returns_);
   std::size_t next_return = 0;
@@ -62,6 +66,8 @@ void VelodyneFrameAssembler::add(std::span<const std::uint8_t> packet, std::vect
     if (!current_ || wrapped) {
       const std::size_t firing = decoder_.model() == VelodyneModel::kHdl64e ? b : (dual ? b / 2 : b);
       begin((packet_us + velodyne_block_offset_us(decoder_.model(), firing)) * 1e-6, b, done);
+      // A frame begun right after a gap may lack its first packets as well (where the gap lay is not known).
+      if (b == first_block) current_->missing_packets += gap;
       counted = false;
     }
     if (!counted) {

@@ -26,6 +26,10 @@ struct VelodyneFrame {
   LabelledCloud cloud;  ///< remission 0..255 as sent, ring, time
   double time = 0.0;    ///< [s] the sensor's clock, unwrapped
   std::size_t packets = 0;
+  /// Packets missing by the timestamps' gaps while it was filled, or just
+  /// before it began (see missing_packets()): a gap between two frames
+  /// counts for both.
+  std::size_t missing_packets = 0;
 };
 
 class VelodyneFrameAssembler {
@@ -50,7 +54,8 @@ class VelodyneFrameAssembler {
 
  private:
   [[nodiscard]] double unwrap_us(std::uint32_t timestamp_us);
-  void count_gap(double packet_us, bool dual);
+  /// Packets missing before this one (counted, and charged to the frame being filled); 0 without a gap.
+  std::size_t count_gap(double packet_us, bool dual);
   void begin(double time_s, std::size_t block, std::vector<VelodyneFrame>& done);
 
   VelodyneDecoder decoder_;

@@ -10,11 +10,13 @@
 #include "saloam/io/sequence_source.hpp"
 #include "saloam/sensors/pcap_reader.hpp"
 #include "saloam/sources/kitti_raw_drive.hpp"
+#include "saloam/sources/live_udp_source.hpp"
 #include "saloam/sources/pcap_source.hpp"
 #include "saloam/sources/point_cloud_folder.hpp"
 #include "saloam/sources/ros2_bag_source.hpp"
 #include "saloam/sources/rosbag_source.hpp"
 #include "saloam/sources/scan_files.hpp"
+#include "saloam/sources/udp_socket.hpp"
 
 namespace fs = std::filesystem;
 
@@ -108,6 +110,7 @@ ScanFormat detect_scan_format(const fs::path& path) {
 std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptions& given) {
   SourceOptions options = given;
   options.ignore_labels = given.ignore_labels || given.segmentation.has_value();
+  if (is_udp_url(path.string())) return std::make_unique<LiveUdpSource>(path.string(), options);
   const ScanFormat format = options.format == ScanFormat::kAuto ? detect_scan_format(path) : options.format;
   switch (format) {
     case ScanFormat::kSemanticKitti: return open_semantic_kitti(path, options);
@@ -124,7 +127,9 @@ std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptio
 }
 
 std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, const SourceOptions& options) {
-  if (options.frames.first > 0 || options.frames.end < source->size()) {
+  // A live source's size is not known: any bound given is its frame limit.
+  const bool bounded = source->info().live ? options.frames.end != FrameRange{}.end : options.frames.end < source->size();
+  if (options.frames.first > 0 || bounded) {
     source = std::make_unique<FrameRangeSource>(std::move(source), options.frames);
   }
   if (options.segmentation) source = std::make_unique<SegmentedSource>(std::move(source), *options.segmentation);

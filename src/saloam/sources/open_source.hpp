@@ -11,6 +11,7 @@
 //              rosbag         RosbagSource         (sources/rosbag_source.hpp)
 //              rosbag2, mcap  Ros2BagSource        (sources/ros2_bag_source.hpp)
 //              pcap           PcapSource           (sources/pcap_source.hpp)
+//              udp://         LiveUdpSource        (sources/live_udp_source.hpp: live)
 //   stages   the frame range (--frames A:B, FrameRangeSource), then the
 //            segmentation (--segment: labels from a network, SegmentedSource)
 // A new reader is one more case in open_reader() (and in detect_scan_format
@@ -43,7 +44,8 @@ namespace saloam {
 /// and .ply files lie in one folder).
 ScanFormat detect_scan_format(const std::filesystem::path& path);
 
-/// The reader for `path` as `options.format` (detected when kAuto), with
+/// The reader for `path` as `options.format` (detected when kAuto), or for
+/// a `udp://[ADDRESS]:PORT` the live source (sources/live_udp_source.hpp), with
 /// options.topic, labels, ignore_labels and ignore_calib (labels are not
 /// read when the segmentation stage makes them). InputError naming
 /// the file for a missing path, a layout that is not that format, a corrupt

@@ -8,6 +8,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/sensors/ouster_frame.hpp"
+#include "saloam/sensors/packet_frames.hpp"
 #include "saloam/sensors/velodyne_frame.hpp"
 
 namespace fs = std::filesystem;
@@ -21,7 +22,7 @@ constexpr double kNs = 1e-9;
 class OusterDecoder final : public CaptureDecoder {
  public:
   OusterDecoder(const fs::path& metadata_file, OusterMetadata metadata)
-      : metadata_file_(metadata_file), metadata_(std::move(metadata)), lut_(metadata_), assembler_(metadata_) {}
+      : metadata_file_(metadata_file), metadata_(std::move(metadata)), assembler_(metadata_), framer_(metadata_) {}
 
   void index(const UdpDatagram& d, std::vector<CaptureFrame>& done) override {
     if (!is_lidar(d)) return;
@@ -51,22 +52,18 @@ class OusterDecoder final : public CaptureDecoder {
   }
 
   LabelledCloud read(PcapReader& reader, const CaptureFrame& frame) override {
-    OusterFrameAssembler assembler(metadata_);
-    std::vector<OusterScan> scans;
+    // The frame's own packets, through the frame assembly a live source uses too.
+    framer_.restart();
+    std::vector<PacketFrame> frames;
     UdpDatagram d;
     while (reader.next(d) && d.offset <= frame.last_offset) {
-      if (is_lidar(d) && assembler.format().check(d.payload).empty() &&
-          assembler.format().frame_id(d.payload) == frame.tag) {
-        assembler.add(d.payload, scans);
+      if (framer_.is_lidar(d.payload, d.dst_port) && framer_.format().check(d.payload).empty() &&
+          framer_.format().frame_id(d.payload) == frame.tag) {
+        framer_.add(d.payload, d.dst_port, frames);
       }
     }
-    if (auto last = assembler.finish()) scans.push_back(std::move(*last));
-    for (const auto& scan : scans) {
-      if (scan.frame_id != frame.tag) continue;
-      const auto t0 = scan.first_valid_timestamp();
-      return ouster_cloud(scan, lut_, t0.value_or(0), 1.0F);
-    }
-    return {};
+    framer_.finish(frames);
+    return frames.empty() ? LabelledCloud{} : std::move(frames.front().cloud);
   }
 
   [[nodiscard]] std::vector<std::string> notes() const override {
@@ -90,8 +87,8 @@ class OusterDecoder final : public CaptureDecoder {
     return out;
   }
 
-  [[nodiscard]] std::string point_fields() const override { return "x y z reflectivity ring t"; }
-  [[nodiscard]] std::string intensity_field() const override { return "Ouster REFLECTIVITY, 8 bits"; }
+  [[nodiscard]] std::string point_fields() const override { return framer_.point_fields(); }
+  [[nodiscard]] std::string intensity_field() const override { return framer_.intensity_field(); }
 
  private:
   struct Span {
@@ -133,8 +130,8 @@ class OusterDecoder final : public CaptureDecoder {
 
   fs::path metadata_file_;
   OusterMetadata metadata_;
-  OusterXyzLut lut_;
-  OusterFrameAssembler assembler_;
+  OusterFrameAssembler assembler_;  ///< the index pass's
+  OusterPacketFramer framer_;       ///< reading a frame again
   std::vector<OusterScan> scans_;
   std::map<std::uint32_t, Span> spans_;
   std::size_t lidar_packets_ = 0;
@@ -147,7 +144,7 @@ class OusterDecoder final : public CaptureDecoder {
 /// Velodyne data packets cut into sweeps (sensors/velodyne_frame.hpp).
 class VelodyneCaptureDecoder final : public CaptureDecoder {
  public:
-  explicit VelodyneCaptureDecoder(VelodyneDecoder decoder) : assembler_(std::move(decoder)) {}
+  explicit VelodyneCaptureDecoder(const VelodyneDecoder& decoder) : assembler_(decoder), framer_(decoder) {}
 
   void index(const UdpDatagram& d, std::vector<CaptureFrame>& done) override {
     if (d.payload.size() != kVelodynePacketBytes) return;
@@ -168,18 +165,17 @@ class VelodyneCaptureDecoder final : public CaptureDecoder {
   }
 
   LabelledCloud read(PcapReader& reader, const CaptureFrame& frame) override {
-    VelodyneFrameAssembler assembler(assembler_.decoder());
-    std::vector<VelodyneFrame> frames;
+    // From the block where the frame began, through the frame assembly a live source uses too.
+    framer_.restart();
+    std::vector<PacketFrame> frames;
     UdpDatagram d;
     bool first = true;
     while (frames.empty() && reader.next(d) && d.offset <= frame.last_offset) {
       if (d.payload.size() != kVelodynePacketBytes) continue;
-      assembler.add(d.payload, frames, first ? frame.tag : 0);
+      framer_.add_from_block(d.payload, first ? frame.tag : 0, frames);
       first = false;
     }
-    if (frames.empty()) {
-      if (auto last = assembler.finish()) frames.push_back(std::move(*last));
-    }
+    if (frames.empty()) framer_.finish(frames);
     return frames.empty() ? LabelledCloud{} : std::move(frames.front().cloud);
   }
 
@@ -197,8 +193,8 @@ class VelodyneCaptureDecoder final : public CaptureDecoder {
             "sweeps; points timed by the model's firing sequence"};
   }
 
-  [[nodiscard]] std::string point_fields() const override { return "x y z intensity ring t"; }
-  [[nodiscard]] std::string intensity_field() const override { return "Velodyne intensity, 8 bits"; }
+  [[nodiscard]] std::string point_fields() const override { return framer_.point_fields(); }
+  [[nodiscard]] std::string intensity_field() const override { return framer_.intensity_field(); }
 
  private:
   /// Pairs a finished frame with where it began.
@@ -212,7 +208,8 @@ class VelodyneCaptureDecoder final : public CaptureDecoder {
     done.push_back(entry);
   }
 
-  VelodyneFrameAssembler assembler_;
+  VelodyneFrameAssembler assembler_;  ///< the index pass's
+  VelodynePacketFramer framer_;       ///< reading a frame again
   std::vector<VelodyneFrame> frames_;
   std::vector<CaptureFrame> starts_;
   std::int64_t last_offset_ = 0;

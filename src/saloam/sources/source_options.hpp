@@ -16,7 +16,10 @@
 //   pcap           a sensor's packet capture: Ouster (with its metadata JSON)
 //                  or Velodyne VLP-16 / HDL-32E / HDL-64E (sources/pcap_source.hpp)
 //   auto           detected from the path (detect_scan_format)
+// A path `udp://[ADDRESS]:PORT` is no layout but a live source: a sensor's
+// UDP packets as they arrive (sources/live_udp_source.hpp, LiveOptions).
 
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -36,6 +39,21 @@ enum class ScanFormat { kAuto, kSemanticKitti, kKittiRaw, kPcd, kPly, kRosbag, k
 [[nodiscard]] std::optional<ScanFormat> scan_format_from_name(std::string_view name);
 /// Every --format value, for option checks and help texts.
 [[nodiscard]] const std::vector<std::string>& scan_format_names();
+
+/// What a live source (udp://) needs besides the address.
+struct LiveOptions {
+  /// --sensor: whose packets arrive: vlp16, hdl32e, hdl64e (Velodyne), or
+  /// an Ouster (os1-64, os1-128, or any name with --metadata META.json).
+  std::string sensor;
+  /// --idle-timeout [s]: the stream ends when no packet arrived for this
+  /// long (from the start too); 0: never (only Ctrl-C or a frame limit end it).
+  double idle_timeout_s = 10.0;
+  /// --queue: frames held for a run that falls behind; beyond, the oldest
+  /// whole frame is dropped (and counted).
+  std::size_t queue_frames = 4;
+  /// SO_RCVBUF asked for [bytes] (the kernel may grant less: said in the log).
+  int receive_buffer_bytes = 64 << 20;
+};
 
 struct SourceOptions {
   ScanFormat format = ScanFormat::kAuto;  ///< --format
@@ -58,6 +76,7 @@ struct SourceOptions {
   /// the field's type or its first scan (io/intensity_scale.hpp).
   std::optional<float> intensity_scale;
   FrameRange frames;  ///< --frames A:B; everything by default
+  LiveOptions live;  ///< a udp:// source's
   /// --segment: every scan labelled by this model (the reader's labels are not read).
   std::optional<SegmentationStageOptions> segmentation;
 };
