@@ -203,6 +203,31 @@ TEST(SimulatedSequence, AdaptiveClassWeightsFollowTheResidualNoise) {
   EXPECT_LT((err.inverse() * est).translation().norm() / path, 0.01);
 }
 
+/// The semantic odometry (defaults) over a simulated climb: its evaluation,
+/// the true rise of the last pose above the first and the height error of
+/// the last pose, unaligned (both start at the first scan's frame, z up),
+/// printed under `name`.
+struct Climb {
+  TrajectoryEvaluation ev;
+  double rise = 0.0;          // [m]
+  double height_error = 0.0;  // [m] estimated minus true
+};
+
+Climb climb(const SimulationOptions& options, const std::filesystem::path& dir, const char* name) {
+  simulate_sequence(options, dir);
+  const SequenceReader reader(dir);
+  SemanticOdometry odometry{OdometryConfig{}};
+  register_all(odometry, reader);
+  const auto gt = reader.lidar_poses();
+  Climb c{evaluate_trajectories(gt, odometry.poses()), gt.back().translation().z() - gt.front().translation().z(),
+          odometry.poses().back().translation().z() - gt.back().translation().z()};
+  std::printf("%s: %zu frames, t_err %.4f %%, ATE %.4f m, sideways / vertical / forward %.4f / %.4f / %.4f m, "
+              "vertical bias %+.4f %%, final height error %+.4f m\n",
+              name, reader.size(), c.ev.kitti.t_err_percent, c.ev.ate.aligned.rmse, c.ev.ate_axes.sideways_m,
+              c.ev.ate_axes.vertical_m, c.ev.ate_axes.forward_m, c.ev.bias.vertical_percent, c.height_error);
+  return c;
+}
+
 // A climb along KITTI 08's real height profile (issue #43): frames 2700:2950
 // rise 15 m over 260 m (grades of 5 to 7.5 %) up to a crest, world seed 2,
 // emulated network labels. Measured: t_err 0.043 %, ATE 0.0165 m, of it
@@ -223,24 +248,13 @@ TEST(SimulatedSequence, KeepsItsHeightUpAHill) {
   options.seed = 2;
   options.labels = LabelMode::kNoisy;
   options.show_progress = false;
-  ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 250u);
-  const SequenceReader reader(dir.path());
-  SemanticOdometry odometry{OdometryConfig{}};
-  register_all(odometry, reader);
-  const auto gt = reader.lidar_poses();
-  const TrajectoryEvaluation ev = evaluate_trajectories(gt, odometry.poses());
-  // Unaligned: the height gained, estimated against true (both start at the
-  // first scan's frame, z up).
-  const double height_error = odometry.poses().back().translation().z() - gt.back().translation().z();
-  std::printf("climb: t_err %.4f %%, ATE %.4f m, sideways / vertical / forward %.4f / %.4f / %.4f m, "
-              "vertical bias %+.4f %%, final height error %+.4f m\n",
-              ev.kitti.t_err_percent, ev.ate.aligned.rmse, ev.ate_axes.sideways_m, ev.ate_axes.vertical_m,
-              ev.ate_axes.forward_m, ev.bias.vertical_percent, height_error);
+  const Climb c = climb(options, dir.path(), "climb");
+  ASSERT_EQ(c.ev.gt_poses, 250u);  // the frames simulated
   // The route climbs: 5.9 m above the first scan's horizon (its frame is
   // pitched up the hill already), 15 m in KITTI's world.
-  ASSERT_GT(gt.back().translation().z() - gt.front().translation().z(), 5.0);
-  EXPECT_LT(ev.ate_axes.vertical_m, 0.0035);
-  EXPECT_LT(std::abs(height_error), 0.075);
+  ASSERT_GT(c.rise, 5.0);
+  EXPECT_LT(c.ev.ate_axes.vertical_m, 0.0035);
+  EXPECT_LT(std::abs(c.height_error), 0.075);
 }
 
 // Over the main crest of the simulator's climbing route ("hill-climb"
@@ -262,21 +276,12 @@ TEST(SimulatedSequence, KeepsItsHeightOverAMountainCrest) {
   options.seed = 2;
   options.labels = LabelMode::kNoisy;
   options.show_progress = false;
-  ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 180u);
-  const SequenceReader reader(dir.path());
-  SemanticOdometry odometry{OdometryConfig{}};
-  register_all(odometry, reader);
-  const auto gt = reader.lidar_poses();
-  const TrajectoryEvaluation ev = evaluate_trajectories(gt, odometry.poses());
-  const double height_error = odometry.poses().back().translation().z() - gt.back().translation().z();
-  std::printf("crest: t_err %.4f %%, ATE %.4f m, sideways / vertical / forward %.4f / %.4f / %.4f m, "
-              "final height error %+.4f m\n",
-              ev.kitti.t_err_percent, ev.ate.aligned.rmse, ev.ate_axes.sideways_m, ev.ate_axes.vertical_m,
-              ev.ate_axes.forward_m, height_error);
+  const Climb c = climb(options, dir.path(), "crest");
+  ASSERT_EQ(c.ev.gt_poses, 180u);
   // Over the crest: 16 m below the first scan's horizon (pitched up the hill).
-  ASSERT_LT(gt.back().translation().z() - gt.front().translation().z(), -12.0);
-  EXPECT_LT(ev.ate_axes.vertical_m, 0.007);
-  EXPECT_LT(std::abs(height_error), 0.05);
+  ASSERT_LT(c.rise, -12.0);
+  EXPECT_LT(c.ev.ate_axes.vertical_m, 0.007);
+  EXPECT_LT(std::abs(c.height_error), 0.05);
 }
 
 }  // namespace
