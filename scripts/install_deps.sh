@@ -17,6 +17,7 @@ packages=(
   libpcap-dev  # sensor packet captures (.pcap: Ouster, Velodyne)
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module `import saloam` and its tests (python/)
   python3-dask python3-distributed  # saloam fleet: fleet mapping on Dask (docs/fleet.md)
+  python3-torch  # scripts/segnet_torch.py: SegNet trained with PyTorch (a GPU where there is one) and its test
 )
 
 missing=()

@@ -142,7 +142,7 @@ def fold_job(args, k, held_out, all_sequences):
     fold_dir = os.path.join(args.out, f"fold{k}")
     os.makedirs(fold_dir, exist_ok=True)
     log = os.path.join(fold_dir, "log.txt")
-    model = args.model
+    model = args.fold_models.format(k=k) if args.fold_models else args.model
     if model is None:
         teacher = os.path.join(args.teacher, f"fold{k}", "run", "model.yaml") if args.pseudo else None
         model = train_model(args, fold_dir, [s for s in all_sequences if s not in held_out],
@@ -184,6 +184,8 @@ def main():
     p.add_argument("--folds", default=DEFAULT_FOLDS, help=f"sequences per fold, ';' between folds ({DEFAULT_FOLDS})")
     p.add_argument("--run-folds", help="only these folds (numbers, e.g. 0,1); each still trains on every other fold")
     p.add_argument("--model", help="score this model in every fold, without training (a baseline)")
+    p.add_argument("--fold-models", help="score a model trained elsewhere per fold, without training: a path with "
+                                         "{k} for the fold's number (e.g. segnet_torch.py's runs, exported)")
     p.add_argument("--init", help="segment-train --init: the model to fine-tune")
     p.add_argument("--sim-recipe", help="a segment-train recipe whose train: sources are trained on beside the real ones")
     p.add_argument("--scan-cache", help="a run's scans/ folder holding the simulated sources' cache (hard-linked)")
