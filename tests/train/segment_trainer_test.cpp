@@ -279,3 +279,84 @@ TEST(SegmentTrainer, TrainingOnRealAndSimulatedScansLowersTheLoss) {
 
 }  // namespace
 }  // namespace saloam
+
+namespace saloam {
+namespace {
+
+/// A scan of `beams` rings around the sensor (a cylinder 10 m away, one point
+/// per degree), every point of class `target`.
+TrainingScan ring_cylinder(int beams, std::uint8_t target) {
+  TrainingScan scan;
+  scan.beams = beams;
+  for (int ring = 0; ring < beams; ++ring)
+    for (int degree = 0; degree < 360; ++degree) {
+      const double azimuth = degree * M_PI / 180.0;
+      const double z = 1.0 - 0.2 * ring;  // top ring first
+      scan.xyz.push_back({static_cast<std::int16_t>(std::lround(10.0 * std::cos(azimuth) / kScanPositionStep)),
+                          static_cast<std::int16_t>(std::lround(10.0 * std::sin(azimuth) / kScanPositionStep)),
+                          static_cast<std::int16_t>(std::lround(z / kScanPositionStep))});
+      scan.remission.push_back(100);
+      scan.target.push_back(target);
+      scan.ring.push_back(static_cast<std::uint8_t>(ring));
+    }
+  return scan;
+}
+
+ScanAugmentOptions no_augmentation() {
+  ScanAugmentOptions a;
+  a.rotate = false;
+  a.flip = a.max_tilt_deg = a.max_height_shift = a.max_range_noise = 0;
+  a.max_point_dropout = a.max_ring_dropout = a.occlusion = a.remission_constant = 0;
+  a.remission_gamma = 1;
+  a.remission_gain = a.remission_offset = a.remission_noise = 0;
+  return a;
+}
+
+/// The class of each image row (0: none; -1: more than one).
+std::vector<int> row_classes(const TrainingSample& sample) {
+  std::vector<int> rows(static_cast<std::size_t>(sample.rows), 0);
+  for (int y = 0; y < sample.rows; ++y)
+    for (int x = 0; x < sample.cols; ++x) {
+      const auto c = static_cast<int>(sample.target[static_cast<std::size_t>(y * sample.cols + x)]);
+      if (c == 0) continue;
+      auto& row = rows[static_cast<std::size_t>(y)];
+      row = row == 0 || row == c ? c : -1;
+    }
+  return rows;
+}
+
+TEST(SegmentTrainingSamples, MixingTakesAlternateRingBandsFromTheSecondScan) {
+  constexpr std::uint8_t kCar = 1, kRoad = 9;
+  const TrainingScan first = ring_cylinder(16, kCar), second = ring_cylinder(16, kRoad);
+  ProjectionSpec projection;
+  projection.columns = 512;
+  ScanAugmentOptions mixing = no_augmentation();
+  mixing.mix = 1;
+  for (std::uint64_t seed = 0; seed < 6; ++seed) {
+    const auto rows = row_classes(make_training_sample(first, projection, mixing, seed, 0, &second));
+    // Some band count k in 2..6 explains every row: even bands the first scan's, odd the second's.
+    bool explained = false;
+    for (int k = 2; k <= 6 && !explained; ++k) {
+      explained = true;
+      for (int y = 0; y < 16; ++y) explained &= rows[static_cast<std::size_t>(y)] == ((y * k / 16) % 2 ? kRoad : kCar);
+    }
+    EXPECT_TRUE(explained) << "seed " << seed;
+  }
+  // Never mixed: at mix 0, without a partner, or with a partner of another beam count.
+  const std::vector<int> all_car(16, kCar);
+  EXPECT_EQ(row_classes(make_training_sample(first, projection, no_augmentation(), 3, 0, &second)), all_car);
+  EXPECT_EQ(row_classes(make_training_sample(first, projection, mixing, 3, 0)), all_car);
+  const TrainingScan other_beams = ring_cylinder(32, kRoad);
+  EXPECT_EQ(row_classes(make_training_sample(first, projection, mixing, 3, 0, &other_beams)), all_car);
+}
+
+TEST(SegmentTrainingSamples, MixIsAnAugmentationOfTheCommandLine) {
+  ScanAugmentOptions a;
+  EXPECT_EQ(a.mix, 0.0);  // the shipped recipes draw no second scan
+  set_augment_option(a, "mix", "0.5");
+  EXPECT_EQ(a.mix, 0.5);
+  EXPECT_THROW(set_augment_option(a, "mix", "1.5"), ConfigError);
+}
+
+}  // namespace
+}  // namespace saloam

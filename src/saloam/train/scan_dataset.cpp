@@ -272,6 +272,25 @@ Augmented augment(const TrainingScan& scan, const ScanAugmentOptions& a, std::ui
   return out;
 }
 
+/// LaserMix: the rings cut into `bands` bands of equal height; `a` keeps
+/// its points in the even bands (and those without a ring) and takes the
+/// partner's in the odd ones.
+void mix_ring_bands(Augmented& a, const Augmented& partner, int beams, int bands) {
+  const auto band = [&](std::int16_t ring) { return ring * bands / std::max(beams, 1); };
+  Augmented mixed;
+  mixed.cloud.reserve(a.cloud.size());
+  const auto keep = [&](const Augmented& from, std::size_t i) {
+    mixed.cloud.push_back(from.cloud.points[i], from.cloud.remission[i]);
+    mixed.ring.push_back(from.ring[i]);
+    mixed.target.push_back(from.target[i]);
+  };
+  for (std::size_t i = 0; i < a.cloud.size(); ++i)
+    if (a.ring[i] < 0 || band(a.ring[i]) % 2 == 0) keep(a, i);
+  for (std::size_t i = 0; i < partner.cloud.size(); ++i)
+    if (partner.ring[i] >= 0 && band(partner.ring[i]) % 2 == 1) keep(partner, i);
+  a = std::move(mixed);
+}
+
 }  // namespace
 
 TrainingScan compact_scan(const LabelledCloud& cloud, const std::vector<std::int16_t>& ring, int beams) {
@@ -376,8 +395,14 @@ void fit_channel_statistics(const std::vector<TrainingScanSet>& sequences, Proje
 }
 
 TrainingSample make_training_sample(const TrainingScan& scan, const ProjectionSpec& spec,
-                                    const ScanAugmentOptions& augment_options, std::uint64_t seed, int crop_columns) {
-  const Augmented a = augment(scan, augment_options, seed);
+                                    const ScanAugmentOptions& augment_options, std::uint64_t seed, int crop_columns,
+                                    const TrainingScan* partner) {
+  Augmented a = augment(scan, augment_options, seed);
+  if (partner != nullptr && partner->beams == scan.beams &&
+      hash_to_unit(hash_combine(seed, 0x313full)) < augment_options.mix) {
+    const int bands = 2 + static_cast<int>(hash_combine(seed, 0xba5dull) % 5);
+    mix_ring_bands(a, augment(*partner, augment_options, hash_combine(seed, 0x9a27ull)), scan.beams, bands);
+  }
   const RangeImage image = project_scan(a.cloud, a.ring, scan.beams, spec);
   const int cols = crop_columns > 0 && crop_columns < image.cols ? crop_columns : image.cols;
   const int first = cols == image.cols ? 0 : static_cast<int>(hash_combine(seed, 0x5eedull) % static_cast<std::uint64_t>(image.cols));

@@ -79,6 +79,11 @@ struct ScanAugmentOptions {
   double remission_gain = 0.5;         ///< a uniform in [1 - x, 1 + x]
   double remission_offset = 0.1;       ///< b uniform in [-x, x]
   double remission_noise = 0.05;       ///< per-point Gaussian sigma uniform in [0, max]
+  /// Probability that a sample is two scans mixed by ring bands (LaserMix:
+  /// Kong et al., CVPR 2023): the rings cut into 2-6 bands of equal height,
+  /// alternate bands from each scan (both augmented on their own), so that
+  /// a few places make many scenes. 0 (the default): no second scan drawn.
+  double mix = 0.0;
 };
 
 /// Calls v(name, member, description, range) for every augmentation (bool:
@@ -99,6 +104,7 @@ void visit_fields(ScanAugmentOptions& a, Visitor&& v) {
   v("remission_gain", a.remission_gain, "remission gain in [1 - x, 1 + x]", Range{0, 1});
   v("remission_offset", a.remission_offset, "remission offset in [-x, x]", Range{0, 1});
   v("remission_noise", a.remission_noise, "per-point remission noise sigma in [0, max]", Range{0, 1});
+  v("mix", a.mix, "probability of mixing in a second scan's ring bands (LaserMix)", Range{0, 1});
 }
 
 /// Sets the augmentation `name` from text ("0.1"; "true"/"false" for rotate):
@@ -117,8 +123,12 @@ struct TrainingSample {
 
 /// Augments `scan` (seeded), projects it with `spec` (ring rows) and cuts
 /// `crop_columns` consecutive columns (the whole image when 0 or wider).
+/// With a `partner` of the same beam count, a share `augment.mix` of the
+/// samples (decided by the seed) take alternate ring bands from the partner,
+/// augmented with its own draws.
 TrainingSample make_training_sample(const TrainingScan& scan, const ProjectionSpec& spec,
-                                    const ScanAugmentOptions& augment, std::uint64_t seed, int crop_columns);
+                                    const ScanAugmentOptions& augment, std::uint64_t seed, int crop_columns,
+                                    const TrainingScan* partner = nullptr);
 
 /// The scan as the segmenter sees it (points, remission; labels left 0) and its rings.
 LabelledCloud scan_cloud(const TrainingScan& scan);

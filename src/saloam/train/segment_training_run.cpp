@@ -10,6 +10,7 @@
 #include <fstream>
 #include <future>
 #include <map>
+#include <optional>
 #include <string_view>
 #include <type_traits>
 
@@ -140,8 +141,24 @@ double learning_rate_at(double base, double progress, int epochs) {
 struct PlannedSample {
   std::uint32_t sequence = 0, scan = 0;
   std::uint64_t seed = 0;
+  /// With augment.mix > 0: a second scan of the same beam count (sequence, scan), drawn as the first.
+  std::optional<std::pair<std::uint32_t, std::uint32_t>> partner;
 };
 using Batch = std::vector<PlannedSample>;
+
+/// A scan of the same beam count as `sample`'s, drawn as samples are (a few
+/// tries; none when every draw has another beam count).
+template <class Pick>
+std::optional<std::pair<std::uint32_t, std::uint32_t>> draw_partner(const std::vector<TrainingScanSet>& train,
+                                                                    const std::vector<PlannedSample>& all, Pick& pick,
+                                                                    const PlannedSample& sample) {
+  const int beams = train[sample.sequence].scans[sample.scan].beams;
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    const PlannedSample& other = all[pick()];
+    if (train[other.sequence].scans[other.scan].beams == beams) return std::pair{other.sequence, other.scan};
+  }
+  return std::nullopt;
+}
 
 /// The batches of one epoch: scans drawn with their set's weight (uniformly
 /// when every set weighs the same), grouped by beam count into batches, in
@@ -151,7 +168,7 @@ std::vector<Batch> plan_epoch(const std::vector<TrainingScanSet>& train, const S
   std::vector<double> weights;
   for (std::uint32_t s = 0; s < train.size(); ++s)
     for (std::uint32_t k = 0; k < train[s].scans.size(); ++k) {
-      all.push_back({s, k, 0});
+      all.push_back({s, k, 0, std::nullopt});
       weights.push_back(train[s].weight);
     }
   const bool uniform = std::all_of(train.begin(), train.end(), [&](const auto& s) { return s.weight == train[0].weight; });
@@ -163,6 +180,7 @@ std::vector<Batch> plan_epoch(const std::vector<TrainingScanSet>& train, const S
   for (std::size_t j = 0; j < options.samples_per_epoch; ++j) {
     PlannedSample sample = all[pick()];
     sample.seed = rng();
+    if (options.augment.mix > 0) sample.partner = draw_partner(train, all, pick, sample);
     by_beams[train[sample.sequence].scans[sample.scan].beams].push_back(sample);
   }
   std::vector<Batch> batches;
@@ -180,7 +198,8 @@ std::vector<TrainingSample> prepare(const Batch& batch, const std::vector<Traini
   for (const auto& p : batch) {
     const TrainingScan& scan = train[p.sequence].scans[p.scan];
     const int crop = options.pixels_per_sample / std::max(scan.beams, 1);
-    samples.push_back(make_training_sample(scan, projection, options.augment, p.seed, crop));
+    const TrainingScan* partner = p.partner ? &train[p.partner->first].scans[p.partner->second] : nullptr;
+    samples.push_back(make_training_sample(scan, projection, options.augment, p.seed, crop, partner));
   }
   return samples;
 }
