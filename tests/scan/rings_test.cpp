@@ -9,41 +9,12 @@
 
 #include "saloam/core/config.hpp"
 #include "saloam/scan/rings.hpp"
+#include "testing/synthetic_scans.hpp"
 
 namespace saloam {
 namespace {
 
-/// A 16-laser scan (VLP-16: +15 to -15 deg in 2 deg steps) of a 10 m
-/// sphere, 720 points per laser at 0.5 deg (half a step off the seam behind
-/// the sensor), stored in a shuffled order (no
-/// storage-order rings), with each point's laser in `ring` numbered from the
-/// BOTTOM (as the Velodyne driver does) and its time in the sweep.
-constexpr int kPerLaser = 720;
-
-LabelledCloud shuffled_vlp16() {
-  LabelledCloud cloud;
-  std::vector<std::uint16_t> ring;
-  std::vector<float> time;
-  for (int laser = 0; laser < 16; ++laser) {
-    const double el = (15.0 - 2.0 * laser) * M_PI / 180.0;
-    for (int a = 0; a < kPerLaser; ++a) {
-      const double az = M_PI - (a + 0.5) * 0.5 * M_PI / 180.0;  // clockwise from behind
-      cloud.push_back(Eigen::Vector3d(10 * std::cos(el) * std::cos(az), 10 * std::cos(el) * std::sin(az),
-                                      10 * std::sin(el)).cast<float>(),
-                      0.5f);
-      ring.push_back(static_cast<std::uint16_t>(15 - laser));
-      time.push_back(0.1f * static_cast<float>(a) / static_cast<float>(kPerLaser));
-    }
-  }
-  std::vector<std::size_t> order(cloud.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::shuffle(order.begin(), order.end(), std::mt19937(3));
-  LabelledCloud shuffled;
-  for (const std::size_t i : order) shuffled.push_back(cloud.points[i], cloud.remission[i]);
-  for (const std::size_t i : order) shuffled.ring.push_back(ring[i]);
-  for (const std::size_t i : order) shuffled.time.push_back(time[i]);
-  return shuffled;
-}
+constexpr int kPerLaser = testing::kVlp16PointsPerLaser;
 
 double elevation_of(const Eigen::Vector3f& p) { return std::atan2(p.z(), std::hypot(p.x(), p.y())) * 180.0 / M_PI; }
 
@@ -63,13 +34,13 @@ void expect_vlp16_rings(const LabelledCloud& cloud, const std::vector<std::vecto
 }
 
 TEST(Rings, TheRingFieldComesFirstAndIsOrderedTopDown) {
-  const LabelledCloud cloud = shuffled_vlp16();
+  const LabelledCloud cloud = testing::shuffled_vlp16_sphere();
   FeatureConfig config;
   expect_vlp16_rings(cloud, scan_rings(cloud, config));
 }
 
 TEST(Rings, WithoutARingFieldTheProfilesLasersSortThePoints) {
-  LabelledCloud cloud = shuffled_vlp16();
+  LabelledCloud cloud = testing::shuffled_vlp16_sphere();
   cloud.ring.clear();
   FeatureConfig config;
   for (int laser = 0; laser < 16; ++laser) config.beam_elevations_deg.push_back(15.0 - 2.0 * laser);
