@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,7 @@
 #include "saloam/runs/localize_run.hpp"
 #include "saloam/runs/slam_run.hpp"
 #include "saloam/runs/trajectory_pairing.hpp"
+#include "saloam/sources/source_options.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 #include "saloam/segmentation/segmenter.hpp"
 #include "saloam/segmentation/segmenter_spec.hpp"
@@ -87,31 +89,58 @@ struct FrameIterator {
 
 py::object frame_type() { return py::module_::import("saloam._saloam").attr("Frame"); }
 
+/// Frame i as a Frame tuple, or None when the source has none: i past the
+/// end, or a live stream ended (idle for its timeout). A stream (a live
+/// source, a recording read once) serves its frames in order, once each.
 py::object read_frame(Source& s, std::size_t i) {
-  LabelledCloud cloud;
+  std::optional<SourceFrame> frame;
   {
     py::gil_scoped_release release;
     std::lock_guard lock(s.mutex);
-    if (!s.info().rereadable) {
+    if (s.info().rereadable) {
+      if (i < s.info().size()) frame = SourceFrame{s.source->scan(i), s.info().times[i]};
+    } else {
       if (i != s.served) throw py::index_error("a stream serves its frames once each, in order");
-      ++s.served;
+      frame = s.source->next_frame(i);
+      if (frame) ++s.served;
     }
-    cloud = s.source->scan(i);
   }
-  const py::tuple arrays = cloud_to_arrays(cloud);
-  return frame_type()(arrays[0], arrays[1], arrays[2], s.info().times.at(i), arrays[3]);
+  if (!frame) return py::none();
+  const py::tuple arrays = cloud_to_arrays(frame->cloud);
+  return frame_type()(arrays[0], arrays[1], arrays[2], frame->time, arrays[3]);
+}
+
+py::object stream_stats_dict(const StreamStats& s) {
+  py::dict d;
+  d["address"] = s.address;
+  d["packets"] = s.packets;
+  d["frames_made"] = s.frames_made;
+  d["frames_served"] = s.frames_served;
+  d["frames_dropped"] = s.frames_dropped;
+  d["frames_out_of_order"] = s.frames_out_of_order;
+  d["frames_incomplete"] = s.frames_incomplete;
+  d["frames_unread"] = s.frames_unread;
+  d["ended_by"] = s.ended_by;
+  return d;
 }
 
 std::shared_ptr<Source> open_source_py(const py::object& path, const std::string& format, const std::string& sensor,
                                        const std::string& topic, const py::object& labels, const std::string& frames,
                                        bool no_calib, const std::string& intensity_scale, bool semantics, bool segment,
                                        const std::string& segmenter, const std::string& projection,
-                                       const py::object& config, const py::object& set) {
+                                       const py::object& config, const py::object& set, const py::object& metadata,
+                                       double idle_timeout, std::size_t queue) {
   cli::SourceArgs args;
   args.path = fspath(path);
   args.format = format;
   args.sensor = sensor;
   args.topic = topic;
+  if (!metadata.is_none()) args.metadata = fspath(metadata);
+  if (!(idle_timeout >= 0)) throw py::value_error("idle_timeout must be >= 0 seconds");
+  if (queue < 1 || queue > 1000) throw py::value_error("queue must hold 1 to 1000 frames");
+  args.accepts_live = true;  // udp://[ADDRESS]:PORT: the frames as the sensor's packets arrive
+  args.idle_timeout_s = idle_timeout;
+  args.queue_frames = queue;
   if (!labels.is_none()) args.labels = fspath(labels);
   args.frames = frames;
   args.no_calib = no_calib;
@@ -501,8 +530,10 @@ Values are checked by the library (the same checks and messages as a
   py::class_<FrameIterator>(m, "_FrameIterator")
       .def("__iter__", [](py::object self) { return self; })
       .def("__next__", [](FrameIterator& it) {
-        if (it.next >= it.source->info().size()) throw py::stop_iteration();
-        return read_frame(*it.source, it.next++);
+        py::object frame = read_frame(*it.source, it.next);
+        if (frame.is_none()) throw py::stop_iteration();
+        ++it.next;
+        return frame;
       });
 
   py::class_<Source, std::shared_ptr<Source>>(m, "Source", "Frames of a recorded sequence; see open_source().")
@@ -511,12 +542,22 @@ Values are checked by the library (the same checks and messages as a
            [](Source& s, py::ssize_t i) {
              const auto n = static_cast<py::ssize_t>(s.info().size());
              if (i < 0) i += n;
-             if (i < 0 || i >= n) throw py::index_error(fmt::format("frame {} of {}", i, n));
-             return read_frame(s, static_cast<std::size_t>(i));
+             if (i < 0 || (s.info().rereadable && i >= n)) throw py::index_error(fmt::format("frame {} of {}", i, n));
+             py::object frame = read_frame(s, static_cast<std::size_t>(i));
+             if (frame.is_none()) throw py::index_error(fmt::format("frame {}: the stream has ended", i));
+             return frame;
            },
            "i"_a, "Frame i (a rereadable source: any frame, any number of times).")
       .def("__iter__", [](const std::shared_ptr<Source>& s) { return FrameIterator{s}; },
            "The frames from the first (a stream: once).")
+      .def_property_readonly("stream_stats",
+                             [](const Source& s) -> py::object {
+                               std::lock_guard lock(const_cast<Source&>(s).mutex);
+                               const auto stats = s.source->stream_stats();
+                               return stats ? stream_stats_dict(*stats) : py::none();
+                             },
+                             "A live source's counts so far (packets, frames made, served, dropped, ...; ended_by "
+                             "once it ended), as the run summary's `live`; None for a recorded source.")
       .def_property_readonly("config", [](const Source& s) { return config_to_dict(s.config); },
                              "The configuration a run over this source takes (the sensor profile applied).")
       .def_property_readonly("sensor", [](const Source& s) { return s.sensor; },
@@ -551,8 +592,9 @@ Values are checked by the library (the same checks and messages as a
   m.def("open_source", &open_source_py, "path"_a, py::kw_only(), "format"_a = "auto", "sensor"_a = "auto",
         "topic"_a = "", "labels"_a = py::none(), "frames"_a = "", "no_calib"_a = false, "intensity_scale"_a = "auto",
         "semantics"_a = true, "segment"_a = false, "segmenter"_a = "", "projection"_a = "", "config"_a = py::none(),
-        "set"_a = py::none(),
-        R"(Opens a recorded sequence as `saloam odom PATH ...` does and returns a Source.
+        "set"_a = py::none(), "metadata"_a = py::none(), "idle_timeout"_a = LiveOptions{}.idle_timeout_s,
+        "queue"_a = LiveOptions{}.queue_frames,
+        R"(Opens a sequence as `saloam odom PATH ...` does and returns a Source.
 
 Iterating it (or source[i]) gives Frame tuples (points, labels, times, stamp,
 rings) of numpy arrays that Odometry.register(*frame) / Slam.register(*frame)
@@ -561,9 +603,17 @@ take as they are. The options are the command line's: format ("auto",
 a profile name or file), topic, labels (a folder of .label files), frames
 ("A:B"), no_calib, intensity_scale ("auto", "1", "255", "65535"), semantics
 (False: labels are not read, as --no-semantics), segment / segmenter /
-projection (label scans in-process). config / set: as saloam.config();
+projection (label scans in-process), metadata (a capture's Ouster JSON or
+Velodyne calibration). config / set: as saloam.config();
 source.config is that configuration with the sensor profile the source chose,
-the one to give Odometry or Slam for the command line's results.)");
+the one to give Odometry or Slam for the command line's results.
+
+A live sensor: path "udp://[ADDRESS]:PORT" (port 0: a free one, which
+source.name tells) with sensor ("vlp16", "hdl32e", "hdl64e") or an Ouster's
+metadata. Iterating it gives the frames as the packets arrive, until no
+packet came for idle_timeout seconds (0: never); a consumer slower than the
+sensor loses whole frames beyond `queue` held ones, counted in
+source.stream_stats.)");
 
   py::class_<Odometry>(m, "Odometry", "The semantic-assisted LOAM odometry (SA-LOAM Sec. III-B), scan by scan.")
       .def(py::init<const py::object&, const py::object&>(), "config"_a = py::none(), "set"_a = py::none(),
