@@ -56,7 +56,11 @@ class LineOfKeyframes final : public KeyframeSet {
 ScoredCandidates scored(std::vector<std::size_t> keyframes, std::vector<double> scores) {
   ScoredCandidates s;
   s.keyframes = std::move(keyframes);
-  for (const double score : scores) s.matches.push_back(PlaceMatch{score});
+  for (const double score : scores) {
+    PlaceMatch match;
+    match.score = score;
+    s.matches.push_back(match);
+  }
   return s;
 }
 
