@@ -10,7 +10,7 @@
 
 #include "saloam/core/lie.hpp"
 #include "saloam/core/profiling.hpp"
-#include "saloam/maps/map_search.hpp"
+#include "saloam/slam/loop_candidates.hpp"
 
 namespace saloam {
 
@@ -43,7 +43,7 @@ Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optio
   tracking_.parallel = false;
   tracking_.inlier_distance = config.loop.inlier_distance;
   tracking_.level_line_max_rise = 0;  // as the verification's fits (LoopVerificationSettings)
-  score_threshold_ = place_score_threshold(config, places_.detector());
+  search_ = PlaceSearchOptions::from_config(config, places_.detector(), kSamePlaceDistance);
 }
 
 Localizer::~Localizer() = default;
@@ -106,12 +106,6 @@ const Localizer::Submap& Localizer::submap_near(const Eigen::Vector3d& position)
   return *submap_;
 }
 
-bool Localizer::small_correction(const Pose& predicted, const Pose& fitted) const {
-  const Pose difference = predicted.inverse() * fitted;
-  return difference.translation().norm() <= config_.localize.track_max_correction &&
-         rotation_angle(difference) <= config_.localize.track_max_correction_deg * M_PI / 180.0;
-}
-
 LoopVerification Localizer::verify_near(const Pose& predicted) {
   const Submap& submap = submap_near(predicted.translation());
   LoopVerification v;
@@ -139,7 +133,7 @@ void Localizer::track(LocalizedFrame& out) {
       const double total = static_cast<double>(features.edges.size() + features.planars.size());
       out.inlier_fraction = total > 0 ? fit.inliers / total : 0.0;
       out.mean_residual = fit.mean_inlier_residual();
-      if (fit.ok && out.inlier_fraction >= lc.track_min_inlier_fraction && small_correction(predicted, fit.pose)) {
+      if (fit.ok && out.inlier_fraction >= lc.track_min_inlier_fraction && small_correction(predicted, fit.pose, lc)) {
         map_from_odometry_ = orthonormalized(fit.pose * out.odometry_pose.inverse());
         last_fix_ = travelled_;
         out.fitted = true;
@@ -183,10 +177,10 @@ void Localizer::reenter(LocalizedFrame& out) {
 
 void Localizer::confirm(LocalizedFrame& out) {
   const LocalizeConfig& lc = config_.localize;
-  Hypothesis& h = *hypothesis_;
+  PlaceHypothesis& h = *hypothesis_;
   if (travelled_ - h.last_fix < lc.confirm_interval) return;
   const StageTimer timer;
-  const Pose predicted = orthonormalized(h.map_from_odometry * out.odometry_pose);
+  const Pose predicted = h.predict(out.odometry_pose);
   RelocalizationRecord record;
   record.frame = out.frame;
   record.travelled = travelled_;
@@ -194,36 +188,35 @@ void Localizer::confirm(LocalizedFrame& out) {
   record.pose = record.verification.relative;
   out.inlier_fraction = record.verification.inlier_fraction;
   out.mean_residual = record.verification.mean_residual;
-  if (record.verification.accepted && small_correction(predicted, record.verification.relative)) {
+  if (record.verification.accepted && small_correction(predicted, record.verification.relative, lc)) {
     require_measured_motion(record.verification, odometry_.last_features(), submap_->features, h.last_pose,
                             verification_);
   }
-  const bool agrees = record.verification.accepted && small_correction(predicted, record.verification.relative);
-  if (agrees) {
-    h.map_from_odometry = orthonormalized(record.verification.relative * out.odometry_pose.inverse());
-    h.last_fix = travelled_;
-    h.last_pose = record.verification.relative;
-    if (--h.confirmations_left <= 0) {
-      record.outcome = "confirmed";
-      map_from_odometry_ = h.map_from_odometry;
-      last_fix_ = travelled_;
-      if (!first_placed_) first_placed_ = travelled_;
-      out.event = state_ == State::kOdometry ? "relocalised (was on the odometry)" : "relocalised";
-      spdlog::info("frame {}: relocalised in the map at ({:.1f}, {:.1f}) after {:.1f} m", out.frame,
-                   record.pose.translation().x(), record.pose.translation().y(), travelled_);
-      state_ = State::kTracking;
-      frames_since_track_ = 0;
-      out.fitted = true;
-      hypothesis_.reset();
-    } else {
-      record.outcome = "confirms";
-    }
-  } else {
+  const bool agrees = record.verification.accepted && small_correction(predicted, record.verification.relative, lc);
+  if (!agrees) {
     record.outcome = "refuted";
     hypothesis_.reset();
+  } else if (h.confirm(record.verification.relative, out.odometry_pose, travelled_)) {
+    record.outcome = "confirmed";
+    out.event = state_ == State::kOdometry ? "relocalised (was on the odometry)" : "relocalised";
+    spdlog::info("frame {}: relocalised in the map at ({:.1f}, {:.1f}) after {:.1f} m", out.frame,
+                 record.pose.translation().x(), record.pose.translation().y(), travelled_);
+    place(h, out);
+  } else {
+    record.outcome = "confirms";
   }
   relocalizations_.push_back(std::move(record));
   out.timing.relocalization_ms += timer.elapsed_ms();
+}
+
+void Localizer::place(const PlaceHypothesis& h, LocalizedFrame& out) {
+  map_from_odometry_ = h.set_from_odometry;
+  last_fix_ = travelled_;
+  if (!first_placed_) first_placed_ = travelled_;
+  state_ = State::kTracking;
+  frames_since_track_ = 0;
+  out.fitted = true;
+  hypothesis_.reset();
 }
 
 std::vector<std::size_t> Localizer::relocalization_candidates(const LocalizedFrame& out) const {
@@ -232,55 +225,26 @@ std::vector<std::size_t> Localizer::relocalization_candidates(const LocalizedFra
   // candidate must: the drift since the last fix is bounded. Only a run
   // that was never placed, or whose odometry fallback ran out, searches the
   // whole map.
-  std::vector<std::size_t> candidates;
-  if (state_ == State::kOdometry) {
-    const Eigen::Vector3d predicted = (map_from_odometry_ * out.odometry_pose).translation();
-    const double radius =
-        std::max(config_.loop.delta_min, std::min(config_.loop.delta_max, config_.loop.sigma * (travelled_ - last_fix_)));
-    candidates = map_.near(predicted, radius);
-  } else {
-    candidates.resize(map_.size());
-    for (std::size_t k = 0; k < map_.size(); ++k) candidates[k] = k;
-  }
-  return candidates;
-}
-
-std::vector<Localizer::ProposedPlace> Localizer::propose_places(const LabelledCloud& scan,
-                                                               std::vector<std::size_t> candidates) const {
-  const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
-  const double offset = config_.localize.lateral_query_offset;
-  std::vector<double> sideways{0.0};
-  if (offset > 0) sideways.insert(sideways.end(), {offset, -offset});
-  // Each query's best places, its guess made the sensor's.
-  std::vector<ProposedPlace> proposed;
-  for (const double y : sideways) {
-    LabelledCloud seen_from = scan;  // the points in a frame `y` to the left of the sensor
-    for (Eigen::Vector3f& p : seen_from.points) p.y() -= static_cast<float>(y);
-    Pose query_from_sensor = Pose::Identity();
-    query_from_sensor.translation().y() = -y;
-    for (const PlaceCandidate& c : best_places(map_, places_, places_.describe(seen_from), candidates, score_threshold_, n)) {
-      proposed.push_back({c, orthonormalized(place_match_guess(c.match) * query_from_sensor)});
-    }
-  }
-  // The best n over all queries (the sensor's first among equals), one per place.
-  std::stable_sort(proposed.begin(), proposed.end(), [](const ProposedPlace& a, const ProposedPlace& b) {
-    return a.candidate.match.score > b.candidate.match.score;
-  });
-  return one_per_place(map_, proposed, n, [](const ProposedPlace& p) { return p.candidate.keyframe; });
+  if (state_ != State::kOdometry) return all_keyframes(map_);
+  const Eigen::Vector3d predicted = (map_from_odometry_ * out.odometry_pose).translation();
+  return map_.near(predicted, search_radius(CandidateGate::from_config(config_.loop), travelled_ - last_fix_));
 }
 
 void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
   last_relocalization_ = travelled_;
   const StageTimer timer;
-  const std::vector<ProposedPlace> chosen = propose_places(scan, relocalization_candidates(out));
+  // The scan described from the sensor and a lane width to either side.
+  const std::vector<PlaceProposal> chosen =
+      propose_places(map_, places_, lateral_queries(places_, scan, config_.localize.lateral_query_offset),
+                     relocalization_candidates(out), search_);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
   // With no prior (the whole map searched) the fit must also be unique.
   const LoopVerificationSettings& settings = state_ == State::kOdometry ? verification_ : unique_verification_;
-  for (const auto& [candidate, guess] : chosen) {
-    const std::size_t match = candidate.keyframe;
-    const LoopSubmap submap = submap_around(map_, match, w, verification_);
+  for (const PlaceProposal& proposal : chosen) {
+    const std::size_t match = proposal.keyframe;
+    const LoopSubmap submap = submap_around(map_, match, w, verification_, map_.size());
     // Guesses: the descriptor's (its yaw, SSC's offset, the query's side); on the odometry also where it says we are.
-    std::vector<Pose> guesses{guess};
+    std::vector<Pose> guesses{proposal.lateral_guess()};
     if (state_ == State::kOdometry) {
       add_distinct_guess(guesses, orthonormalized(map_.pose(match).inverse() * map_from_odometry_ * out.odometry_pose));
     }
@@ -288,25 +252,17 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
     record.frame = out.frame;
     record.travelled = travelled_;
     record.keyframe = match;
-    record.score = candidate.match;
+    record.score = proposal.match;
     record.verification = verify_loop(odometry_.last_features(), submap, guesses, settings);
     record.pose = orthonormalized(map_.pose(match) * record.verification.relative);
     const bool accepted = record.verification.accepted;
     if (accepted) {
-      Hypothesis h;
-      h.map_from_odometry = orthonormalized(record.pose * out.odometry_pose.inverse());
-      h.confirmations_left = config_.localize.confirmations;
-      h.last_fix = travelled_;
-      h.last_pose = record.pose;
-      if (h.confirmations_left <= 0) {
+      const PlaceHypothesis h =
+          PlaceHypothesis::from_fit(record.pose, out.odometry_pose, travelled_, config_.localize.confirmations);
+      if (h.confirmed()) {
         record.outcome = "confirmed";
-        map_from_odometry_ = h.map_from_odometry;
-        last_fix_ = travelled_;
-        if (!first_placed_) first_placed_ = travelled_;
-        state_ = State::kTracking;
-        frames_since_track_ = 0;
-        out.fitted = true;
         out.event = "relocalised";
+        place(h, out);
       } else {
         record.outcome = "hypothesis";
         hypothesis_ = h;

@@ -6,7 +6,7 @@
 //    every localize.relocalize_interval metres the scan is described (from
 //    the sensor and from a lane width to either side: Scan Context compares
 //    scans taken from one spot) and scored against every map keyframe (the
-//    map's detector), the best
+//    map's detector; the place search, slam/place_search.hpp), the best
 //    loop.num_loop above the detector's threshold are verified exactly as
 //    loop closure verifies a candidate (semantic ICP against the keyframes
 //    around it, coarse to fine, from the descriptor's yaw; the normalized
@@ -46,11 +46,11 @@
 
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
-#include "saloam/maps/map_search.hpp"
 #include "saloam/maps/prior_map.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
 #include "saloam/place/place_recognizer.hpp"
 #include "saloam/slam/loop_verification.hpp"
+#include "saloam/slam/place_search.hpp"
 
 namespace saloam {
 
@@ -115,35 +115,21 @@ class Localizer {
 
  private:
   enum class State { kLost, kTracking, kOdometry };
-  struct Hypothesis {
-    Pose map_from_odometry;
-    int confirmations_left = 0;
-    double last_fix = 0;  ///< travelled at the last fix
-    Pose last_pose = Pose::Identity();  ///< T_map<-sensor at the last fix
-  };
   struct Submap;
 
   void relocalize(const LabelledCloud& scan, LocalizedFrame& out);
   /// The map keyframes a relocalisation attempt scores: all of them, or on
   /// the odometry those within Eq. 3's radius of the prediction.
   [[nodiscard]] std::vector<std::size_t> relocalization_candidates(const LocalizedFrame& out) const;
-  /// A place to verify and the guess of T_keyframe<-sensor its query gives.
-  struct ProposedPlace {
-    PlaceCandidate candidate;
-    Pose guess;
-  };
-  /// The best loop.num_loop places among `candidates` for the scan described
-  /// from the sensor and from localize.lateral_query_offset to either side.
-  [[nodiscard]] std::vector<ProposedPlace> propose_places(const LabelledCloud& scan,
-                                                          std::vector<std::size_t> candidates) const;
   void confirm(LocalizedFrame& out);
+  /// A confirmed hypothesis places the run: tracking from this frame on.
+  void place(const PlaceHypothesis& h, LocalizedFrame& out);
   void track(LocalizedFrame& out);
   void reenter(LocalizedFrame& out);
   /// The tracking submap around `position` (rebuilt when it moved far enough).
   const Submap& submap_near(const Eigen::Vector3d& position);
   /// Registration against the tracking submap from `predicted`, with the loop acceptance test.
   LoopVerification verify_near(const Pose& predicted);
-  [[nodiscard]] bool small_correction(const Pose& predicted, const Pose& fitted) const;
 
   SaloamConfig config_;
   const PriorMap& map_;
@@ -152,10 +138,10 @@ class Localizer {
   LoopVerificationSettings verification_;
   LoopVerificationSettings unique_verification_;  ///< whole_map_verification: a place found with no prior
   RegistrationSettings tracking_;
-  double score_threshold_ = 0;
+  PlaceSearchOptions search_;  ///< loop.num_loop, one per kSamePlaceDistance
 
   State state_ = State::kLost;
-  std::optional<Hypothesis> hypothesis_;
+  std::optional<PlaceHypothesis> hypothesis_;  ///< T_map<-odometry to confirm
   Pose map_from_odometry_ = Pose::Identity();
   double travelled_ = 0;
   double last_fix_ = 0;              ///< travelled at the last fit used

@@ -297,6 +297,44 @@ void write_map_tables(const fs::path& folder, const SavedMap& map,
   folder_replace_step("map.json");
 }
 
+// MAP/config.yaml into map.config (its digest checked; version 3 on, every
+// key present), its detector the manifest's.
+void read_map_config(const fs::path& folder, SavedMap& map) {
+  const fs::path config_file = folder / "config.yaml";
+  const std::string config_text = read_checked(folder, map.manifest, "config.yaml", kMaxConfigBytes);
+  try {
+    apply_config_yaml(map.config, config_text, config_file.string());
+  } catch (const ConfigError& e) {
+    throw InputError(config_file, e.what());
+  }
+  if (map.manifest.version >= 3) {  // written whole by saloam: a missing key is a cut file, never a default
+    const std::vector<std::string> missing = missing_config_keys(config_text, map.config);
+    if (!missing.empty()) {
+      throw InputError(config_file, fmt::format("holds no {} ({} keys missing): a map's configuration holds every key "
+                                                "(is the file cut?)",
+                                                missing.front(), missing.size()));
+    }
+  }
+  if (map.config.loop.detector != map.manifest.detector) {
+    throw InputError(folder / "map.json", fmt::format("detector \"{}\", but config.yaml says loop.detector \"{}\"",
+                                                      map.manifest.detector, map.config.loop.detector));
+  }
+}
+
+// Every place descriptor holds the one of the map's detector.
+void check_place_descriptors(const SavedMap& map, const fs::path& places_file) {
+  const PlaceDetector detector = parse_place_detector(map.manifest.detector);
+  for (std::size_t k = 0; k < map.places.size(); ++k) {
+    const PlaceDescriptor& p = map.places[k];
+    const bool ok = (!uses_scan_context(detector) || p.context.descriptor.size() > 0) &&
+                    (!uses_ssc(detector) || !p.ssc.key_range.empty()) && (!uses_sgpr(detector) || p.graph.nodes.size() > 0 ||
+                                                                          p.embedding.squaredNorm() > 0);
+    if (!ok) {
+      throw InputError(places_file, fmt::format("place {} lacks the descriptor of the map's detector {}", k, map.manifest.detector));
+    }
+  }
+}
+
 }  // namespace
 
 void check_map_destination(const fs::path& folder) {
@@ -333,25 +371,7 @@ SavedMap read_map(const fs::path& folder) {
   map.folder = folder;
   const fs::path manifest_file = folder / "map.json";
   map.manifest = parse_map_manifest(read_file(manifest_file, kMaxManifestBytes, "map manifest"), manifest_file);
-  const fs::path config_file = folder / "config.yaml";
-  const std::string config_text = read_checked(folder, map.manifest, "config.yaml", kMaxConfigBytes);
-  try {
-    apply_config_yaml(map.config, config_text, config_file.string());
-  } catch (const ConfigError& e) {
-    throw InputError(config_file, e.what());
-  }
-  if (map.manifest.version >= 3) {  // written whole by saloam: a missing key is a cut file, never a default
-    const std::vector<std::string> missing = missing_config_keys(config_text, map.config);
-    if (!missing.empty()) {
-      throw InputError(config_file, fmt::format("holds no {} ({} keys missing): a map's configuration holds every key "
-                                                "(is the file cut?)",
-                                                missing.front(), missing.size()));
-    }
-  }
-  if (map.config.loop.detector != map.manifest.detector) {
-    throw InputError(manifest_file, fmt::format("detector \"{}\", but config.yaml says loop.detector \"{}\"",
-                                                map.manifest.detector, map.config.loop.detector));
-  }
+  read_map_config(folder, map);
   const fs::path keyframes_file = folder / "keyframes.bin";
   map.keyframes = parse_map_keyframes(bytes_of(read_table(folder, map.manifest, "keyframes.bin", MapTable::kKeyframes, map.config)), keyframes_file);
   if (map.keyframes.size() != map.manifest.keyframes) {
@@ -373,16 +393,7 @@ SavedMap read_map(const fs::path& folder) {
     map.feature_digests = parse_map_digests(bytes_of(read_table(folder, map.manifest, "digests.bin", MapTable::kDigests, map.config)), map.keyframes.size(),
                                             folder / "digests.bin");
   }
-  const PlaceDetector detector = parse_place_detector(map.manifest.detector);
-  for (std::size_t k = 0; k < map.places.size(); ++k) {
-    const PlaceDescriptor& p = map.places[k];
-    const bool ok = (!uses_scan_context(detector) || p.context.descriptor.size() > 0) &&
-                    (!uses_ssc(detector) || !p.ssc.key_range.empty()) && (!uses_sgpr(detector) || p.graph.nodes.size() > 0 ||
-                                                                          p.embedding.squaredNorm() > 0);
-    if (!ok) {
-      throw InputError(places_file, fmt::format("place {} lacks the descriptor of the map's detector {}", k, map.manifest.detector));
-    }
-  }
+  check_place_descriptors(map, places_file);
   return map;
 }
 

@@ -68,6 +68,11 @@ std::vector<std::size_t> PriorMap::near(const Eigen::Vector3d& position, double 
   return found;
 }
 
+bool PriorMap::in_frame(std::size_t k) const {
+  const std::uint32_t s = map_.keyframes[k].session;
+  return s >= map_.manifest.sessions.size() || map_.manifest.sessions[s].linked;
+}
+
 std::size_t PriorMap::cached_bytes() const {
   std::size_t bytes = 0;
   for (const auto& [k, f] : lru_) bytes += f->bytes();

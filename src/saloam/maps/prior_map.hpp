@@ -3,7 +3,9 @@
 // descriptors in memory, their feature clouds read on demand and kept in a
 // bounded cache (least recently used leave first), so memory follows the
 // part of the map in use, not the whole map. Keyframes near a position are
-// found through a 2D grid of their positions.
+// found through a 2D grid of their positions. It is a KeyframeSet: the
+// place search (slam/place_search.hpp) searches it as it searches the live
+// SLAM's keyframes.
 
 #include <cstddef>
 #include <functional>
@@ -16,10 +18,11 @@
 
 #include "saloam/core/types.hpp"
 #include "saloam/maps/map_format.hpp"
+#include "saloam/slam/place_search.hpp"
 
 namespace saloam {
 
-class PriorMap {
+class PriorMap : public KeyframeSet {
  public:
   /// `load_features(k)` gives keyframe k's features (read_map_features for a
   /// map on disk); at most `cached` of them are held at once.
@@ -31,15 +34,19 @@ class PriorMap {
   static PriorMap open(const std::filesystem::path& folder, SavedMap saved, std::size_t cached);
 
   [[nodiscard]] const SavedMap& saved() const { return map_; }
-  [[nodiscard]] std::size_t size() const { return map_.keyframes.size(); }
-  [[nodiscard]] const Pose& pose(std::size_t k) const { return map_.keyframes[k].pose; }
-  [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const { return map_.places[k]; }
+  [[nodiscard]] std::size_t size() const override { return map_.keyframes.size(); }
+  [[nodiscard]] Pose pose(std::size_t k) const override { return map_.keyframes[k].pose; }
+  [[nodiscard]] std::uint32_t session(std::size_t k) const override { return map_.keyframes[k].session; }
+  /// True unless keyframe k's session was not linked to the first (its poses in a frame of their own).
+  [[nodiscard]] bool in_frame(std::size_t k) const override;
+  [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const override { return map_.places[k]; }
   /// Keyframe k's features (read when not cached).
   [[nodiscard]] std::shared_ptr<const StoredFeatures> features(std::size_t k) const;
+  [[nodiscard]] ScanFeatures scan_features(std::size_t k) const override { return features(k)->expand(); }
 
   /// Keyframes whose position lies within `radius` of `position` (x-y and
   /// z), ascending.
-  [[nodiscard]] std::vector<std::size_t> near(const Eigen::Vector3d& position, double radius) const;
+  [[nodiscard]] std::vector<std::size_t> near(const Eigen::Vector3d& position, double radius) const override;
 
   [[nodiscard]] std::size_t loads() const { return loads_; }   ///< feature files read so far
   [[nodiscard]] std::size_t cached() const { return lru_.size(); }

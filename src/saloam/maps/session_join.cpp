@@ -8,8 +8,8 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
-#include "saloam/maps/map_search.hpp"
 #include "saloam/slam/loop_candidates.hpp"
+#include "saloam/slam/place_search.hpp"
 
 namespace saloam {
 
@@ -40,19 +40,11 @@ class SessionJoiner {
         verification_(LoopVerificationSettings::from_config(config)),
         whole_map_verification_(whole_map_verification(config)),
         gate_(CandidateGate::from_config(config.loop)),
-        threshold_(place_score_threshold(config, places.detector())) {}
+        search_(PlaceSearchOptions::from_config(config, places.detector(), kSamePlaceDistance)) {}
 
   JoinedMaps run();
 
  private:
-  struct Hypothesis {
-    Pose base_from_joining;
-    int confirmations_left = 0;
-    double last_fix = 0;
-    Pose last_pose = Pose::Identity();  ///< T_base<-joining keyframe at the last fix
-    std::vector<CrossEdge> edges;
-  };
-
   void relocalize(std::size_t q);
   void confirm(std::size_t q);
   void search_loop(std::size_t q);
@@ -61,20 +53,20 @@ class SessionJoiner {
   /// `last_fix` (T_base<-keyframe of the hypothesis' last fix; require_measured_motion).
   CrossSessionRecord fit_near(std::size_t q, const Pose& predicted, const Pose& last_fix) const;
   /// Registers joining keyframe q against the base keyframes around `candidate`.
-  CrossSessionRecord verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses,
+  CrossSessionRecord verify(std::size_t q, const PlaceProposal& candidate, std::vector<Pose> guesses,
                             const LoopVerificationSettings& settings) const;
   [[nodiscard]] CrossEdge edge_of(const CrossSessionRecord& r) const {
     return {r.match, r.query, r.verification.relative,
             registration_information(r.verification.registration, 1.0, config_.slam.information_scale)};
   }
-  [[nodiscard]] bool small_correction(const Pose& predicted, const Pose& fitted) const;
   /// A cross-session loop after the link may correct the link's prediction
   /// only as much as the joining map drifts: localize.track_max_correction
   /// (m, deg), times loop.sigma * `since` / track_max_correction where that
   /// is more (`since`: path since the last cross-session loop). Else `r` is
   /// marked not accepted: another place that looks alike.
   void require_link_agrees(CrossSessionRecord& r, const Pose& predicted, double since) const;
-  void link(std::size_t q, const Hypothesis& h);
+  /// The confirmed hypothesis links the maps; its fits become edges.
+  void link(std::size_t q);
   JoinedMaps assemble() const;
   std::vector<Pose> optimize(JoinedMaps& out) const;
 
@@ -85,10 +77,11 @@ class SessionJoiner {
   LoopVerificationSettings verification_;
   LoopVerificationSettings whole_map_verification_;  ///< a place found with no prior must be unique
   CandidateGate gate_;
-  double threshold_;
+  PlaceSearchOptions search_;  ///< loop.num_loop, one per kSamePlaceDistance
 
   std::vector<double> path_;  ///< [m] along the joining map's keyframes (sessions one after the other)
-  std::optional<Hypothesis> hypothesis_;
+  std::optional<PlaceHypothesis> hypothesis_;  ///< T_base<-joining to confirm
+  std::vector<CrossEdge> hypothesis_edges_;    ///< its fits so far
   std::optional<Pose> base_from_joining_;  ///< the link (updated by each cross-session loop)
   Pose initial_link_ = Pose::Identity();    ///< the link as confirmed: places the joining poses before the optimisation
   std::optional<std::size_t> linked_at_;
@@ -122,10 +115,10 @@ JoinedMaps SessionJoiner::run() {
   return out;
 }
 
-CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceCandidate& candidate, std::vector<Pose> guesses,
+CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceProposal& candidate, std::vector<Pose> guesses,
                                          const LoopVerificationSettings& settings) const {
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
-  const LoopSubmap submap = submap_around(base_, candidate.keyframe, w, verification_);
+  const LoopSubmap submap = submap_around(base_, candidate.keyframe, w, verification_, base_.size());
   add_distinct_guess(guesses, place_match_guess(candidate.match));
   CrossSessionRecord r;
   r.query = q;
@@ -139,29 +132,19 @@ CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceCandidate& ca
 
 void SessionJoiner::relocalize(std::size_t q) {
   last_attempt_ = path_[q];
-  std::vector<std::size_t> all(base_.size());
-  for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
-  const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
-  for (const PlaceCandidate& c : best_places(base_, places_, joining_.place(q), std::move(all), threshold_, n)) {
+  const std::vector<PlaceQuery> query{{joining_.place(q), 0.0}};
+  for (const PlaceProposal& c : propose_places(base_, places_, query, all_keyframes(base_), search_)) {
     CrossSessionRecord r = verify(q, c, {}, whole_map_verification_);
     if (!r.verification.accepted) {
       r.outcome = "rejected";
       records_.push_back(std::move(r));
       continue;
     }
-    Hypothesis h;
-    h.base_from_joining = orthonormalized(r.pose * joining_.pose(q).inverse());
-    h.confirmations_left = config_.localize.confirmations;
-    h.last_fix = path_[q];
-    h.last_pose = r.pose;
-    h.edges.push_back(edge_of(r));
-    r.outcome = h.confirmations_left <= 0 ? "confirmed" : "hypothesis";
+    hypothesis_ = PlaceHypothesis::from_fit(r.pose, joining_.pose(q), path_[q], config_.localize.confirmations);
+    hypothesis_edges_ = {edge_of(r)};
+    r.outcome = hypothesis_->confirmed() ? "confirmed" : "hypothesis";
     records_.push_back(std::move(r));
-    if (h.confirmations_left <= 0) {
-      link(q, h);
-    } else {
-      hypothesis_ = std::move(h);
-    }
+    if (hypothesis_->confirmed()) link(q);
     return;
   }
 }
@@ -192,45 +175,35 @@ CrossSessionRecord SessionJoiner::fit_near(std::size_t q, const Pose& predicted,
   return r;
 }
 
-bool SessionJoiner::small_correction(const Pose& predicted, const Pose& fitted) const {
-  const Pose difference = predicted.inverse() * fitted;
-  return difference.translation().norm() <= config_.localize.track_max_correction &&
-         rotation_angle(difference) <= config_.localize.track_max_correction_deg * M_PI / 180.0;
-}
-
 void SessionJoiner::confirm(std::size_t q) {
-  Hypothesis& h = *hypothesis_;
+  PlaceHypothesis& h = *hypothesis_;
   if (path_[q] - h.last_fix < config_.localize.confirm_interval) return;
-  const Pose predicted = orthonormalized(h.base_from_joining * joining_.pose(q));
+  const Pose predicted = h.predict(joining_.pose(q));
   CrossSessionRecord r = fit_near(q, predicted, h.last_pose);
-  if (!r.verification.accepted || !small_correction(predicted, r.pose)) {
+  if (!r.verification.accepted || !small_correction(predicted, r.pose, config_.localize)) {
     r.outcome = "refuted";
     records_.push_back(std::move(r));
     hypothesis_.reset();
     last_attempt_ = path_[q];
     return;
   }
-  h.base_from_joining = orthonormalized(r.pose * joining_.pose(q).inverse());
-  h.last_fix = path_[q];
-  h.last_pose = r.pose;
-  h.edges.push_back(edge_of(r));
-  const bool confirmed = --h.confirmations_left <= 0;
+  hypothesis_edges_.push_back(edge_of(r));
+  const bool confirmed = h.confirm(r.pose, joining_.pose(q), path_[q]);
   r.outcome = confirmed ? "confirmed" : "confirms";
   records_.push_back(std::move(r));
-  if (confirmed) {
-    link(q, h);
-    hypothesis_.reset();
-  }
+  if (confirmed) link(q);
 }
 
-void SessionJoiner::link(std::size_t q, const Hypothesis& h) {
-  base_from_joining_ = h.base_from_joining;
-  initial_link_ = h.base_from_joining;
+void SessionJoiner::link(std::size_t q) {
+  base_from_joining_ = hypothesis_->set_from_odometry;
+  initial_link_ = hypothesis_->set_from_odometry;
   linked_at_ = q;
   last_loop_ = path_[q];
-  edges_.insert(edges_.end(), h.edges.begin(), h.edges.end());
+  edges_.insert(edges_.end(), hypothesis_edges_.begin(), hypothesis_edges_.end());
   spdlog::info("joining keyframe {} ({:.1f} m along its path): linked to the base map by {} verified fits", q, path_[q],
-               h.edges.size());
+               hypothesis_edges_.size());
+  hypothesis_.reset();
+  hypothesis_edges_.clear();
 }
 
 void SessionJoiner::require_link_agrees(CrossSessionRecord& r, const Pose& predicted, double since) const {
@@ -252,10 +225,8 @@ void SessionJoiner::search_loop(std::size_t q) {
   if (path_[q] - last_loop_ < config_.loop.search_interval_after_loop) return;
   const Pose predicted = orthonormalized(*base_from_joining_ * joining_.pose(q));
   const double radius = search_radius(gate_, path_[q] - last_loop_);
-  const auto n = static_cast<std::size_t>(std::max(0, config_.loop.num_loop));
-  const std::vector<PlaceCandidate> candidates =
-      best_places(base_, places_, joining_.place(q), base_.near(predicted.translation(), radius), threshold_, n);
-  for (const PlaceCandidate& c : candidates) {
+  const std::vector<PlaceQuery> query{{joining_.place(q), 0.0}};
+  for (const PlaceProposal& c : propose_places(base_, places_, query, base_.near(predicted.translation(), radius), search_)) {
     CrossSessionRecord r = verify(q, c, {orthonormalized(base_.pose(c.keyframe).inverse() * predicted)}, verification_);
     require_link_agrees(r, predicted, path_[q] - last_loop_);
     const bool accepted = r.verification.accepted;

@@ -13,14 +13,14 @@
 //    loop.submap_half_width either side, from the descriptor's yaw; the loop
 //    acceptance test). Found with no prior, the fit must also be unique
 //    along its least constrained direction (localize.max_runner_up_ratio,
-//    map_search.hpp's whole_map_verification), as in localisation. An
+//    place_search.hpp's whole_map_verification), as in localisation. An
 //    accepted fit is a hypothesis of T_base<-joining.
 //  * Hypothesis: as localisation confirms a relocalisation (localizer.hpp),
 //    localize.confirmations later keyframes, localize.confirm_interval
 //    metres apart, must register against the base keyframes near the pose
 //    the hypothesis predicts (the acceptance test, a correction below
 //    localize.track_max_correction, and registered again from the last
-//    fix's pose the same pose: map_search.hpp's require_measured_motion);
+//    fix's pose the same pose: place_search.hpp's require_measured_motion);
 //    a failing one refutes it. Confirmed,
 //    the hypothesis and its confirmations become cross-session loop edges and
 //    the joining map is linked. Before that it is a component of its own.

@@ -464,6 +464,51 @@ class World::GroundMarch {
   double crossing_ = kInf;
 };
 
+namespace {
+// A ray's walk through a 2D grid of `cell` metres from `origin` (Amanatides &
+// Woo): the cell it is in (ix, iy) and the ray parameter where it leaves it.
+struct GridWalk {
+  GridWalk(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Eigen::Vector2d& origin, double cell) {
+    const double gxf = (o.x() - origin.x()) / cell, gyf = (o.y() - origin.y()) / cell;
+    ix = static_cast<int>(std::floor(gxf));
+    iy = static_cast<int>(std::floor(gyf));
+    step_x = d.x() >= 0 ? 1 : -1;
+    step_y = d.y() >= 0 ? 1 : -1;
+    const double inv_x = std::abs(d.x()) > 1e-12 ? 1.0 / std::abs(d.x()) : kInf;
+    const double inv_y = std::abs(d.y()) > 1e-12 ? 1.0 / std::abs(d.y()) : kInf;
+    t_max_x = (d.x() >= 0 ? (ix + 1 - gxf) : (gxf - ix)) * cell * inv_x;
+    t_max_y = (d.y() >= 0 ? (iy + 1 - gyf) : (gyf - iy)) * cell * inv_y;
+    t_delta_x = cell * inv_x;
+    t_delta_y = cell * inv_y;
+  }
+  [[nodiscard]] double exit() const { return std::min(t_max_x, t_max_y); }
+  void step() {
+    if (t_max_x < t_max_y) {
+      ix += step_x;
+      t_max_x += t_delta_x;
+    } else {
+      iy += step_y;
+      t_max_y += t_delta_y;
+    }
+  }
+
+  int ix = 0, iy = 0, step_x = 1, step_y = 1;
+  double t_max_x = 0, t_max_y = 0, t_delta_x = 0, t_delta_y = 0;
+};
+
+// The return of object `p` hit at `range` (surface normal from `iv`).
+RayHit object_hit(const Primitive& p, const Interval& iv, const Eigen::Vector3d& d, double range) {
+  RayHit hit;
+  hit.hit = true;
+  hit.range = range;
+  hit.label = p.label;
+  hit.instance = p.instance;
+  const double cos_inc = std::abs(iv.normal.dot(d));
+  hit.remission = static_cast<float>(p.remission * (0.55 + 0.45 * cos_inc));
+  return hit;
+}
+}  // namespace
+
 World::RayOrigin World::ray_origin(const Eigen::Vector3d& position) const {
   return {position, position.z() - ground_height(position.x(), position.y())};
 }
@@ -501,61 +546,44 @@ RayHit World::cast_ray(const RayOrigin& origin, const Eigen::Vector3d& d, double
   };
   for (const auto& p : dynamic) consider(p);
 
-  // 2D DDA over the object grid (Amanatides & Woo), mailboxing repeated primitives.
-  const double cell = options_.object_cell;
-  double gxf = (o.x() - ground_.origin.x()) / cell, gyf = (o.y() - ground_.origin.y()) / cell;
-  int ix = static_cast<int>(std::floor(gxf)), iy = static_cast<int>(std::floor(gyf));
-  const int step_x = d.x() >= 0 ? 1 : -1, step_y = d.y() >= 0 ? 1 : -1;
-  const double inv_x = std::abs(d.x()) > 1e-12 ? 1.0 / std::abs(d.x()) : kInf;
-  const double inv_y = std::abs(d.y()) > 1e-12 ? 1.0 / std::abs(d.y()) : kInf;
-  double t_max_x = (d.x() >= 0 ? (ix + 1 - gxf) : (gxf - ix)) * cell * inv_x;
-  double t_max_y = (d.y() >= 0 ? (iy + 1 - gyf) : (gyf - iy)) * cell * inv_y;
-  const double t_delta_x = cell * inv_x, t_delta_y = cell * inv_y;
+  // 2D DDA over the object grid, mailboxing repeated primitives.
+  GridWalk walk(o, d, ground_.origin, options_.object_cell);
   std::array<std::uint32_t, 48> tested{};
   std::size_t n_tested = 0;
   double t_cell_start = 0.0;
   while (nearer(t_cell_start)) {
-    if (ix < 0 || iy < 0 || ix >= gx_ || iy >= gy_) break;
-    const std::size_t c = static_cast<std::size_t>(iy) * static_cast<std::size_t>(gx_) + static_cast<std::size_t>(ix);
+    if (walk.ix < 0 || walk.iy < 0 || walk.ix >= gx_ || walk.iy >= gy_) break;
+    const std::size_t c =
+        static_cast<std::size_t>(walk.iy) * static_cast<std::size_t>(gx_) + static_cast<std::size_t>(walk.ix);
     for (std::uint32_t k = cell_start_[c]; k < cell_start_[c + 1]; ++k) {
       const std::uint32_t id = cell_items_[k];
-      if (std::find(tested.begin(), tested.begin() + static_cast<std::ptrdiff_t>(n_tested), id) !=
-          tested.begin() + static_cast<std::ptrdiff_t>(n_tested)) {
-        continue;
-      }
+      const auto tested_end = tested.begin() + static_cast<std::ptrdiff_t>(n_tested);
+      if (std::find(tested.begin(), tested_end, id) != tested_end) continue;
       if (n_tested < tested.size()) tested[n_tested++] = id;
       consider(primitives_[id]);
     }
-    const double t_exit = std::min(t_max_x, t_max_y);
+    const double t_exit = walk.exit();
     if (!nearer(t_exit)) break;
     t_cell_start = t_exit;
-    if (t_max_x < t_max_y) {
-      ix += step_x;
-      t_max_x += t_delta_x;
-    } else {
-      iy += step_y;
-      t_max_y += t_delta_y;
-    }
+    walk.step();
   }
 
   // An object was kept only where the ground crosses beyond it; otherwise the
   // ground is the nearest surface (or nothing within range).
   const double best_t = ground.beyond(object_t) ? object_t : ground.crossing();
   if (blocked || best_t > max_range) return best;
-  best.hit = true;
-  best.range = best_t;
-  if (best_p != nullptr) {
-    best.label = best_p->label;
-    best.instance = best_p->instance;
-    const double cos_inc = std::abs(best_iv.normal.dot(d));
-    best.remission = static_cast<float>(best_p->remission * (0.55 + 0.45 * cos_inc));
-  } else {
-    const Eigen::Vector3d p = o + best_t * d;
-    const GroundInfo g = ground_at(p.x(), p.y());
-    best.label = g.label;
-    best.remission = static_cast<float>(g.remission * (0.6 + 0.4 * std::min(1.0, std::abs(d.z()) * 4.0)));
-  }
-  return best;
+  return best_p != nullptr ? object_hit(*best_p, best_iv, d, best_t) : ground_hit(o, d, best_t);
+}
+
+RayHit World::ground_hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double range) const {
+  RayHit hit;
+  hit.hit = true;
+  hit.range = range;
+  const Eigen::Vector3d p = o + range * d;
+  const GroundInfo g = ground_at(p.x(), p.y());
+  hit.label = g.label;
+  hit.remission = static_cast<float>(g.remission * (0.6 + 0.4 * std::min(1.0, std::abs(d.z()) * 4.0)));
+  return hit;
 }
 
 }  // namespace saloam

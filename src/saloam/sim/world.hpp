@@ -228,8 +228,9 @@ class World {
   [[nodiscard]] RayHit cast_ray(const RayOrigin& origin, const Eigen::Vector3d& direction, double max_range, double t,
                                 std::span<const Primitive> dynamic, Rng& rng) const;
 
-
  private:
+  /// The ground's return `range` metres along the ray from `o` in direction `d`.
+  [[nodiscard]] RayHit ground_hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d, double range) const;
   /// Where agent `a` stands at time t (ground-plane position [m]) and the
   /// path's direction there; false when it is not on the path then.
   bool agent_place(const Agent& a, double t, Eigen::Vector2d& xy, Eigen::Vector2d& direction) const;

@@ -40,6 +40,14 @@ std::size_t StoredFeatures::bytes() const {
   return (edge_points.size() + planar_points.size()) * (sizeof(Eigen::Vector3f) + sizeof(ClassIndex));
 }
 
+std::vector<std::size_t> LiveKeyframes::near(const Eigen::Vector3d& position, double radius) const {
+  std::vector<std::size_t> found;
+  for (std::size_t k = 0; k < keyframes_.size(); ++k) {
+    if ((graph_.pose(k).translation() - position).norm() <= radius) found.push_back(k);
+  }
+  return found;
+}
+
 SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> network)
     : config_(config),
       odometry_(config.odometry),
@@ -47,13 +55,8 @@ SlamSystem::SlamSystem(const SaloamConfig& config, std::optional<SgprNetwork> ne
       gate_(CandidateGate::from_config(config.loop)),
       verification_(LoopVerificationSettings::from_config(config)),
       graph_options_(PoseGraphOptions::from_config(config.slam)),
-      rng_(config.loop.seed) {
-  switch (places_.detector()) {
-    case PlaceDetector::kSgpr: score_threshold_ = config.loop.zeta; break;
-    case PlaceDetector::kSsc: score_threshold_ = config.loop.ssc_zeta; break;
-    default: score_threshold_ = config.loop.scancontext_zeta; break;
-  }
-}
+      search_(PlaceSearchOptions::from_config(config, places_.detector(), 0.0)),
+      rng_(config.loop.seed) {}
 
 SlamSystem::~SlamSystem() = default;
 
@@ -118,13 +121,13 @@ void SlamSystem::close_loops(SlamFrameTimings& timing) {
   StageTimer timer;
   const std::size_t query = keyframes_.size() - 1;
   const std::vector<std::size_t> candidates = select_candidates(query);
-  const std::vector<Proposal> proposals = score_candidates(query, candidates);
+  const std::vector<PlaceProposal> proposals = propose(query, candidates);
   timing.search_ms = timer.lap().wall_ms;
 
   bool closed = false;
   // Best score first; the first accepted loop ends the search: the others
   // would constrain the same stretch again.
-  for (const Proposal& proposal : proposals) {
+  for (const PlaceProposal& proposal : proposals) {
     LoopRecord record = verify(query, proposal);
     const bool accepted = record.verification.accepted;
     loops_.push_back(std::move(record));
@@ -146,62 +149,31 @@ std::vector<std::size_t> SlamSystem::select_candidates(std::size_t query) {
   return loop_candidates(keyframe_places_[query], earlier, gate_, rng_);
 }
 
-std::vector<SlamSystem::Proposal> SlamSystem::score_candidates(std::size_t query,
-                                                               const std::vector<std::size_t>& candidates) const {
-  std::vector<const PlaceDescriptor*> descriptors;
-  descriptors.reserve(candidates.size());
-  for (const std::size_t c : candidates) descriptors.push_back(&keyframes_[c].place);
-  const std::vector<PlaceMatch> matches = places_.match(keyframes_[query].place, descriptors);
-  std::vector<Proposal> proposals;
-  for (std::size_t k = 0; k < candidates.size(); ++k) {
-    if (matches[k].score > score_threshold_) proposals.push_back({candidates[k], matches[k]});
-  }
-  // Highest score first; ties by the older keyframe (deterministic).
-  std::sort(proposals.begin(), proposals.end(), [](const Proposal& a, const Proposal& b) {
-    return a.match.score != b.match.score ? a.match.score > b.match.score : a.keyframe < b.keyframe;
-  });
-  if (proposals.size() > static_cast<std::size_t>(std::max(0, config_.loop.num_loop))) {
-    proposals.resize(static_cast<std::size_t>(std::max(0, config_.loop.num_loop)));
-  }
+std::vector<PlaceProposal> SlamSystem::propose(std::size_t query, const std::vector<std::size_t>& candidates) const {
+  const ScoredCandidates scored = score_candidates(live_, places_, keyframes_[query].place, candidates);
+  std::vector<PlaceProposal> proposals = rank_places(live_, scored, search_);
   // Beyond the paper: the candidate nearest to the query by the current
   // estimate, when nearer than proximity_radius, is verified too, whatever
   // its score (descriptors lose similarity on reverse revisits in the other
   // lane; the estimate, corrected by earlier loops, still knows the place).
-  if (config_.loop.proximity_radius > 0 && !candidates.empty()) {
-    const Eigen::Vector3d& q = keyframe_places_[query].position;
-    std::size_t nearest = candidates.size();
-    double best = config_.loop.proximity_radius * config_.loop.proximity_radius;
-    for (std::size_t k = 0; k < candidates.size(); ++k) {
-      const double d2 = (keyframe_places_[candidates[k]].position - q).squaredNorm();
-      if (d2 < best) {
-        best = d2;
-        nearest = k;
-      }
-    }
-    const bool proposed = nearest < candidates.size() &&
-                          std::any_of(proposals.begin(), proposals.end(),
-                                      [&](const Proposal& p) { return p.keyframe == candidates[nearest]; });
-    if (nearest < candidates.size() && !proposed) proposals.push_back({candidates[nearest], matches[nearest], true});
+  if (config_.loop.proximity_radius > 0) {
+    add_nearest(proposals, live_, scored, keyframe_places_[query].position, config_.loop.proximity_radius);
   }
   return proposals;
 }
 
-LoopRecord SlamSystem::verify(std::size_t query, const Proposal& proposal) const {
+LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) const {
   const std::size_t match = proposal.keyframe;
-  const Pose match_inverse = graph_.pose(match).inverse();
   // The submap: keyframes around the match (never the query's own recent
   // past), placed by the current estimates relative to the match.
-  LoopSubmap submap(verification_);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
-  const std::size_t first = match >= w ? match - w : 0;
-  const std::size_t last = std::min(match + w, query - 1);
-  for (std::size_t k = first; k <= last; ++k) {
-    if (keyframes_[query].travelled - keyframes_[k].travelled < 0.5 * gate_.exclude_recent_distance) continue;
-    submap.add(keyframes_[k].features.expand(), match_inverse * graph_.pose(k));
-  }
+  const double recent = 0.5 * gate_.exclude_recent_distance;
+  const LoopSubmap submap = submap_around(live_, match, w, verification_, query, [&](std::size_t k) {
+    return keyframes_[query].travelled - keyframes_[k].travelled >= recent;
+  });
   // Initial guesses: the current estimates, and the descriptor's yaw (with
   // its x-y offset when it gives one, SSC's) in place.
-  std::vector<Pose> guesses{orthonormalized(match_inverse * graph_.pose(query))};
+  std::vector<Pose> guesses{orthonormalized(graph_.pose(match).inverse() * graph_.pose(query))};
   if (proposal.match.yaw) add_distinct_guess(guesses, place_match_guess(proposal.match));
   LoopRecord record;
   record.query_keyframe = query;

@@ -4,8 +4,10 @@
 //
 //   odometry_pose = odometry.register_frame(scan)
 //   if a keyframe is due:   describe the place, keep the features, add a graph node
-//   if a search is due:     candidates (Eq. 3) -> scores (> threshold, best N_loop)
-//                           -> geometric verification -> loop edge -> optimise
+//   if a search is due:     the place search (place_search.hpp) over the
+//                           earlier keyframes: candidates (Eq. 3) -> scores
+//                           (> threshold, best N_loop) -> geometric
+//                           verification -> loop edge -> optimise
 //
 // Keyframes (every `slam.keyframe_distance` metres or `keyframe_angle_deg`
 // degrees) are the pose graph's nodes and the only frames searched for or
@@ -27,6 +29,7 @@
 #include "saloam/place/place_recognizer.hpp"
 #include "saloam/slam/loop_candidates.hpp"
 #include "saloam/slam/loop_verification.hpp"
+#include "saloam/slam/place_search.hpp"
 #include "saloam/slam/pose_graph.hpp"
 
 namespace saloam {
@@ -49,6 +52,24 @@ struct Keyframe {
   Pose odometry_pose = Pose::Identity();
   StoredFeatures features;
   PlaceDescriptor place;
+};
+
+/// The live SLAM's keyframes as the place search sees them: one session,
+/// poses at the pose graph's current estimates, features kept in memory.
+class LiveKeyframes final : public KeyframeSet {
+ public:
+  LiveKeyframes(const std::vector<Keyframe>& keyframes, const PoseGraph& graph) : keyframes_(keyframes), graph_(graph) {}
+  [[nodiscard]] std::size_t size() const override { return keyframes_.size(); }
+  [[nodiscard]] Pose pose(std::size_t k) const override { return graph_.pose(k); }
+  [[nodiscard]] std::uint32_t session(std::size_t /*k*/) const override { return 0; }
+  [[nodiscard]] bool in_frame(std::size_t /*k*/) const override { return true; }
+  [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const override { return keyframes_[k].place; }
+  [[nodiscard]] ScanFeatures scan_features(std::size_t k) const override { return keyframes_[k].features.expand(); }
+  [[nodiscard]] std::vector<std::size_t> near(const Eigen::Vector3d& position, double radius) const override;
+
+ private:
+  const std::vector<Keyframe>& keyframes_;
+  const PoseGraph& graph_;
 };
 
 /// One verified loop candidate (a row of loops.csv).
@@ -104,19 +125,13 @@ class SlamSystem {
   [[nodiscard]] std::size_t keyframe_bytes() const;
 
  private:
-  struct Proposal {
-    std::size_t keyframe;
-    PlaceMatch match;
-    bool by_proximity = false;  ///< proposed for its estimated distance, not its score
-  };
-
   [[nodiscard]] bool keyframe_due(const Pose& odometry_pose) const;
   void add_keyframe(const LabelledCloud& scan, const Pose& odometry_pose, double timestamp, SlamFrameTimings& timing);
   [[nodiscard]] bool search_due() const;
   void close_loops(SlamFrameTimings& timing);
   [[nodiscard]] std::vector<std::size_t> select_candidates(std::size_t query);
-  [[nodiscard]] std::vector<Proposal> score_candidates(std::size_t query, const std::vector<std::size_t>& candidates) const;
-  [[nodiscard]] LoopRecord verify(std::size_t query, const Proposal& proposal) const;
+  [[nodiscard]] std::vector<PlaceProposal> propose(std::size_t query, const std::vector<std::size_t>& candidates) const;
+  [[nodiscard]] LoopRecord verify(std::size_t query, const PlaceProposal& proposal) const;
   void add_loop_edge(const LoopRecord& record);
   void optimize();
   /// Edge information from a registration: scale * (H / N + eps I).
@@ -128,13 +143,14 @@ class SlamSystem {
   CandidateGate gate_;
   LoopVerificationSettings verification_;
   PoseGraphOptions graph_options_;
-  double score_threshold_ = 0;
+  PlaceSearchOptions search_;  ///< every keyframe its own place (same_place_distance 0)
   std::mt19937_64 rng_;
 
   PoseGraph graph_;
   std::vector<Keyframe> keyframes_;
   std::vector<KeyframePlace> keyframe_places_;  ///< positions at the current estimates
   std::vector<std::size_t> frame_keyframe_;     ///< per frame: the keyframe it rides on
+  LiveKeyframes live_{keyframes_, graph_};
   std::vector<LoopRecord> loops_;
   std::size_t accepted_ = 0;
   std::size_t optimizations_ = 0;
