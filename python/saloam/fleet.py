@@ -202,11 +202,11 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
         slams = [client.submit(slam_drive, k, d, work, program, tuple(slam_options), plan, pure=False, retries=2,
                                key=f"slam-{k}-{uuid.uuid4().hex[:8]}")
                  for k, d in enumerate(drives)]
-        # The merge tree: pairs of neighbours, level by level; a merge may
-        # run once its two inputs are there. Dask gives a free worker the
-        # earliest submitted task that can run, so the SLAMs go first and the
-        # merges fill the workers after them, level by level: only the last
-        # merge leaves a worker idle.
+        # The merge tree: pairs of neighbours, level by level. A merge runs
+        # once its two inputs are there: Dask hands a free worker a ready
+        # merge before the SLAMs still queued, so the merging overlaps the
+        # mapping, and after the last SLAM only the merges on its path up
+        # the tree remain (log2 N of them, one after the other).
         level, merges, depth = slams, [], 0
         while len(level) > 1:
             depth += 1
