@@ -29,7 +29,7 @@ declare -A MAX_LEN=(
   [times]=2048 [sgw]=200000 [graph_json]=8192 [config]=8192 [segmenter_spec]=4096 [sensor_profile]=4096
   [pcd]=4096 [ply]=4096 [pointcloud2]=4096 [kitti_raw]=2048 [rosbag]=16384 [map]=8192
   [pointcloud2_cdr]=4096 [mcap]=16384 [rosbag2]=32768
-  [ouster_packet]=20000 [velodyne_packet]=8192
+  [ouster_packet]=20000 [velodyne_packet]=8192 [path_rules]=256
 )
 
 build() {

@@ -328,6 +328,7 @@ std::unique_ptr<FrameSource> SourceArgs::open(bool ignore_labels, SaloamConfig& 
     spdlog::info("sensor: {}, {}", choice.profile->title(), choice.how);
   }
   if (options.segmentation) options.segmentation->rings = config.odometry.features;
+  options.sensor_lasers = choice.lasers;
   if (chosen) *chosen = std::move(choice);
   return add_stages(std::move(reader), options);
 }
@@ -357,6 +358,7 @@ SensorChoice choose_sensor(const std::string& sensor, FrameSource& source) {
   if (sensor != "auto") {
     choice.profile = sensor_profile(sensor);
     choice.how = fmt::format("as given (--sensor {})", sensor);
+    choice.lasers = static_cast<std::size_t>(choice.profile->beams());
     return choice;
   }
   if (!source.info().rereadable || source.size() == 0) {
@@ -375,6 +377,12 @@ SensorChoice choose_sensor(const std::string& sensor, FrameSource& source) {
   }
   const SensorGuess guess = guess_sensor(first, profiles);
   choice.profile = profiles[guess.profile];
+  // The guess is the nearest profile; a first scan numbering its rings
+  // beyond the profile's lasers says it is not the sensor itself, so its
+  // rings are not held to that count.
+  const auto lasers = static_cast<std::size_t>(choice.profile->beams());
+  const bool rings_fit = !first.has_rings() || std::ranges::all_of(first.ring, [&](auto r) { return r < lasers; });
+  choice.lasers = rings_fit ? lasers : 0;
   std::string subset;
   if (auto kept = laser_subset(*choice.profile, guess.lasers)) {
     subset = fmt::format(", {} of its {} lasers", kept->beams(), choice.profile->beams());

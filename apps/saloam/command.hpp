@@ -76,6 +76,10 @@ struct SegmentOptions {
 struct SensorChoice {
   std::optional<SensorProfile> profile;  ///< none with --sensor none
   std::string how;                       ///< "given (--sensor vlp16)", "guessed from the first scan: ..."
+  /// Rings at or beyond this fit no laser of the sensor (SourceOptions::sensor_lasers): the whole
+  /// profile's laser count (also when a subset of its lasers was kept); 0: not checked (no profile,
+  /// or a guess whose first scan has rings beyond the guessed profile's lasers).
+  std::size_t lasers = 0;
 };
 
 /// The sensor profiles shipped in data_dir()/config/sensors/ (by name).

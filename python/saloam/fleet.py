@@ -21,7 +21,6 @@ import argparse
 import ctypes
 import json
 import os
-import resource
 import shutil
 import signal
 import subprocess
@@ -40,22 +39,46 @@ def _die_with_parent():
         pass
 
 
-def _cpu_seconds():
-    """CPU time of this process's finished children (a worker runs one task at a time: its task's)."""
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
 def run_saloam(args, program=None):
-    """Runs `saloam ARGS...` and returns its output; RuntimeError with it when it fails."""
+    """Runs `saloam ARGS...`; returns its output (stdout and stderr), CPU seconds (user + sys) and peak resident
+    memory [MiB] (the subprocess's own rusage); RuntimeError with the output when it fails."""
     command = [program or cli_path(), "-q", *[str(a) for a in args]]
     # Dask's workers set MALLOC_TRIM_THRESHOLD_ for their own heap; in the
     # program it made the SLAM 30-60 % slower (docs/fleet.md).
     env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
-    done = subprocess.run(command, capture_output=True, text=True, preexec_fn=_die_with_parent, env=env)
-    if done.returncode != 0:
-        raise RuntimeError(f"{' '.join(command)} failed ({done.returncode}):\n{done.stderr}{done.stdout}")
-    return done.stdout
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                               preexec_fn=_die_with_parent, env=env)
+    with process.stdout:
+        output = process.stdout.read()
+    _, status, usage = os.wait4(process.pid, 0)
+    process.returncode = os.waitstatus_to_exitcode(status)
+    if process.returncode != 0:
+        raise RuntimeError(f"{' '.join(command)} failed ({process.returncode}):\n{output}")
+    return {"output": output, "cpu_s": round(usage.ru_utime + usage.ru_stime, 3),
+            "peak_mib": round(usage.ru_maxrss / 1024, 1)}
+
+
+def threads_per_task(plan):
+    """The odometry threads of a task on this host: `plan` is an int, or {host name: threads} (1 on a host that
+    joined after the plan was made)."""
+    if isinstance(plan, int):
+        return plan
+    return plan.get(os.uname().nodename, 1)
+
+
+def thread_plan(client, threads):
+    """`threads` (> 0) for every task; 0: each host's cores shared among the task slots (worker threads) it
+    runs, at least 1, as {host name: threads}. On a 2-core host, 2 one-thread workers give each task's SLAM 1
+    thread and 1 worker gives it 2: the workers use the cores without oversubscribing them."""
+    if threads > 0:
+        return threads
+    hosts = client.run(lambda: (os.uname().nodename, os.cpu_count() or 1))
+    nthreads = {address: w["nthreads"] for address, w in client.scheduler_info()["workers"].items()}
+    slots, cores = {}, {}
+    for address, (host, count) in hosts.items():
+        slots[host] = slots.get(host, 0) + nthreads.get(address, 1)
+        cores[host] = count
+    return {host: max(1, cores[host] // slots[host]) for host in cores}
 
 
 def _put_in_place(attempt, final):
@@ -68,33 +91,39 @@ def _put_in_place(attempt, final):
         shutil.rmtree(attempt, ignore_errors=True)
 
 
-def slam_drive(index, drive, work, program=None, options=()):
-    """Task: `saloam slam DRIVE --save-map`; returns what the summary needs."""
-    start, cpu = time.time(), _cpu_seconds()
+def slam_drive(index, drive, work, program=None, options=(), threads=1):
+    """Task: `saloam slam DRIVE --save-map` with `threads` odometry threads (an int, or a plan of
+    thread_plan()); returns what the summary needs."""
+    start = time.time()
     final_out, final_map = os.path.join(work, f"slam_{index:03d}"), os.path.join(work, f"map_{index:03d}")
+    threads = threads_per_task(threads)
+    usage = {"cpu_s": None, "peak_mib": None}  # when an earlier attempt's map is in place
     if not os.path.isdir(final_map):
         token = uuid.uuid4().hex[:8]
         out, saved = f"{final_out}.{token}.part", f"{final_map}.{token}.part"
-        run_saloam(["slam", drive, "--out", out, "--no-map", "--save-map", saved, *options], program)
+        # The fleet's thread count first: a --set threads=N of the options comes later and wins.
+        usage = run_saloam(["slam", drive, "--out", out, "--no-map", "--save-map", saved,
+                            "--set", f"odometry.threads={threads}", *options], program)
         _put_in_place(out, final_out)
         _put_in_place(saved, final_map)
     with open(os.path.join(final_out, "summary.json")) as f:
         summary = json.load(f)
     return {"drive": os.path.abspath(drive), "map": final_map, "drives": [index], "start": start, "end": time.time(),
             "frames": summary.get("frames"), "keyframes": summary.get("keyframes"),
-            "loops_accepted": summary.get("loops_accepted"), "host": os.uname().nodename,
-            "cpu_s": round(_cpu_seconds() - cpu, 3)}
+            "loops_accepted": summary.get("loops_accepted"), "host": os.uname().nodename, "threads": threads,
+            "cpu_s": usage["cpu_s"], "peak_mib": usage["peak_mib"]}
 
 
 def merge_pair(a, b, out, program=None, options=()):
     """Task: `saloam merge A B --out OUT` (A's frame); returns the merged map and its drives."""
-    start, cpu = time.time(), _cpu_seconds()
+    start = time.time()
+    usage = {"cpu_s": None, "peak_mib": None}
     if not os.path.isdir(out):
         attempt = f"{out}.{uuid.uuid4().hex[:8]}.part"
-        run_saloam(["merge", a["map"], b["map"], "--out", attempt, *options], program)
+        usage = run_saloam(["merge", a["map"], b["map"], "--out", attempt, *options], program)
         _put_in_place(attempt, out)
     return {"map": out, "drives": a["drives"] + b["drives"], "start": start, "end": time.time(),
-            "merged": [a["map"], b["map"]], "cpu_s": round(_cpu_seconds() - cpu, 3)}
+            "merged": [a["map"], b["map"]], "cpu_s": usage["cpu_s"], "peak_mib": usage["peak_mib"]}
 
 
 def simulate_drive(index, out, preset, passes, beams, seed, program=None):
@@ -132,8 +161,10 @@ def _span(records):
 
 
 def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, slam_options=(), merge_options=(),
-              simulate=None, summary_file=None, log=print):
+              simulate=None, summary_file=None, threads=0, log=print):
     """Maps `drives` (sequence folders) into one map at `out`; returns the summary (also written as JSON).
+
+    threads: each drive's odometry threads; 0: each host's cores shared among its worker threads (thread_plan).
 
     simulate: {"drives": N, "frames": F, "preset": P, "beams": B, "seed": S, "reverse": bool} makes the
     drives first (tasks as well), in `work`/drives.
@@ -166,12 +197,16 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
         if not drives:
             raise RuntimeError("no drives given")
         drives = [os.path.abspath(d) for d in drives]
-        t = time.time()
-        slams = [client.submit(slam_drive, k, d, work, program, tuple(slam_options), pure=False, retries=2,
+        plan = thread_plan(client, threads)
+        t = mapping_start = time.time()
+        slams = [client.submit(slam_drive, k, d, work, program, tuple(slam_options), plan, pure=False, retries=2,
                                key=f"slam-{k}-{uuid.uuid4().hex[:8]}")
                  for k, d in enumerate(drives)]
-        # The merge tree: pairs of neighbours, level by level; each merge
-        # starts as soon as its two inputs are there.
+        # The merge tree: pairs of neighbours, level by level. A merge runs
+        # once its two inputs are there: Dask hands a free worker a ready
+        # merge before the SLAMs still queued, so the merging overlaps the
+        # mapping, and after the last SLAM only the merges on its path up
+        # the tree remain (log2 N of them, one after the other).
         level, merges, depth = slams, [], 0
         while len(level) > 1:
             depth += 1
@@ -218,15 +253,20 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
               for d, s in zip(final["drives"], sessions)]
     summary = {
         "map": out,
-        "drives": [{k: r[k] for k in ("drive", "map", "frames", "keyframes", "loops_accepted", "host", "cpu_s")} |
-                   {"seconds": round(r["end"] - r["start"], 3)} for r in slam_results],
+        "drives": [{k: r[k] for k in ("drive", "map", "frames", "keyframes", "loops_accepted", "host", "threads",
+                                      "cpu_s", "peak_mib")} |
+                   {"started_s": round(r["start"] - mapping_start, 3), "seconds": round(r["end"] - r["start"], 3)}
+                   for r in slam_results],
         "joined": joined,
         "linked_drives": sum(j["linked"] for j in joined),
         "cross_drive_loops": manifest.get("cross_session_loops", 0),
         "keyframes": manifest.get("keyframes"),
-        "merges": [{"maps": m["merged"], "seconds": round(m["end"] - m["start"], 3), "cpu_s": m["cpu_s"]}
+        "merges": [{"maps": m["merged"], "started_s": round(m["start"] - mapping_start, 3),
+                    "seconds": round(m["end"] - m["start"], 3), "cpu_s": m["cpu_s"],
+                    "peak_mib": m["peak_mib"]}
                    for m in merge_results],
         "workers": None if scheduler else workers,
+        "threads_per_task": plan,
         "scheduler": scheduler or "LocalCluster",
     }
     # The merged map's error per drive, when every drive has reference poses.
@@ -262,6 +302,9 @@ def main(argv=None):
     parser.add_argument("--out", required=True, help="the merged map's folder")
     parser.add_argument("--scheduler", help="a running Dask scheduler (tcp://HOST:8786); default a LocalCluster")
     parser.add_argument("--workers", type=int, default=2, help="LocalCluster workers, one thread each (default 2)")
+    parser.add_argument("--threads-per-task", type=int, default=0, metavar="N",
+                        help="odometry threads of each drive's SLAM (default 0: each host's cores divided by its "
+                             "workers' threads, at least 1)")
     parser.add_argument("--work", help="intermediate results (per-drive runs and maps, merges); default OUT.fleet, "
                                        "on a file system every worker sees")
     parser.add_argument("--summary", help="the summary JSON (default OUT.fleet.json)")
@@ -279,6 +322,8 @@ def main(argv=None):
         parser.error("give DRIVE folders or --simulate N (one of them)")
     if args.workers < 1:
         parser.error("--workers must be at least 1")
+    if args.threads_per_task < 0:
+        parser.error("--threads-per-task must be at least 0 (0: the host's cores divided among its workers)")
     slam_options = [a for s in args.set for a in ("--set", s)] + (["--config", args.config] if args.config else [])
     simulate = None
     if args.simulate:
@@ -286,7 +331,8 @@ def main(argv=None):
                     "seed": args.seed, "reverse": args.reverse}
     try:
         map_fleet(args.drives, args.out, work=args.work, scheduler=args.scheduler, workers=args.workers,
-                  slam_options=slam_options, simulate=simulate, summary_file=args.summary)
+                  slam_options=slam_options, simulate=simulate, summary_file=args.summary,
+                  threads=args.threads_per_task)
     except (RuntimeError, OSError) as e:
         print(f"[error] {e}", file=sys.stderr)
         return 2

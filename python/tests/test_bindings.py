@@ -239,3 +239,50 @@ def test_installed_package_finds_its_data_and_program(tmp_path):
     assert lines[2] == str(prefix / "share" / "saloam") and lines[3] == str(prefix / "bin" / "saloam")
     fleet = subprocess.run([prefix / "bin" / "saloam", "fleet", "--help"], capture_output=True, text=True, env=env)
     assert fleet.returncode == 0 and "--scheduler" in fleet.stdout, fleet.stderr
+
+
+@pytest.fixture(scope="module")
+def two_maps(sequence, tmp_path_factory):
+    """The sequence's first and second halves mapped by `saloam slam --save-map` (overlapping by 10 frames)."""
+    folder = tmp_path_factory.mktemp("maps")
+    for name, frames in (("a", "0:25"), ("b", "15:40")):
+        run_cli("-q", "slam", sequence, "--frames", frames, "--out", folder / f"slam_{name}", "--no-map",
+                "--save-map", folder / f"map_{name}")
+    return folder / "map_a", folder / "map_b"
+
+
+def test_map_localize_gives_the_poses_of_saloam_localize(sequence, two_maps, tmp_path):
+    map_a, _ = two_maps
+    run_cli("-q", "localize", sequence, "--frames", "10:40", "--map", map_a, "--out", tmp_path / "cli")
+    source = saloam.open_source(sequence, frames="10:40")
+    counts = saloam.Map(map_a).localize(source, tmp_path / "py")
+    cli = json.loads((tmp_path / "cli" / "summary.json").read_text())
+    assert counts["frames"] == cli["frames"] == 30
+    for key in ("localized", "unplaced", "odometry", "first_placed_frame"):
+        assert counts[key] == cli[key], key
+    assert counts["localized"] > 0 and counts["localized"] + counts["unplaced"] + counts["odometry"] == 30
+    for name in ("poses.txt", "poses_tum.txt", "frames.csv", "relocalizations.csv"):
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # the frames from the first placed one on, near the reference
+    ours, _ = saloam.read_trajectory(tmp_path / "py" / "poses.txt")
+    reference = source.reference_poses[counts["first_placed_frame"]:]
+    assert len(ours) == len(reference) == counts["localized"]
+    assert np.max(np.linalg.norm(ours[:, :3, 3] - reference[:, :3, 3], axis=1)) < 0.5
+
+
+def test_merge_gives_the_map_of_saloam_merge(two_maps, tmp_path):
+    map_a, map_b = two_maps
+    run_cli("-q", "merge", map_a, map_b, "--out", tmp_path / "cli")
+    result = saloam.merge(map_a, map_b, tmp_path / "py")
+    ours, theirs = saloam.Map(tmp_path / "py"), saloam.Map(tmp_path / "cli")
+    np.testing.assert_array_equal(ours.poses(), theirs.poses())
+    info, cli_info = ours.info(), theirs.info()
+    for key in ("keyframes", "edges", "loop_edges", "cross_session_loops", "sessions", "detector"):
+        assert info[key] == cli_info[key], key
+    assert result["linked"] and result["sessions"] == 2 == len(info["sessions"])
+    assert result["cross_session_loops"] == info["cross_session_loops"] > 0
+    assert info["keyframes"] == saloam.Map(map_a).info()["keyframes"] + saloam.Map(map_b).info()["keyframes"]
+    # the rule for paths holds here too: an output inside an input is refused before anything is written
+    with pytest.raises(saloam.Error, match="inside"):
+        saloam.merge(map_a, map_b, map_a / "merged")
+    assert not (map_a / "merged").exists()

@@ -64,10 +64,31 @@ def test_local_cluster_maps_and_merges_every_drive(drives, local_run):
     assert set(summary["stages"]) >= {"slam_s", "merge_s", "eval_s", "total_s"}
     errors = summary["error_per_drive"]
     assert len(errors["sessions"]) == DRIVES, errors
+    # the host's cores shared among the 2 workers; each task's own CPU time and peak memory
+    assert summary["threads_per_task"] == {os.uname().nodename: max(1, os.cpu_count() // 2)}
+    for drive in summary["drives"]:
+        assert drive["threads"] == max(1, os.cpu_count() // 2)
+        assert drive["cpu_s"] > 0 and 10 < drive["peak_mib"] < 4096, drive
+    assert all(m["cpu_s"] > 0 and m["peak_mib"] > 10 for m in summary["merges"]), summary["merges"]
     # each drive's map is the one `saloam slam --save-map` makes
     run_cli("-q", "slam", drives[1], "--out", out.parent / "slam1", "--no-map", "--save-map", out.parent / "map1")
     np.testing.assert_array_equal(keyframe_poses(out.parent / "map1"),
                                   keyframe_poses(out.parent / "map.fleet" / "map_001"))
+
+
+def test_the_map_does_not_depend_on_the_threads_per_task(drives, local_run, tmp_path):
+    out = tmp_path / "map"
+    process = fleet(*drives, "--out", out, "--workers", 1, "--threads-per-task", 3)
+    output, _ = process.communicate(timeout=120)
+    assert process.returncode == 0, output
+    summary = json.loads((tmp_path / "map.fleet.json").read_text())
+    assert summary["threads_per_task"] == 3 and {d["threads"] for d in summary["drives"]} == {3}
+    np.testing.assert_array_equal(keyframe_poses(out), keyframe_poses(local_run[0]))
+    for k in range(DRIVES):
+        for name in ("poses.txt", "poses_tum.txt", "loops.csv"):
+            ours = (tmp_path / "map.fleet" / f"slam_{k:03d}" / name).read_bytes()
+            assert ours == (local_run[0].parent / "map.fleet" / f"slam_{k:03d}" / name).read_bytes(), name
+    assert summary["cross_drive_loops"] == local_run[1]["cross_drive_loops"]
 
 
 def free_port():
@@ -126,4 +147,7 @@ def test_fleet_refuses_what_it_cannot_do(tmp_path):
     done = subprocess.run([saloam_cli(), "fleet", "--out", tmp_path / "m"], capture_output=True, text=True)
     assert done.returncode == 2 and "DRIVE folders or --simulate" in done.stderr
     help_text = subprocess.run([saloam_cli(), "fleet", "--help"], capture_output=True, text=True).stdout
-    assert "--scheduler" in help_text and "--workers" in help_text
+    assert "--scheduler" in help_text and "--workers" in help_text and "--threads-per-task" in help_text
+    done = subprocess.run([saloam_cli(), "fleet", "D", "--out", tmp_path / "m", "--threads-per-task", "-1"],
+                          capture_output=True, text=True)
+    assert done.returncode == 2 and "--threads-per-task must be at least 0" in done.stderr

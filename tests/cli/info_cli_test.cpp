@@ -2,8 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "saloam/io/pcd.hpp"
 #include "saloam/sources/open_source.hpp"
@@ -80,6 +84,58 @@ TEST(InfoCli, ASimulatedVlp16InPcdFilesHasRingsTimesAndItsSensor) {
       << output;
   EXPECT_NE(output.find("sensor: vlp16 (Velodyne VLP-16), guessed"), std::string::npos) << output;
   EXPECT_NE(output.find("4 frames, 0 registration failures"), std::string::npos) << output;
+}
+
+// Rings against the sensor's lasers (issue #39): a VLP-16 has rings 0..15, so
+// points of a ring 16 or beyond are dropped and counted once the profile is
+// known, given or guessed, with the readers' warning; a frame of nothing but
+// such points is an error naming the source and frame.
+TEST(InfoCli, RingsBeyondTheSensorsLasersAreDroppedAndCounted) {
+  TempDir dir;
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd("simulate --out ") + quoted(dir / "vlp") +
+                            " --preset straight --frames 0:3 --sensor vlp16 --azimuth-steps 900 --format pcd",
+                        &output),
+            0)
+      << output;
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir / "vlp")) {
+    if (e.path().extension() == ".pcd") files.push_back(e.path());
+  }
+  std::sort(files.begin(), files.end());
+  ASSERT_EQ(files.size(), 3u);
+  DecodedCloud second = read_pcd(files[1]);
+  const std::size_t n = second.cloud.size();
+  for (std::size_t i = 0; i < 25; ++i) second.cloud.ring[i * 7] = static_cast<std::uint16_t>(16 + i % 3);  // 25 points
+  write_pcd(files[1], second.cloud, PcdEncoding::kBinary);
+  const std::string expected = fmt::format("frame 1: dropped 25 of {} points with a ring at or beyond the sensor's 16 "
+                                           "lasers (0..15)", n);
+  for (const std::string sensor : {"", "--sensor vlp16"}) {
+    SCOPED_TRACE(sensor);
+    ASSERT_EQ(run_command(saloam_cmd("odom ") + quoted(dir / "vlp") + " --out " + quoted(dir / "odom") + " " + sensor,
+                          &output),
+              0)
+        << output;
+    EXPECT_NE(output.find(expected), std::string::npos) << output;
+    EXPECT_EQ(output.find("frame 0: dropped"), std::string::npos) << output;
+  }
+  // A 64-laser profile holds them all: nothing dropped.
+  ASSERT_EQ(run_command(saloam_cmd("odom ") + quoted(dir / "vlp") + " --out " + quoted(dir / "odom64") +
+                            " --sensor os1-64", &output),
+            0)
+      << output;
+  EXPECT_EQ(output.find("dropped"), std::string::npos) << output;
+  // Every point beyond: an error naming the frame.
+  for (auto& r : second.cloud.ring) r = 40;
+  write_pcd(files[1], second.cloud, PcdEncoding::kBinary);
+  EXPECT_EQ(run_command(saloam_cmd("odom ") + quoted(dir / "vlp") + " --out " + quoted(dir / "odom2") +
+                            " --sensor vlp16", &output),
+            2)
+      << output;
+  EXPECT_NE(output.find(fmt::format("frame 1: every one of its {} points has a ring at or beyond the sensor's 16 "
+                                    "lasers", n)),
+            std::string::npos)
+      << output;
 }
 
 TEST(InfoCli, WhatIsNotASourceIsAnErrorSayingWhy) {

@@ -53,6 +53,17 @@ TEST(PathRules, FollowsLinksAndHardLinks) {
   fs::create_hard_link(tmp / "seq/poses.txt", tmp / "hard.txt");
   EXPECT_NE(breach(PathRules().input("SEQ", tmp / "seq").output("--out", tmp / "alias/run", OutputUse::kFolder)), "");
   EXPECT_NE(breach(PathRules().input("--gt", tmp / "seq/poses.txt").output("--json", tmp / "hard.txt")), "");
+  // A link after a missing folder and `..` (found by the path_rules fuzz
+  // harness): creating new/ and going up from it reaches the link, so the
+  // output is the input's folder.
+  EXPECT_NE(breach(PathRules().input("SEQ", tmp / "seq/velodyne").output("--out", tmp / "new/../alias",
+                                                                          OutputUse::kReplacedFolder)),
+            "");
+  EXPECT_NE(breach(PathRules().input("SEQ", tmp / "new/../alias/../seq").output("--out", tmp / "seq/run",
+                                                                                OutputUse::kFolder)),
+            "");
+  EXPECT_EQ(breach(PathRules().input("SEQ", tmp / "seq").output("--out", tmp / "alias/../run", OutputUse::kFolder)),
+            "");
 }
 
 TEST(PathRules, AReplacedFolderNeverHoldsAnotherOutput) {

@@ -35,11 +35,22 @@ fs::path comparable_path(const fs::path& path) {
   std::error_code ec;
   fs::path absolute = fs::absolute(path, ec);
   if (ec) absolute = path;
-  fs::path canonical = fs::weakly_canonical(absolute, ec);
-  if (ec) canonical = absolute.lexically_normal();
-  fs::path out;
-  for (const fs::path& part : canonical) {
-    if (!part.empty() && part != ".") out /= part;
+  // Component by component, as a run that creates the missing folders
+  // would reach it: `..` goes up from what the path so far resolved to, and
+  // a link is followed wherever it appears, also after a missing folder and
+  // `..` ("new/../link": weakly_canonical takes it lexically, not the link).
+  fs::path out = absolute.root_path();
+  for (const fs::path& part : absolute.relative_path()) {
+    if (part.empty() || part == ".") continue;
+    if (part == "..") {
+      out = out.parent_path();
+      continue;
+    }
+    out /= part;
+    if (fs::is_symlink(out, ec)) {
+      const fs::path target = fs::canonical(out, ec);
+      if (!ec) out = target;  // a dangling or looping link stays as named
+    }
   }
   return out;
 }

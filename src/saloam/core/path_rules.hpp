@@ -6,9 +6,11 @@
 // writes anything; a breach is an InputError naming the output, its option,
 // the other path and its option.
 //
-// Paths are compared absolute and weakly canonical (links of the existing
-// part resolved, `.` and `..` removed), component by component: /a/bc is not
-// inside /a/b. Two existing paths that are one file (a hard link) are equal.
+// Paths are compared absolute and resolved component by component as a run
+// that creates the missing folders would reach them (every link followed,
+// also after a missing folder and `..`; `.` and `..` removed), then by
+// components: /a/bc is not inside /a/b. Two existing paths that are one
+// file (a hard link) are equal.
 
 #include <filesystem>
 #include <string>
@@ -28,7 +30,8 @@ enum class OutputUse {
 /// as given: use comparable_path() first).
 bool path_within(const std::filesystem::path& inner, const std::filesystem::path& outer);
 
-/// `path` absolute and weakly canonical, without a trailing separator.
+/// `path` absolute, `..` and `.` resolved and every link followed, component by component (see above), without a
+/// trailing separator.
 std::filesystem::path comparable_path(const std::filesystem::path& path);
 
 class PathRules {

@@ -29,6 +29,13 @@ bool keep_ring(double ring, PointCheckCounts& counts) {
   return false;
 }
 
+bool keep_sensor_ring(std::uint16_t ring, std::size_t lasers, PointCheckCounts& counts) {
+  counts.sensor_lasers = lasers;
+  if (ring < lasers) return true;
+  ++counts.ring_beyond_sensor;
+  return false;
+}
+
 float checked_time(double seconds, PointCheckCounts& counts) {
   if (!std::isfinite(seconds)) {
     ++counts.time_nonfinite;
@@ -59,6 +66,10 @@ void warn_point_checks(const std::filesystem::path& file, std::size_t points_in_
   if (counts.bad_ring > 0) {
     spdlog::warn("{}: dropped {} of {} points with a ring outside 0..{:g}", name, counts.bad_ring, points_in_file,
                  kMaxRings - 1);
+  }
+  if (counts.ring_beyond_sensor > 0) {
+    spdlog::warn("{}: dropped {} of {} points with a ring at or beyond the sensor's {} lasers (0..{})", name,
+                 counts.ring_beyond_sensor, points_in_file, counts.sensor_lasers, counts.sensor_lasers - 1);
   }
   if (counts.time_nonfinite > 0) {
     spdlog::warn("{}: {} of {} points have a NaN/Inf time, taken as the scan's timestamp", name,

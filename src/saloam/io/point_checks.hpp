@@ -5,7 +5,9 @@
 //   coordinates  non-finite, or beyond kMaxScanCoordinate along an axis:
 //                the point is dropped
 //   ring         not within 0..kMaxSensorLasers-1 (the most lasers a sensor
-//                profile may list): the point is dropped (its beam is unknown)
+//                profile may list): the point is dropped (its beam is unknown);
+//                once the sensor profile is known (sources/sensor_rings_source.hpp),
+//                at or beyond its laser count: dropped too
 //   time         relative to the scan's timestamp (which may be the sweep's
 //                start, middle or end, so a time may be negative): non-finite
 //                -> 0, beyond +-kMaxSweepSeconds (the longest sweep a sensor
@@ -16,6 +18,7 @@
 //                refused, naming the order that fits
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <string_view>
@@ -41,16 +44,21 @@ struct PointCheckCounts {
   std::size_t nonfinite = 0;          ///< dropped: NaN/Inf coordinates
   std::size_t out_of_range = 0;       ///< dropped: a coordinate beyond kMaxScanCoordinate
   std::size_t bad_ring = 0;           ///< dropped: a ring outside 0..kMaxRings-1
+  std::size_t ring_beyond_sensor = 0; ///< dropped: a ring at or beyond sensor_lasers
+  std::size_t sensor_lasers = 0;      ///< the sensor profile's laser count checked against (0: none)
   std::size_t time_nonfinite = 0;     ///< set to 0
   std::size_t time_before_sweep = 0;  ///< below -kMaxSweepSeconds: set to it
   std::size_t time_after_sweep = 0;   ///< beyond kMaxSweepSeconds: set to it
-  [[nodiscard]] std::size_t dropped() const { return nonfinite + out_of_range + bad_ring; }
+  [[nodiscard]] std::size_t dropped() const { return nonfinite + out_of_range + bad_ring + ring_beyond_sensor; }
 };
 
 /// Whether a point with these coordinates is kept; counts the reason when not.
 [[nodiscard]] bool keep_coordinates(double x, double y, double z, PointCheckCounts& counts);
 /// Whether a point with this ring value is kept; counts it when not.
 [[nodiscard]] bool keep_ring(double ring, PointCheckCounts& counts);
+/// Whether a point with this ring is kept by a sensor of `lasers` lasers
+/// (rings 0..lasers-1); counts it when not.
+[[nodiscard]] bool keep_sensor_ring(std::uint16_t ring, std::size_t lasers, PointCheckCounts& counts);
 /// A per-point time [s from the scan's timestamp] clamped into +-kMaxSweepSeconds (non-finite: 0), counted when it was not.
 [[nodiscard]] float checked_time(double seconds, PointCheckCounts& counts);
 

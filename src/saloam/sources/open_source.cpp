@@ -16,6 +16,7 @@
 #include "saloam/sources/ros2_bag_source.hpp"
 #include "saloam/sources/rosbag_source.hpp"
 #include "saloam/sources/scan_files.hpp"
+#include "saloam/sources/sensor_rings_source.hpp"
 #include "saloam/sources/udp_socket.hpp"
 
 namespace fs = std::filesystem;
@@ -127,6 +128,7 @@ std::unique_ptr<FrameSource> open_reader(const fs::path& path, const SourceOptio
 }
 
 std::unique_ptr<FrameSource> add_stages(std::unique_ptr<FrameSource> source, const SourceOptions& options) {
+  if (options.sensor_lasers > 0) source = std::make_unique<SensorRingsSource>(std::move(source), options.sensor_lasers);
   // A live source's size is not known: any bound given is its frame limit.
   const bool bounded = source->info().live ? options.frames.end != FrameRange{}.end : options.frames.end < source->size();
   if (options.frames.first > 0 || bounded) {

@@ -12,7 +12,8 @@
 //              rosbag2, mcap  Ros2BagSource        (sources/ros2_bag_source.hpp)
 //              pcap           PcapSource           (sources/pcap_source.hpp)
 //              udp://         LiveUdpSource        (sources/live_udp_source.hpp: live)
-//   stages   the frame range (--frames A:B, FrameRangeSource), then the
+//   stages   the sensor's laser count on the ring field (SensorRingsSource),
+//            the frame range (--frames A:B, FrameRangeSource), then the
 //            segmentation (--segment: labels from a network, SegmentedSource)
 // A new reader is one more case in open_reader() (and in detect_scan_format
 // when a path can say what it is); a new stage wraps the source in

@@ -77,6 +77,9 @@ struct SourceOptions {
   std::optional<float> intensity_scale;
   FrameRange frames;  ///< --frames A:B; everything by default
   LiveOptions live;  ///< a udp:// source's
+  /// The sensor profile's laser count (--sensor, or guessed): points with a
+  /// ring at or beyond it are dropped and counted (SensorRingsSource); 0: no profile.
+  std::size_t sensor_lasers = 0;
   /// --segment: every scan labelled by this model (the reader's labels are not read).
   std::optional<SegmentationStageOptions> segmentation;
 };
