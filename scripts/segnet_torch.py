@@ -367,84 +367,103 @@ class Samples:
                 return scan
 
 
-def train(args):
+def training_data(args, device):
+    """The training sources (the held-out real sequences left out), the sample stream and the loss's class
+    weights."""
     import torch
-    import torch.nn.functional as F
-
-    torch.manual_seed(args.seed)
-    torch.backends.cudnn.benchmark = True  # a GPU run is not bit-reproducible anyway (atomic scatters)
-    device = torch.device("cuda" if torch.cuda.is_available() and not args.cpu else "cpu")
-    template = read_template(args.template)
-    projection = template["projection"]
+    projection = read_template(args.template)["projection"]
     means = np.array(projection["means"], np.float32)
     stds = np.array(projection["stds"], np.float32)
     sources = load_sources(args.scans)
     held = set(args.hold_out.split(",")) if args.hold_out else set()
-    train_names = [n for n in sorted(sources) if not (is_real(n) and sequence_of(n) in held)]
-    samples = Samples(sources, train_names, args, means, stds, device)
-    weights = torch.tensor(class_weights(sources, train_names, samples.real_fraction), dtype=torch.float32)
-    SegNet = network_module()
+    names = [n for n in sorted(sources) if not (is_real(n) and sequence_of(n) in held)]
+    samples = Samples(sources, names, args, means, stds, device)
+    weights = torch.tensor(class_weights(sources, names, samples.real_fraction), dtype=torch.float32)
+    return names, samples, weights
+
+
+def build_network(args, device):
+    import torch
     widths = [int(w) for w in args.widths.split(",")]
-    net = SegNet(widths, args.stem_stride, args.context_blocks)
+    net = network_module()(widths, args.stem_stride, args.context_blocks)
     if args.init:
         net.load_state_dict(read_weights(args.init))
-    net = net.to(device).to(memory_format=torch.channels_last)
-    optimiser = torch.optim.AdamW(net.parameters(), lr=args.lr, weight_decay=args.weight_decay)
-    plan = dict(steps=args.steps)  # with --time-budget, fixed once the first steps are timed
+    return net.to(device).to(memory_format=torch.channels_last), widths
 
-    def rate(step):
-        if step < args.warmup:
-            return (step + 1) / args.warmup
-        t = min(1.0, (step - args.warmup) / max(1, plan["steps"] - args.warmup))
+
+class Schedule:
+    """The learning rate's factor: a linear warm-up over args.warmup steps, then a cosine to 1 % at `steps`
+    (with --time-budget, the steps that fit: set once the warm-up is timed, from its speed after step 20)."""
+
+    def __init__(self, args):
+        self.args, self.steps, self.timed_from = args, args.steps, None
+
+    def __call__(self, step):
+        warmup = self.args.warmup
+        if step < warmup:
+            return (step + 1) / warmup
+        t = min(1.0, (step - warmup) / max(1, self.steps - warmup))
         return 0.01 + 0.99 * 0.5 * (1 + math.cos(math.pi * t))
 
-    schedule = torch.optim.lr_scheduler.LambdaLR(optimiser, rate)
-    os.makedirs(args.out, exist_ok=True)
-    log = dict(args=vars(args), train_sources=train_names, class_weights=weights.tolist(), losses=[],
-               device=str(device), torch=torch.__version__)
-    weights = weights.to(device)
-    use_bf16 = device.type == "cuda"
-    start, total, count = time.time(), torch.zeros((), device=device), 0
-    net.train()
+    def timed(self, step, start):
+        """After step `step` (counted from 1): fixes the step count at the end of a timed warm-up; True then."""
+        if step == 20:
+            self.timed_from = time.time()  # after the first steps' one-time costs
+        if not self.args.time_budget or step != self.args.warmup:
+            return False
+        now = time.time()
+        speed = (step - 20) / (now - self.timed_from)
+        self.steps = max(step + 1, int(step + speed * (self.args.time_budget - (now - start))))
+        return True
+
+
+def train(args):
+    import torch
+    import torch.nn.functional as F
+
     if args.time_budget and args.warmup < 40:
         raise SystemExit("--time-budget needs --warmup of at least 40 steps to time")
-    step, timed_from = 0, time.time()
-    while step < plan["steps"]:
+    torch.manual_seed(args.seed)
+    torch.backends.cudnn.benchmark = True  # a GPU run is not bit-reproducible anyway (atomic scatters)
+    device = torch.device("cuda" if torch.cuda.is_available() and not args.cpu else "cpu")
+    names, samples, weights = training_data(args, device)
+    net, widths = build_network(args, device)
+    optimiser = torch.optim.AdamW(net.parameters(), lr=args.lr, weight_decay=args.weight_decay)
+    schedule = Schedule(args)
+    rates = torch.optim.lr_scheduler.LambdaLR(optimiser, schedule)
+    os.makedirs(args.out, exist_ok=True)
+    log = dict(args=vars(args), train_sources=names, class_weights=weights.tolist(), losses=[],
+               device=str(device), torch=torch.__version__)
+    weights = weights.to(device)
+    start, total, count, step = time.time(), torch.zeros((), device=device), 0, 0
+    net.train()
+    while step < schedule.steps:
+        # One step: a batch augmented on the device, the class-weighted cross-entropy (bf16 on a GPU).
         images, labels = samples.batch(step)
-        images = images.contiguous(memory_format=torch.channels_last)
-        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=use_bf16):
-            logits = net(images)
+        with torch.autocast(device.type, dtype=torch.bfloat16, enabled=device.type == "cuda"):
+            logits = net(images.contiguous(memory_format=torch.channels_last))
         loss = F.cross_entropy(logits.float().permute(0, 3, 1, 2), labels, weight=weights, ignore_index=0)
         optimiser.zero_grad(set_to_none=True)
         loss.backward()
         optimiser.step()
-        schedule.step()
-        total += loss.detach()
-        count += 1
-        step += 1
-        if step == 20:
-            timed_from = time.time()  # after the first steps' one-time costs
-        if args.time_budget and step == args.warmup:
-            # The steps that fit the budget at the speed since step 20; training.json records them, and
-            # `--steps` with that number repeats this run.
-            now = time.time()
-            speed = (step - 20) / (now - timed_from)
-            plan["steps"] = max(step + 1, int(step + speed * (args.time_budget - (now - start))))
-            log["steps_for_time_budget"] = plan["steps"]
-            print(f"{args.out}: {plan['steps']} steps fit {args.time_budget:.0f} s", flush=True)
-        if count == args.log_every or step == plan["steps"]:
-            mean = total.item() / count
-            log["losses"].append([step, mean, time.time() - start])
-            print(f"{args.out}: step {step}/{plan['steps']} loss {mean:.4f} {time.time() - start:.0f} s", flush=True)
+        rates.step()
+        total, count, step = total + loss.detach(), count + 1, step + 1
+        # The steps that fit the time budget (training.json records them: `--steps` with them repeats the run).
+        if schedule.timed(step, start):
+            log["steps_for_time_budget"] = schedule.steps
+            print(f"{args.out}: {schedule.steps} steps fit {args.time_budget:.0f} s", flush=True)
+        if count == args.log_every or step == schedule.steps:
+            log["losses"].append([step, total.item() / count, time.time() - start])
+            print(f"{args.out}: step {step}/{schedule.steps} loss {total.item() / count:.4f} "
+                  f"{time.time() - start:.0f} s", flush=True)
             total, count = torch.zeros((), device=device), 0
         if args.max_seconds and time.time() - start > args.max_seconds:
             log["stopped_at_step"] = step
             print(f"{args.out}: stopped at step {step} after {args.max_seconds} s", flush=True)
             break
-    state = {k: v.detach().cpu().numpy() for k, v in net.state_dict().items()}
-    np.savez(os.path.join(args.out, "weights.npz"), **state)
-    log["seconds"] = time.time() - start
-    log["shape"] = dict(widths=widths, stem_stride=args.stem_stride, context_blocks=args.context_blocks)
+    np.savez(os.path.join(args.out, "weights.npz"), **{k: v.detach().cpu().numpy() for k, v in net.state_dict().items()})
+    log.update(seconds=time.time() - start,
+               shape=dict(widths=widths, stem_stride=args.stem_stride, context_blocks=args.context_blocks))
     with open(os.path.join(args.out, "training.json"), "w") as f:
         json.dump(log, f, indent=1)
 
