@@ -77,7 +77,7 @@ struct Source {
   std::string sensor;      ///< the profile's name, "" when none
   std::string sensor_how;  ///< how it was chosen
   std::size_t served = 0;  ///< frames a stream has served
-  std::mutex mutex;
+  mutable std::mutex mutex;
 
   [[nodiscard]] const SourceInfo& info() const { return source->info(); }
 };
@@ -552,7 +552,7 @@ Values are checked by the library (the same checks and messages as a
            "The frames from the first (a stream: once).")
       .def_property_readonly("stream_stats",
                              [](const Source& s) -> py::object {
-                               std::lock_guard lock(const_cast<Source&>(s).mutex);
+                               std::lock_guard lock(s.mutex);
                                const auto stats = s.source->stream_stats();
                                return stats ? stream_stats_dict(*stats) : py::none();
                              },

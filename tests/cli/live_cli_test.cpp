@@ -129,10 +129,16 @@ TEST_F(LiveCli, AtOneXTheLiveSlamGivesTheCapturesPosesByteForByte) {
   expect_has(live.log, "30 frames made, 30 run, 0 dropped");
 }
 
+/// The poses of `trajectory` by their timestamps.
+std::map<double, Pose> poses_by_time(const Trajectory& trajectory) {
+  std::map<double, Pose> by_time;
+  for (std::size_t i = 0; i < trajectory.size(); ++i) by_time.emplace(trajectory.timestamps[i], trajectory.poses[i]);
+  return by_time;
+}
+
 /// Largest translation [m] and rotation [deg] between each pose of `kept` and the pose of `all` with its timestamp.
 std::pair<double, double> kept_frames_difference(const Trajectory& kept, const Trajectory& all) {
-  std::map<double, Pose> by_time;
-  for (std::size_t i = 0; i < all.size(); ++i) by_time.emplace(all.timestamps[i], all.poses[i]);
+  const std::map<double, Pose> by_time = poses_by_time(all);
   double translation = 0, rotation = 0;
   for (std::size_t i = 0; i < kept.size(); ++i) {
     const auto match = by_time.find(kept.timestamps[i]);
@@ -153,8 +159,7 @@ struct KeptMotion {
 };
 
 KeptMotion kept_motion_difference(const Trajectory& kept, const Trajectory& all, int max_apart) {
-  std::map<double, Pose> by_time;
-  for (std::size_t i = 0; i < all.size(); ++i) by_time.emplace(all.timestamps[i], all.poses[i]);
+  const std::map<double, Pose> by_time = poses_by_time(all);
   KeptMotion out;
   for (std::size_t i = 1; i < kept.size(); ++i) {
     const double apart = (kept.timestamps[i] - kept.timestamps[i - 1]) / 0.1;
