@@ -225,9 +225,9 @@ int run_demo(const DemoOptions& options) {
   const std::size_t shown = info.size() / 2;
   const std::vector<double> range_image_rows = LidarModel::hdl64e().elevation_deg;
   SlamRunOptions run_options;
-  run_options.on_scan = [&](std::size_t i, const LabelledCloud& scan, double t) {
-    if (baseline) baseline->add(scan, t, info.first_frame + i);
-    if (i == shown) render_range_image(scan, out / fmt::format("range_{:06d}.png", shown), range_image_rows);
+  run_options.follow = [&](const FinishedFrame& frame) {
+    if (baseline) baseline->add(frame.scan, frame.time, info.first_frame + frame.index);
+    if (frame.index == shown) render_range_image(frame.scan, out / fmt::format("range_{:06d}.png", shown), range_image_rows);
   };
   OutputFolder slam_folder = open_slam_folder(out / "slam", info);
   const SlamRunResult slam = run_slam(*source.frames, config, load_loop_network(config), slam_folder, run_options);

@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
+#include "live_serving.hpp"
 #include "saloam/runs/odometry_run.hpp"
 
 namespace saloam::cli {
@@ -21,6 +22,7 @@ struct OdomOptions {
   SourceArgs source;
   std::string out;
   bool no_semantics = false;
+  ServeOptions serve;
   ConfigOptions config;
 };
 
@@ -31,12 +33,19 @@ int run_odom(const OdomOptions& options) {
   if (options.no_semantics) config.odometry.use_semantics = false;
   const std::unique_ptr<FrameSource> source = options.source.open(!config.odometry.use_semantics, config);
   const std::filesystem::path out_dir(options.out);
-  const OdometryRunResult result = run_odometry(*source, config.odometry, out_dir);
+  OdometryRunOptions run_options;
+  std::unique_ptr<LiveServing> live;
+  if (options.serve.serve) {
+    live = std::make_unique<LiveServing>(options.source.path, "odom", options.serve.port);
+    run_options.follow = live->follower();
+  }
+  const OdometryRunResult result = run_odometry(*source, config.odometry, out_dir, run_options);
   const double median_ms = result.median_frame_ms();
   std::cout << fmt::format("{} frames, {} registration failures, {} degenerate frames, median {:.1f} ms/frame ({:.1f} Hz)\n",
                            result.frames, result.registration_failures, result.degenerate_frames, median_ms,
                            median_ms > 0 ? 1000.0 / median_ms : 0.0);
   std::cout << fmt::format("wrote {} ({})\n", out_dir.string(), fmt::join(result.files, ", "));
+  if (live) live->run_ended(result.interrupted);
   if (result.interrupted) {
     spdlog::warn("interrupted: {} frames written", result.frames);
     return 130;
@@ -53,6 +62,7 @@ const CommandRegistration kRegistration{Command{
                    "Label-agnostic run with plain voxel grid (FLOAM-like baseline)");
       add_no_calib_flag(app, options->source.no_calib);
       options->source.add_live_to(app);
+      options->serve.add_to(app);
       options->config.add_to(app);
       return [options] { return run_odom(*options); };
     }}};

@@ -10,6 +10,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
+#include "live_serving.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/maps/prior_map.hpp"
@@ -28,6 +29,7 @@ struct SlamOptions {
   bool no_map = false;
   std::string save_map;
   std::string map;
+  ServeOptions serve;
   ConfigOptions config;
 };
 
@@ -105,6 +107,11 @@ int run_slam_command(const SlamOptions& options) {
   run_options.join_map = join_map.get();
 
   OutputFolder folder = open_slam_folder(options.out, source->info());
+  std::unique_ptr<LiveServing> live;
+  if (options.serve.serve) {
+    live = std::make_unique<LiveServing>(options.source.path, "slam", options.serve.port);
+    run_options.follow = live->follower();
+  }
   const SlamRunResult result = run_slam(*source, config, load_loop_network(config), folder, run_options);
   print_summary(result);
   if (!result.join.empty()) std::cout << result.join << '\n';
@@ -114,6 +121,7 @@ int run_slam_command(const SlamOptions& options) {
   }
   if (run_options.write_map && !result.interrupted) write_view_page(folder);
   std::cout << fmt::format("wrote {} ({})\n", folder.path().string(), fmt::join(folder.files(), ", "));
+  if (live) live->run_ended(result.interrupted);
   if (result.interrupted) {
     spdlog::warn("interrupted: results of the {} frames processed were written", result.frames);
     return 130;
@@ -142,6 +150,7 @@ const CommandRegistration kRegistration{Command{
           ->check(CLI::ExistingDirectory);
       add_no_calib_flag(app, options->source.no_calib);
       options->source.add_live_to(app);
+      options->serve.add_to(app);
       options->config.add_to(app);
       return [options] { return run_slam_command(*options); };
     }}};

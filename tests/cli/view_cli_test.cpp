@@ -2,9 +2,7 @@
 // (no JavaScript error, a map in class colours on the canvas; a saved map's
 // sessions each in its colour), and --serve serves it until Ctrl-C.
 
-#include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -22,18 +20,18 @@
 #include <gtest/gtest.h>
 
 #include "saloam/maps/map_format.hpp"
+#include "browser_fixture.hpp"
 #include "testing/test_support.hpp"
 #include "viewer/viewer_fixture.hpp"
 
 // After Eigen: httplib.h includes <resolv.h>, whose `_res` macro breaks Eigen's headers.
 #include <httplib.h>
 
-extern char** environ;
-
 namespace saloam {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::chromium;
 using testing::cli_path;
 using testing::quoted;
 using testing::run_command;
@@ -109,26 +107,6 @@ TEST(ViewCli, MissingMapIsAClearError) {
   EXPECT_NE(output.find("map.ply: not found: the global map"), std::string::npos) << output;
   EXPECT_EQ(run_command(saloam_cmd("view " + quoted(tmp / "nowhere")), &output), 2);
   EXPECT_NE(output.find("nowhere: run folder not found"), std::string::npos) << output;
-}
-
-/// Headless Chromium, or a skip (a failure with CI=true) when it is not installed.
-#define SALOAM_REQUIRE_CHROMIUM()                                                                     \
-  do {                                                                                                \
-    if (run_command("command -v chromium") != 0) {                                                    \
-      const char* ci = std::getenv("CI");                                                             \
-      if (ci && std::string(ci) == "true") FAIL() << "chromium is not installed (CI=true)";           \
-      GTEST_SKIP() << "chromium is not installed (Debian package chromium; scripts/install_deps.sh)"; \
-    }                                                                                                 \
-  } while (false)
-
-std::string chromium(const TempDir& tmp, const std::string& args, const fs::path& page) {
-  std::string output;
-  const std::string command = fmt::format(
-      "timeout 120 chromium --headless=new --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader "
-      "--disable-dev-shm-usage --user-data-dir={} --enable-logging=stderr --v=0 {} {}",
-      quoted(tmp / "chromium_profile"), args, testing::quoted(fs::path("file://" + fs::absolute(page).string())));
-  run_command(command, &output);
-  return output;
 }
 
 struct PixelCounts {
@@ -280,39 +258,16 @@ TEST(ViewCli, SavedMapShowsOneTrajectoryPerSession) {
   EXPECT_GT(second, 20U) << "session 1's trajectory is not drawn";
 }
 
-/// `saloam ARGS...` as a child process, its output into `log`.
-pid_t spawn_saloam(const std::vector<std::string>& args, const fs::path& log) {
-  std::vector<std::string> argv_text{cli_path().string()};
-  argv_text.insert(argv_text.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& a : argv_text) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, 1, 2);
-  pid_t pid = -1;
-  if (posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid = -1;
-  posix_spawn_file_actions_destroy(&actions);
-  return pid;
-}
-
 TEST(ViewCli, ServeAnswersUntilCtrlC) {
   TempDir tmp;
   const auto run = testing::write_fake_run(tmp.path(), 2000, 20, 1000);
   const fs::path log = tmp / "serve.log";
-  const pid_t pid = spawn_saloam({"view", run.run_dir.string(), "--serve", "--port", "0", "--scan-points", "700"}, log);
+  const pid_t pid = testing::spawn_saloam({"view", run.run_dir.string(), "--serve", "--port", "0", "--scan-points", "700"}, log);
   ASSERT_GT(pid, 0);
-  std::smatch url;
-  std::string text;
-  for (int i = 0; i < 300 && !std::regex_search(text, url, std::regex(R"(http://127\.0\.0\.1:(\d+)/)")); ++i) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    text = testing::read_text(log);
-  }
-  ASSERT_FALSE(url.empty()) << text;
-  const int port = std::stoi(url[1].str());
+  const std::optional<int> port = testing::served_port(log);
+  ASSERT_TRUE(port) << testing::read_text(log);
 
-  httplib::Client client("127.0.0.1", port);
+  httplib::Client client("127.0.0.1", *port);
   const auto page = client.Get("/");
   ASSERT_TRUE(page);
   EXPECT_EQ(page->status, 200);

@@ -119,6 +119,14 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
     std::optional<SourceFrame> frame = source.next_frame(i);
     if (!frame) break;
     run.add(frame->cloud, frame->time, info.first_frame + i);
+    if (options.follow) {
+      options.follow(FinishedFrame{.index = i,
+                                   .time = frame->time,
+                                   .scan = frame->cloud,
+                                   .pose = run.odometry().poses().back(),
+                                   .corrected = nullptr,
+                                   .loops = {}});
+    }
     progress.set_status(fmt::format("{:.0f} ms", run.odometry().timings().back().total_ms()));
     progress.advance();
   }

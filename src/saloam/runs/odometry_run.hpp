@@ -21,6 +21,7 @@
 #include "saloam/core/types.hpp"
 #include "saloam/io/frame_source.hpp"
 #include "saloam/odometry/semantic_odometry.hpp"
+#include "saloam/runs/finished_frame.hpp"
 #include "saloam/runs/trajectory_writer.hpp"
 
 namespace saloam {
@@ -28,6 +29,8 @@ namespace saloam {
 struct OdometryRunOptions {
   bool show_progress = true;
   std::string progress_label = "odom";
+  /// Called with every frame after the odometry has registered it (e.g. the live viewer).
+  FrameFollower follow;
 };
 
 /// How the frames' registrations went: failures (too few correspondences:

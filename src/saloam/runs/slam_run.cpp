@@ -277,6 +277,27 @@ SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
 
 namespace {
 
+// Tells the run's follower about frame `i` once the SLAM has processed it:
+// its loop-closed pose, every pose when loop closure moved them (the pose
+// graph was optimised since `optimizations_before`), the loops accepted
+// since `loops_before`.
+void tell_follower(const FrameFollower& follow, const SlamSystem& slam, std::size_t i, const LabelledCloud& scan,
+                   double time, std::size_t loops_before, std::size_t optimizations_before) {
+  std::vector<std::pair<std::size_t, std::size_t>> accepted;
+  for (std::size_t l = loops_before; l < slam.loops().size(); ++l) {
+    const LoopRecord& loop = slam.loops()[l];
+    if (loop.verification.accepted) accepted.emplace_back(loop.query_frame, loop.match_frame);
+  }
+  std::optional<std::vector<Pose>> corrected;
+  if (slam.optimizations() != optimizations_before) corrected = slam.optimized_poses();
+  follow(FinishedFrame{.index = i,
+                       .time = time,
+                       .scan = scan,
+                       .pose = corrected ? corrected->back() : slam.optimized_pose(i),
+                       .corrected = corrected ? &*corrected : nullptr,
+                       .loops = accepted});
+}
+
 // The frame loop: every frame of `source` through the SLAM, the odometry's
 // poses written as they come, and a stream's scans kept for the map.
 double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& odometry_writer,
@@ -290,9 +311,10 @@ double process_frames(FrameSource& source, SlamSystem& slam, TrajectoryWriter& o
     if (!frame) break;
     const LabelledCloud& scan = frame->cloud;
     const double t = frame->time;
+    const std::size_t loops_before = slam.loops().size(), optimizations_before = slam.optimizations();
     odometry_writer.write(t, slam.process(scan, t));
     health.note(slam.odometry(), info.first_frame + i);
-    if (options.on_scan) options.on_scan(i, scan, t);
+    if (options.follow) tell_follower(options.follow, slam, i, scan, t, loops_before, optimizations_before);
     if (map_scans) map_scans->offer(i, scan);
     progress.set_status(fmt::format("{} loops, {:.0f} ms", slam.accepted_loops(), slam.timings().back().total_ms()));
     progress.advance();

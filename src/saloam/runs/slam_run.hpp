@@ -32,6 +32,7 @@
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/frame_source.hpp"
 #include "saloam/maps/prior_map.hpp"
+#include "saloam/runs/finished_frame.hpp"
 #include "saloam/runs/loop_truth.hpp"
 #include "saloam/slam/slam_system.hpp"
 
@@ -40,9 +41,9 @@ namespace saloam {
 struct SlamRunOptions {
   bool show_progress = true;
   bool write_map = true;  ///< map.ply / map.png (re-reads the scans, or keeps copies of a stream's)
-  /// Called with every scan after the SLAM has processed it (e.g. to run a
-  /// second odometry on the same stream).
-  std::function<void(std::size_t frame, const LabelledCloud& scan, double time)> on_scan;
+  /// Called with every frame after the SLAM has processed it (e.g. to run a
+  /// second odometry on the same stream, or the live viewer).
+  FrameFollower follow;
   /// Where to save the map for later runs (`--save-map`, maps/map_format.hpp);
   /// none: no map is saved. Not saved when the run is interrupted.
   std::optional<std::filesystem::path> save_map;

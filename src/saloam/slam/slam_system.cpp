@@ -222,6 +222,11 @@ std::vector<Pose> SlamSystem::optimized_poses(const std::vector<Pose>& keyframe_
   return poses;
 }
 
+Pose SlamSystem::optimized_pose(std::size_t frame) const {
+  const std::size_t k = frame_keyframe_.at(frame);
+  return orthonormalized(graph_.pose(k) * (keyframes_[k].odometry_pose.inverse() * odometry_.poses()[frame]));
+}
+
 std::size_t SlamSystem::keyframe_bytes() const {
   std::size_t bytes = 0;
   for (const auto& kf : keyframes_) {

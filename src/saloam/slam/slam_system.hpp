@@ -110,6 +110,8 @@ class SlamSystem {
   /// keyframe, e.g. after a joint optimisation with another map): each frame
   /// rides on its keyframe with its odometry offset.
   [[nodiscard]] std::vector<Pose> optimized_poses(const std::vector<Pose>& keyframe_poses) const;
+  /// Frame `frame`'s pose after loop closure (an element of optimized_poses()).
+  [[nodiscard]] Pose optimized_pose(std::size_t frame) const;
   [[nodiscard]] const std::vector<Pose>& odometry_poses() const { return odometry_.poses(); }
   [[nodiscard]] const std::vector<double>& timestamps() const { return odometry_.timestamps(); }
   [[nodiscard]] const SemanticOdometry& odometry() const { return odometry_; }

@@ -8,6 +8,8 @@ namespace saloam::viewer_assets {
 
 /// viewer.html: the page, with /*SALOAM_...*/ placeholders for the scripts and the data.
 extern const std::string_view kPageTemplate;
+/// live.html: the page of a run in progress (`--serve`), with the same placeholders.
+extern const std::string_view kLivePageTemplate;
 /// three.min.js and examples/js/controls/OrbitControls.js; empty when
 /// libjs-three was not installed when saloam was configured.
 extern const std::string_view kThreeJs;

@@ -157,7 +157,7 @@ std::string script_safe(std::string text) {
 
 void replace_once(std::string& page, std::string_view placeholder, std::string_view text) {
   const std::size_t at = page.find(placeholder);
-  if (at == std::string::npos) throw std::logic_error(fmt::format("viewer.html has no {}", placeholder));
+  if (at == std::string::npos) throw std::logic_error(fmt::format("the page template has no {}", placeholder));
   page.replace(at, placeholder.size(), text);
 }
 
@@ -165,22 +165,34 @@ void replace_once(std::string& page, std::string_view placeholder, std::string_v
 
 bool viewer_has_three_js() { return !viewer_assets::kThreeJs.empty() && !viewer_assets::kOrbitControlsJs.empty(); }
 
+namespace {
+
+void require_three_js() {
+  if (viewer_has_three_js()) return;
+  throw InputError("/usr/share/javascript/three/three.min.js",
+                   "three.js was not found when saloam was built: install the Debian package libjs-three "
+                   "(scripts/install_deps.sh), then reconfigure and rebuild saloam");
+}
+
+/// A page template with three.js and `data` in place of its placeholders.
+std::string fill_page(std::string_view page_template, const json& data) {
+  std::string page(page_template);
+  // Last placeholder first: every search finds its placeholder before any inserted text.
+  replace_once(page, "/*SALOAM_DATA*/", script_safe(data.dump(-1, ' ', false, json::error_handler_t::replace)));
+  replace_once(page, "/*SALOAM_ORBIT_CONTROLS_JS*/", viewer_assets::kOrbitControlsJs);
+  replace_once(page, "/*SALOAM_THREE_JS*/", viewer_assets::kThreeJs);
+  return page;
+}
+
+}  // namespace
+
 std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
                         ViewerPageStats* stats) {
-  if (!viewer_has_three_js()) {
-    throw InputError("/usr/share/javascript/three/three.min.js",
-                     "three.js was not found when saloam was built: install the Debian package libjs-three "
-                     "(scripts/install_deps.sh), then reconfigure and rebuild saloam");
-  }
+  require_three_js();
   ViewerPageStats local;
   ViewerPageStats& s = stats ? *stats : local;
   s = ViewerPageStats{};
-  const std::string data = script_safe(page_data(scene, options, source, s).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
-  std::string page(viewer_assets::kPageTemplate);
-  // Last placeholder first: every search finds its placeholder before any inserted text.
-  replace_once(page, "/*SALOAM_DATA*/", data);
-  replace_once(page, "/*SALOAM_ORBIT_CONTROLS_JS*/", viewer_assets::kOrbitControlsJs);
-  replace_once(page, "/*SALOAM_THREE_JS*/", viewer_assets::kThreeJs);
+  const std::string page = fill_page(viewer_assets::kPageTemplate, page_data(scene, options, source, s));
   s.bytes = page.size();
   s.map_points = scene.map.size();
   s.map_points_total = scene.map_points_total;
@@ -190,6 +202,12 @@ std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, 
   s.sessions = scene.sessions.size();
   s.ground_truth = !scene.ground_truth.empty();
   return page;
+}
+
+std::string live_viewer_page(int poll_ms) {
+  require_three_js();
+  return fill_page(viewer_assets::kLivePageTemplate,
+                   json{{"classes", class_table()}, {"scan_scale", kScanScale}, {"poll_ms", poll_ms}});
 }
 
 namespace {

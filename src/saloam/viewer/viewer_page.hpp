@@ -39,6 +39,11 @@ bool viewer_has_three_js();
 std::string viewer_page(const ViewerScene& scene, const ViewerOptions& options, ViewerDataSource source,
                         ViewerPageStats* stats = nullptr);
 
+/// The page of a run in progress (ViewerServer with a LiveView), which asks
+/// the server for news every `poll_ms`. InputError when saloam was built
+/// without three.js.
+std::string live_viewer_page(int poll_ms);
+
 /// Where `saloam view FOLDER` writes its page by default: FOLDER/view.html
 /// for a run folder; beside a saved map, MAP.view.html (the map folder holds
 /// only the map: write_map replaces it whole).

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string_view>
 
@@ -29,19 +31,44 @@ constexpr time_t kWriteSeconds = 10;
 // The viewer takes no request bodies: a larger one is answered 413 and
 // skipped, never buffered (httplib's default buffers any size).
 constexpr std::size_t kMaxRequestBodyBytes = 64 * 1024;
+// How often the live page asks for the run's news.
+constexpr int kLivePollMs = 500;
 }  // namespace
 
 struct ViewerServer::Impl {
   ViewerScene scene;
   ViewerOptions options;
+  std::shared_ptr<const LiveView> live;  ///< a run in progress instead of a scene
   std::string page;
   std::string map_bytes;
   httplib::Server server;
   int port = 0;  ///< bound port, for the Host check
 
+  void configure();
+  void add_common_routes();
   void add_routes();
+  void add_live_routes();
   void send_scan(const httplib::Request& request, httplib::Response& response) const;
 };
+
+namespace {
+
+/// A query parameter as a number (0 when absent); nullopt when it is not one.
+std::optional<std::uint64_t> number_parameter(const httplib::Request& request, const char* name) {
+  if (!request.has_param(name)) return 0;
+  const std::string text = request.get_param_value(name);
+  std::uint64_t value = 0;
+  const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (error != std::errc{} || end != text.data() + text.size() || text.size() > 19) return std::nullopt;
+  return value;
+}
+
+void bad_parameter(httplib::Response& response, const char* name) {
+  response.status = 400;
+  response.set_content(fmt::format("{}: not a number\n", name), "text/plain");
+}
+
+}  // namespace
 
 bool viewer_host_allowed(std::string_view host, int port) {
   const std::string suffix = fmt::format(":{}", port);
@@ -51,7 +78,7 @@ bool viewer_host_allowed(std::string_view host, int port) {
   return name == "127.0.0.1" || name == "localhost" || name == "[::1]";
 }
 
-void ViewerServer::Impl::add_routes() {
+void ViewerServer::Impl::add_common_routes() {
   // DNS rebinding: a page of another site whose name now resolves to
   // 127.0.0.1 sends its own name as Host. Only the loopback names pass.
   server.set_pre_routing_handler([this](const httplib::Request& request, httplib::Response& response) {
@@ -67,11 +94,32 @@ void ViewerServer::Impl::add_routes() {
   server.Get("/", [this](const httplib::Request&, httplib::Response& response) {
     response.set_content(page, "text/html; charset=utf-8");
   });
+}
+
+void ViewerServer::Impl::add_routes() {
   server.Get("/map.bin", [this](const httplib::Request&, httplib::Response& response) {
     response.set_content(map_bytes, "application/octet-stream");
   });
   server.Get(R"(/scan/(\d+))",
              [this](const httplib::Request& request, httplib::Response& response) { send_scan(request, response); });
+}
+
+void ViewerServer::Impl::add_live_routes() {
+  server.Get("/live.json", [this](const httplib::Request& request, httplib::Response& response) {
+    const auto revision = number_parameter(request, "revision");
+    const auto frames = number_parameter(request, "frames");
+    if (!revision) return bad_parameter(response, "revision");
+    if (!frames) return bad_parameter(response, "frames");
+    response.set_content(live->state_json(*revision, static_cast<std::size_t>(*frames)), "application/json");
+  });
+  server.Get("/live/map", [this](const httplib::Request& request, httplib::Response& response) {
+    const auto from = number_parameter(request, "from");
+    if (!from) return bad_parameter(response, "from");
+    response.set_content(live->map_chunks(static_cast<std::size_t>(*from)), "application/octet-stream");
+  });
+  server.Get("/live/scan", [this](const httplib::Request&, httplib::Response& response) {
+    response.set_content(live->latest_scan(), "application/octet-stream");
+  });
 }
 
 void ViewerServer::Impl::send_scan(const httplib::Request& request, httplib::Response& response) const {
@@ -91,17 +139,30 @@ void ViewerServer::Impl::send_scan(const httplib::Request& request, httplib::Res
   }
 }
 
+void ViewerServer::Impl::configure() {
+  add_common_routes();
+  server.new_task_queue = [] { return new httplib::ThreadPool(kWorkerThreads); };
+  server.set_keep_alive_timeout(kKeepAliveSeconds);
+  server.set_read_timeout(kReadSeconds, 0);
+  server.set_write_timeout(kWriteSeconds, 0);
+  server.set_payload_max_length(kMaxRequestBodyBytes);
+}
+
 ViewerServer::ViewerServer(ViewerScene scene, const ViewerOptions& options) : impl_(std::make_unique<Impl>()) {
   impl_->options = options;
   impl_->page = viewer_page(scene, options, ViewerDataSource::kServer);
   impl_->map_bytes = encode_map(scene.map, map_quantization(scene.map));
   impl_->scene = std::move(scene);
+  impl_->configure();
   impl_->add_routes();
-  impl_->server.new_task_queue = [] { return new httplib::ThreadPool(kWorkerThreads); };
-  impl_->server.set_keep_alive_timeout(kKeepAliveSeconds);
-  impl_->server.set_read_timeout(kReadSeconds, 0);
-  impl_->server.set_write_timeout(kWriteSeconds, 0);
-  impl_->server.set_payload_max_length(kMaxRequestBodyBytes);
+}
+
+ViewerServer::ViewerServer(std::shared_ptr<const LiveView> live) : impl_(std::make_unique<Impl>()) {
+  if (!live) throw std::invalid_argument("ViewerServer: no live view");
+  impl_->page = live_viewer_page(kLivePollMs);
+  impl_->live = std::move(live);
+  impl_->configure();
+  impl_->add_live_routes();
 }
 
 ViewerServer::~ViewerServer() { stop(); }

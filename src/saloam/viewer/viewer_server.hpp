@@ -4,6 +4,11 @@
 //   /            the page (ViewerDataSource::kServer)
 //   /map.bin     the decimated map (point_encoding.hpp)
 //   /scan/N      scan N (processed-frame index), loaded from the sequence on demand
+// Or, for a run in progress (`saloam slam|odom ... --serve`, live_view.hpp):
+//   /                                  the live page, which polls
+//   /live.json?revision=R&frames=N     LiveView::state_json(R, N)
+//   /live/map?from=K                   LiveView::map_chunks(K)
+//   /live/scan                         LiveView::latest_scan()
 // Only requests whose Host names the loopback and the port are answered (DNS
 // rebinding); error bodies are short and name no file.
 
@@ -11,6 +16,7 @@
 #include <string>
 #include <string_view>
 
+#include "saloam/viewer/live_view.hpp"
 #include "saloam/viewer/viewer_scene.hpp"
 
 namespace saloam {
@@ -24,6 +30,9 @@ class ViewerServer {
  public:
   /// Prepares the page and the map; InputError as write_viewer_page.
   ViewerServer(ViewerScene scene, const ViewerOptions& options);
+  /// Serves the live page of a run that adds its frames to `live`.
+  /// InputError when saloam was built without three.js.
+  explicit ViewerServer(std::shared_ptr<const LiveView> live);
   ~ViewerServer();
   ViewerServer(const ViewerServer&) = delete;
   ViewerServer& operator=(const ViewerServer&) = delete;

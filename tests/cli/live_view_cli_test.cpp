@@ -1,0 +1,215 @@
+// End-to-end: `saloam slam|odom ... --serve` shows the run as it goes. A
+// client that polls as the page does ends with the run's own loop-closed
+// poses and its accepted loops; headless Chromium draws the page without
+// errors; a run that ends by itself keeps its page until Ctrl-C (exit 0),
+// and Ctrl-C during the run ends both (exit 130, the outputs written).
+
+#include <signal.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "browser_fixture.hpp"
+#include "saloam/io/trajectory_io.hpp"
+#include "saloam/viewer/viewer_scene.hpp"
+#include "viewer/viewer_fixture.hpp"
+
+// After Eigen: httplib.h includes <resolv.h>, whose `_res` macro breaks Eigen's headers.
+#include <httplib.h>
+
+namespace saloam {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::quoted;
+using testing::run_command;
+using testing::TempDir;
+
+std::string saloam_cmd(const std::string& args) { return quoted(testing::cli_path()) + " " + args; }
+
+std::vector<float> floats_of(const std::string& base64_text) {
+  static const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string bytes;
+  std::uint32_t buffer = 0;
+  int bits = 0;
+  for (const char c : base64_text) {
+    if (c == '=') break;
+    buffer = (buffer << 6) | static_cast<std::uint32_t>(alphabet.find(c));
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      bytes.push_back(static_cast<char>((buffer >> bits) & 0xFFU));
+    }
+  }
+  std::vector<float> values(bytes.size() / 4);
+  std::memcpy(values.data(), bytes.data(), values.size() * 4);
+  return values;
+}
+
+/// What a client polling as the live page does holds: the poses merged
+/// across revisions, the loops, and the revisions it saw.
+struct Follower {
+  std::uint64_t revision = 0;
+  std::vector<float> poses;  ///< 12 a frame
+  nlohmann::json state = nlohmann::json::object();
+  std::set<std::string> statuses;
+
+  /// One poll; false when the server did not answer.
+  bool poll(httplib::Client& client) {
+    const auto answer = client.Get(fmt::format("/live.json?revision={}&frames={}", revision, poses.size() / 12));
+    if (!answer || answer->status != 200) return false;
+    state = nlohmann::json::parse(answer->body);
+    const std::vector<float> news = floats_of(state["poses"]);
+    const std::size_t first = state["first"];
+    EXPECT_TRUE(first == poses.size() / 12 || first == 0);
+    poses.resize(12 * first);
+    poses.insert(poses.end(), news.begin(), news.end());
+    EXPECT_EQ(poses.size(), 12 * state["frames"].get<std::size_t>());
+    revision = state["revision"];
+    statuses.insert(state["status"].get<std::string>());
+    return true;
+  }
+};
+
+/// Accepted (query, match) of a loops.csv.
+std::set<std::pair<std::size_t, std::size_t>> accepted_loops(const fs::path& file) {
+  std::set<std::pair<std::size_t, std::size_t>> loops;
+  for (const auto& [query, match] : read_accepted_loops(file)) loops.emplace(query, match);
+  return loops;
+}
+
+/// A `saloam ... --serve` child, killed when a failed assertion leaves it serving.
+class Child {
+ public:
+  Child(const std::vector<std::string>& args, const fs::path& log) : pid_(testing::spawn_saloam(args, log)) {}
+  ~Child() {
+    if (pid_ <= 0) return;
+    kill(pid_, SIGKILL);
+    waitpid(pid_, nullptr, 0);
+  }
+  Child(const Child&) = delete;
+  Child& operator=(const Child&) = delete;
+  [[nodiscard]] bool started() const { return pid_ > 0; }
+  void interrupt() const { kill(pid_, SIGINT); }
+  /// Its exit status; -1 when it did not exit normally.
+  int wait() {
+    int status = 0;
+    const bool waited = waitpid(pid_, &status, 0) == pid_;
+    pid_ = -1;
+    return waited && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  }
+
+ private:
+  pid_t pid_ = -1;
+};
+
+/// A figure eight at 16 beams: 407 frames, a few seconds, loops closed.
+class LiveViewCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new TempDir();
+    std::string output;
+    ASSERT_EQ(run_command(saloam_cmd("-q simulate --preset figure-eight --beams 16 --azimuth-steps 900 --stride 4 --out " +
+                                     quoted(*dir_ / "seq")),
+                          &output),
+              0)
+        << output;
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    dir_ = nullptr;
+  }
+  static fs::path sequence() { return *dir_ / "seq"; }
+  static TempDir* dir_;
+};
+TempDir* LiveViewCli::dir_ = nullptr;
+
+TEST_F(LiveViewCli, SlamShowsItsRunAsItGoesAndKeepsThePageUntilCtrlC) {
+  TempDir tmp;
+  const fs::path log = tmp / "run.log", out = tmp / "out";
+  Child run({"slam", sequence().string(), "--out", out.string(), "--no-map", "--serve", "--port", "0"}, log);
+  ASSERT_TRUE(run.started());
+  const std::optional<int> port = testing::served_port(log);
+  ASSERT_TRUE(port) << testing::read_text(log);
+  httplib::Client client("127.0.0.1", *port);
+  Follower follower;
+  for (int i = 0; i < 2400 && follower.state.value("status", "running") == "running"; ++i) {
+    follower.poll(client);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(follower.state.value("status", ""), "finished") << testing::read_text(log);
+
+  // The poses merged across revisions are the run's loop-closed poses (float32).
+  const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");
+  ASSERT_EQ(follower.poses.size(), 12 * written.poses.size());
+  double worst = 0;
+  for (std::size_t f = 0; f < written.poses.size(); ++f) {
+    for (int a = 0; a < 3; ++a) {
+      worst = std::max(worst, std::abs(follower.poses[12 * f + 4 * a + 3] - written.poses[f].translation()[a]));
+    }
+  }
+  EXPECT_LT(worst, 1e-3);
+  std::set<std::pair<std::size_t, std::size_t>> shown;
+  for (const auto& loop : follower.state["loops"]) shown.emplace(loop[0], loop[1]);
+  EXPECT_EQ(shown, accepted_loops(out / "loops.csv"));
+  EXPECT_GE(shown.size(), 1U);
+  EXPECT_GE(follower.state["revision"].get<int>(), 1);  // loop closure moved the trajectory
+  const auto map = client.Get("/live/map?from=0");
+  ASSERT_TRUE(map);
+  EXPECT_GT(map->body.size(), 8U * follower.state["chunks"].get<std::size_t>());
+
+  SALOAM_REQUIRE_CHROMIUM();
+  const std::string dom = testing::chromium_url(tmp, "--virtual-time-budget=5000 --dump-dom",
+                                                fmt::format("http://127.0.0.1:{}/", *port));
+  EXPECT_NE(dom.find(fmt::format("<title>live:finished frames:{} ", written.poses.size())), std::string::npos)
+      << dom.substr(0, 2000);
+  EXPECT_EQ(dom.find("<title>error"), std::string::npos) << dom.substr(0, 2000);  // the page's errors go to its title
+
+  run.interrupt();
+  EXPECT_EQ(run.wait(), 0) << testing::read_text(log);
+  const std::string text = testing::read_text(log);
+  EXPECT_NE(text.find("its page stays at"), std::string::npos) << text;
+  EXPECT_NE(text.find("server stopped"), std::string::npos) << text;
+}
+
+TEST_F(LiveViewCli, CtrlCDuringTheRunEndsTheRunAndItsPage) {
+  TempDir tmp;
+  const fs::path log = tmp / "run.log", out = tmp / "out";
+  Child run({"odom", sequence().string(), "--out", out.string(), "--serve", "--port", "0"}, log);
+  ASSERT_TRUE(run.started());
+  const std::optional<int> port = testing::served_port(log);
+  ASSERT_TRUE(port) << testing::read_text(log);
+  httplib::Client client("127.0.0.1", *port);
+  Follower follower;
+  while (follower.poll(client) && follower.state["frames"].get<std::size_t>() < 20 &&
+         follower.state["status"] == "running") {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  run.interrupt();
+  const int code = run.wait();
+  const std::string text = testing::read_text(log);
+  if (follower.state.value("status", "") == "finished") {
+    EXPECT_EQ(code, 0) << text;
+    GTEST_SKIP() << "the run ended before it could be interrupted (" << follower.state["frames"] << " frames)";
+  }
+  EXPECT_EQ(code, 130) << text;
+  EXPECT_EQ(text.find("stays at"), std::string::npos) << text;
+  const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");
+  EXPECT_GE(written.poses.size(), 20U);
+  EXPECT_LT(written.poses.size(), 407U);
+  EXPECT_FALSE(client.Get("/live.json"));  // the server is gone with the run
+}
+
+}  // namespace
+}  // namespace saloam
