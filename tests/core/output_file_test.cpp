@@ -101,6 +101,14 @@ TEST(OutputFolder, ASecondRunOnTheFolderStopsAtOnceNamingTheFirst) {
       << message;
 }
 
+TEST(OutputFolder, AFolderReachedThroughALinkAfterAMissingFolderIsTheSameFolder) {
+  TempDir dir;
+  const OutputFolder first(dir / "out", "slam");
+  fs::create_directory_symlink(dir / "out", dir / "link");
+  const std::string message = input_error_of([&] { OutputFolder second(dir / "new" / ".." / "link", "odom"); });
+  EXPECT_NE(message.find("slam"), std::string::npos) << message;
+}
+
 TEST(OutputFolder, AnotherProcessHoldingTheLockIsRespected) {
   TempDir dir;
   { const OutputFolder earlier(dir.path(), "slam"); }

@@ -120,6 +120,13 @@ TEST(SlamEndToEnd, RefusesToWriteOverTheSequence) {
   const std::string odometry_error =
       testing::input_error_of([&] { run_odometry(source, OdometryConfig{}, dir.path(), odometry_options); });
   EXPECT_NE(odometry_error.find("overwrite its ground truth"), std::string::npos) << odometry_error;
+  // A link to the sequence reached through a folder not yet made and `..`:
+  // the folder the system would write into is the sequence's.
+  testing::TempDir elsewhere("saloam_slam_link");
+  std::filesystem::create_directory_symlink(dir.path(), elsewhere / "link");
+  const std::string link_error = testing::input_error_of(
+      [&] { run_slam(source, SaloamConfig{}, std::nullopt, elsewhere / "new" / ".." / "link", options); });
+  EXPECT_NE(link_error.find("is the sequence folder"), std::string::npos) << link_error;
   EXPECT_EQ(std::filesystem::file_size(dir / "poses.txt"), before);
 }
 

@@ -16,6 +16,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/output_file.hpp"
+#include "saloam/core/path_rules.hpp"
 
 namespace fs = std::filesystem;
 
@@ -36,12 +37,9 @@ std::vector<OutputFolder*>& registry() {
   return folders;
 }
 
-// The folder itself, with its links resolved, for comparing paths.
-fs::path resolved(const fs::path& path) {
-  std::error_code ec;
-  fs::path out = fs::weakly_canonical(fs::absolute(path, ec), ec);
-  return ec ? fs::absolute(path, ec).lexically_normal() : out;
-}
+// The folder itself, with its links resolved, for comparing paths (the
+// path rule's resolution: a link after a missing folder and `..` too).
+fs::path resolved(const fs::path& path) { return comparable_path(path); }
 
 // `path` relative to `root` when it lies inside it (both resolved); empty otherwise.
 fs::path inside(const fs::path& path, const fs::path& root) {

@@ -7,6 +7,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/output_file.hpp"
+#include "saloam/core/path_rules.hpp"
 
 namespace saloam {
 namespace {
@@ -30,9 +31,7 @@ void write_summary_file(OutputFolder& folder, nlohmann::json summary) {
 OutputFolder open_run_folder(const std::filesystem::path& out_dir, const std::optional<std::filesystem::path>& sequence,
                              std::string command, const std::vector<std::string>& own_names) {
   std::error_code error;
-  const auto out = std::filesystem::weakly_canonical(out_dir, error);
-  const auto root = sequence ? std::filesystem::weakly_canonical(*sequence, error) : std::filesystem::path();
-  if (sequence && !error && out == root) {
+  if (sequence && comparable_path(out_dir) == comparable_path(*sequence)) {
     throw InputError(out_dir, fmt::format("is the sequence folder {}: the run's poses.txt would overwrite its ground "
                                           "truth; choose another output folder",
                                           sequence->string()));

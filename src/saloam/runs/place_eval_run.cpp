@@ -14,6 +14,7 @@
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/output_file.hpp"
+#include "saloam/core/path_rules.hpp"
 #include "saloam/runs/output_folder.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
@@ -249,11 +250,7 @@ std::vector<Eigen::Vector3d> truth_positions(const SourceInfo& info) {
 // removed by the new run's clean start before they are read.
 void check_graphs_outside(const PlaceEvalOptions& options, const std::filesystem::path& out_dir) {
   if (!options.graphs) return;
-  std::error_code error;
-  const auto graphs = std::filesystem::weakly_canonical(*options.graphs, error);
-  const auto out = std::filesystem::weakly_canonical(out_dir, error);
-  const auto [o, g] = std::mismatch(out.begin(), out.end(), graphs.begin(), graphs.end());
-  if (o == out.end()) {
+  if (path_within(comparable_path(*options.graphs), comparable_path(out_dir))) {
     throw ConfigError(fmt::format("--graphs {} lies in the output folder {}, which a new run clears: copy the graphs "
                                   "elsewhere or choose another --out",
                                   options.graphs->string(), out_dir.string()));
