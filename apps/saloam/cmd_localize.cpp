@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command.hpp"
+#include "live_serving.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 #include "saloam/core/lie.hpp"
@@ -28,6 +29,7 @@ struct LocalizeOptions {
   std::string map;
   std::string out;
   std::string model;
+  ServeOptions serve;
   ConfigOptions config;
 };
 
@@ -66,6 +68,12 @@ int run_localize_command(const LocalizeOptions& options) {
     run_options.map_error = map_error_against_source(map);
     std::cout << "the map and the scans are passes of one simulated world: relocalisations are judged against the truth\n";
   }
+  std::unique_ptr<LiveServing> live;
+  if (options.serve.serve) {
+    live = std::make_unique<LiveServing>(options.source.path, "localize", options.serve.port);
+    live->show_map(options.map);
+    run_options.follow = live->follower();
+  }
   const LocalizeRunResult r = run_localize(*source, config, map, load_loop_network(config), options.out, run_options);
 
   std::cout << fmt::format("{} frames: {} localized, {} on the odometry outside the map, {} not placed; median {:.1f} ms/frame "
@@ -93,6 +101,7 @@ int run_localize_command(const LocalizeOptions& options) {
   }
   if (r.aligned_ate_m) std::cout << fmt::format("placed frames against the reference: ATE {:.3f} m (SE(3)-aligned)\n", *r.aligned_ate_m);
   std::cout << fmt::format("wrote {} ({})\n", options.out, fmt::join(r.files, ", "));
+  if (live) live->run_ended(r.interrupted);
   if (r.interrupted) {
     spdlog::warn("interrupted: results of the {} frames processed were written", r.frames);
     return 130;
@@ -111,6 +120,7 @@ const CommandRegistration kRegistration{Command{
           ->check(CLI::ExistingFile);
       add_no_calib_flag(app, options->source.no_calib);
       options->source.add_live_to(app);
+      options->serve.add_to(app);
       options->config.add_to(app);
       return [options] { return run_localize_command(*options); };
     }}};

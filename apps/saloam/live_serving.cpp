@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "saloam/core/cancellation.hpp"
+#include "saloam/viewer/viewer_scene.hpp"
 
 namespace saloam::cli {
 
@@ -29,6 +30,10 @@ LiveServing::LiveServing(const std::string& title, const std::string& command, i
 LiveServing::~LiveServing() {
   if (!ended_) view_->finish(LiveRunStatus::kFailed);
   stop();
+}
+
+void LiveServing::show_map(const std::filesystem::path& folder) {
+  view_->set_background(load_map_viewer_scene(folder).map);
 }
 
 FrameFollower LiveServing::follower() const {

@@ -1,11 +1,12 @@
 #pragma once
-// `--serve` of `saloam slam` and `saloam odom`: the live page of the run at
+// `--serve` of `saloam slam`, `odom` and `localize`: the live page of the run at
 // http://127.0.0.1:PORT/ while the run goes on (viewer/live_view.hpp). The
 // server answers from its own threads; the run feeds it through follower().
 // A run that ends by itself keeps its page until Ctrl-C (as `saloam view
 // --serve`); one that Ctrl-C or an error ended stops the server at once.
 
 #include <atomic>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
@@ -35,6 +36,9 @@ class LiveServing {
   LiveServing(const LiveServing&) = delete;
   LiveServing& operator=(const LiveServing&) = delete;
 
+  /// Shows the saved map at `folder` under the run (`localize`): its
+  /// keyframes' features, decimated as `saloam view` decimates them.
+  void show_map(const std::filesystem::path& folder);
   /// What the run calls after each frame.
   [[nodiscard]] FrameFollower follower() const;
   /// The run has ended and written its outputs: after an interruption the

@@ -1,6 +1,7 @@
-// End-to-end: `saloam slam|odom ... --serve` shows the run as it goes. A
-// client that polls as the page does ends with the run's own loop-closed
-// poses and its accepted loops; headless Chromium draws the page without
+// End-to-end: `saloam slam|odom|localize ... --serve` shows the run as it
+// goes. A client that polls as the page does ends with the run's own
+// loop-closed poses and its accepted loops (localize: its placed frames and
+// the saved map); headless Chromium draws the page without
 // errors; a run that ends by itself keeps its page until Ctrl-C (exit 0),
 // and Ctrl-C during the run ends both (exit 130, the outputs written).
 
@@ -181,6 +182,41 @@ TEST_F(LiveViewCli, SlamShowsItsRunAsItGoesAndKeepsThePageUntilCtrlC) {
   const std::string text = testing::read_text(log);
   EXPECT_NE(text.find("its page stays at"), std::string::npos) << text;
   EXPECT_NE(text.find("server stopped"), std::string::npos) << text;
+}
+
+TEST_F(LiveViewCli, LocalizeShowsTheSavedMapAndTheFramesItPlaces) {
+  TempDir tmp;
+  std::string output;
+  ASSERT_EQ(run_command(saloam_cmd(fmt::format("-q slam {} --frames 0:200 --no-map --out {} --save-map {}",
+                                               quoted(sequence()), quoted(tmp / "mapped"), quoted(tmp / "map"))),
+                        &output),
+            0)
+      << output;
+  const fs::path log = tmp / "run.log", out = tmp / "out";
+  Child run({"localize", sequence().string(), "--frames", "100:300", "--map", (tmp / "map").string(), "--out",
+             out.string(), "--serve", "--port", "0"},
+            log);
+  ASSERT_TRUE(run.started());
+  const std::optional<int> port = testing::served_port(log);
+  ASSERT_TRUE(port) << testing::read_text(log);
+  httplib::Client client("127.0.0.1", *port);
+  Follower follower;
+  for (int i = 0; i < 2400 && follower.state.value("status", "running") == "running"; ++i) {
+    follower.poll(client);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(follower.state.value("status", ""), "finished") << testing::read_text(log);
+  // The page follows the frames placed in the map: those of poses_tum.txt, in the map's frame.
+  const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");
+  ASSERT_GT(written.poses.size(), 50U);
+  ASSERT_EQ(follower.poses.size(), 12 * written.poses.size());
+  EXPECT_NEAR(follower.poses[12 * 10 + 3], written.poses[10].translation().x(), 1e-3);
+  EXPECT_GT(follower.state["background"]["points"].get<std::size_t>(), 1000U);
+  const auto background = client.Get("/live/background");
+  ASSERT_TRUE(background);
+  EXPECT_EQ(background->body.size(), 7 * follower.state["background"]["points"].get<std::size_t>());
+  run.interrupt();
+  EXPECT_EQ(run.wait(), 0) << testing::read_text(log);
 }
 
 TEST_F(LiveViewCli, CtrlCDuringTheRunEndsTheRunAndItsPage) {

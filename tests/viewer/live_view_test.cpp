@@ -167,6 +167,18 @@ TEST(LiveView, TheNewestScanIsNamedByItsFrameWithinItsBudget) {
   EXPECT_GE(points, 600U);  // every third point of 2000
 }
 
+TEST(LiveView, ABackgroundMapIsSentOnceWithItsQuantisation) {
+  LiveView view("seq", "localize");
+  const LabelledCloud map = testing::fake_street(5000);
+  view.set_background(map);
+  const MapQuantization q = map_quantization(map);
+  EXPECT_EQ(view.background(), encode_map(map, q));
+  const auto background = nlohmann::json::parse(view.state_json(0, 0))["background"];
+  EXPECT_EQ(background["points"], 5000);
+  EXPECT_EQ(background["scale"], q.scale);
+  EXPECT_EQ(background["origin"][0], q.origin.x());
+}
+
 TEST(LiveView, TheServerAnswersThePageItsStateItsMapAndItsScan) {
   auto view = std::make_shared<LiveView>("seq", "slam");
   const LabelledCloud scan = testing::fake_scan(2000);
@@ -197,6 +209,10 @@ TEST(LiveView, TheServerAnswersThePageItsStateItsMapAndItsScan) {
     ASSERT_TRUE(answer);
     EXPECT_EQ(answer->status, 400) << bad;
   }
+  const auto none = client.Get("/live/background");
+  ASSERT_TRUE(none);
+  EXPECT_TRUE(none->body.empty());
+  EXPECT_TRUE(nlohmann::json::parse(view->state_json(0, 0))["background"].is_null());
   const auto rebound = client.Get("/live.json", {{"Host", "attacker.example:" + std::to_string(port)}});
   ASSERT_TRUE(rebound);
   EXPECT_EQ(rebound->status, 403);

@@ -118,15 +118,20 @@ namespace {
 
 // The frame loop: every frame of `source` through the localiser, the placed
 // frames' poses written as they come; returns the loop's wall time [s].
-double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWriter& writer, bool show_progress) {
+double localize_frames(FrameSource& source, Localizer& localizer, TrajectoryWriter& writer,
+                       const LocalizeRunOptions& options) {
   const SourceInfo& info = source.info();
-  ProgressBar progress(info.size(), "localize", show_progress && !info.live);
+  ProgressBar progress(info.size(), "localize", options.show_progress && !info.live);
   const StageTimer timer;
   for (std::size_t i = 0; !stop_requested(); ++i) {
     const std::optional<SourceFrame> frame = source.next_frame(i);
     if (!frame) break;
     const LocalizedFrame& f = localizer.process(frame->cloud, frame->time);
     if (f.status != LocalizationStatus::kUnplaced) writer.write(f.timestamp, f.pose);
+    if (f.status != LocalizationStatus::kUnplaced && options.follow) {
+      options.follow(FinishedFrame{
+          .index = i, .time = f.timestamp, .scan = frame->cloud, .pose = f.pose, .corrected = nullptr, .loops = {}});
+    }
     progress.set_status(fmt::format("{}, {:.0f} ms", localization_status_name(f.status), f.timing.total_ms()));
     progress.advance();
   }
@@ -279,7 +284,7 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
 
   Localizer localizer(config, map, std::move(network));
   LocalizeRunResult result;
-  result.seconds = localize_frames(source, localizer, writer, options.show_progress);
+  result.seconds = localize_frames(source, localizer, writer, options);
   result.interrupted = stop_requested();
   writer.commit();
 

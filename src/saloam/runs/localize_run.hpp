@@ -25,6 +25,7 @@
 #include "saloam/io/frame_source.hpp"
 #include "saloam/maps/localizer.hpp"
 #include "saloam/maps/prior_map.hpp"
+#include "saloam/runs/finished_frame.hpp"
 
 namespace saloam {
 
@@ -55,6 +56,9 @@ struct LocalizeRunOptions {
   /// its alignment before they are compared with the truth, so that the
   /// localisation error and the mapping ATE measure the same thing.
   std::optional<MapError> map_error;
+  /// Called with every frame placed in the map (its pose in the map's frame),
+  /// e.g. the live viewer; frames not placed are not followed.
+  FrameFollower follow;
 };
 
 struct LocalizeRunResult {

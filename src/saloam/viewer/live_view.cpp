@@ -90,6 +90,15 @@ void LiveView::add_frame(const Pose& pose, const LabelledCloud& scan) {
   if (due) keep_chunk(frame, scan);
 }
 
+void LiveView::set_background(const LabelledCloud& map) {
+  const MapQuantization quantization = map_quantization(map);
+  std::string bytes = encode_map(map, quantization);
+  const std::lock_guard lock(mutex_);
+  background_ = std::move(bytes);
+  background_origin_ = {quantization.origin.x(), quantization.origin.y(), quantization.origin.z()};
+  background_scale_ = quantization.scale;
+}
+
 void LiveView::replace_poses(std::vector<Pose> poses) {
   const std::lock_guard lock(mutex_);
   if (poses.size() != poses_.size()) throw std::invalid_argument("LiveView::replace_poses: one pose per frame added");
@@ -112,6 +121,10 @@ std::string LiveView::state_json(std::uint64_t revision, std::size_t known_frame
   const std::size_t first = revision == revision_ ? std::min(known_frames, poses_.size()) : 0;
   nlohmann::json loops = nlohmann::json::array();
   for (const auto& [query, match] : loops_) loops.push_back({query, match});
+  nlohmann::json background = nullptr;
+  if (!background_.empty()) {
+    background = {{"points", background_.size() / 7}, {"origin", background_origin_}, {"scale", background_scale_}};
+  }
   const nlohmann::json state{{"title", title_},
                              {"command", command_},
                              {"status", status_name(status_)},
@@ -123,7 +136,8 @@ std::string LiveView::state_json(std::uint64_t revision, std::size_t known_frame
                              {"chunks", chunks_.size()},
                              {"map_points", map_points_},
                              {"chunk_spacing", spacing_},
-                             {"travelled", travelled_}};
+                             {"travelled", travelled_},
+                             {"background", background}};
   return state.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
@@ -141,6 +155,11 @@ std::string LiveView::map_chunks(std::size_t first) const {
 std::string LiveView::latest_scan() const {
   const std::lock_guard lock(mutex_);
   return latest_scan_;
+}
+
+std::string LiveView::background() const {
+  const std::lock_guard lock(mutex_);
+  return background_;
 }
 
 std::size_t LiveView::frames() const {

@@ -8,6 +8,7 @@
 //                counts and whether the run is still going
 //   map_chunks   the map's pieces the page lacks
 //   latest_scan  the newest scan
+//   background   a map the run happens in (localisation's saved map), once
 // The map is pieces of scans (a decimated scan every `chunk_spacing` metres
 // travelled), each kept in its own frame's LiDAR frame and placed by that
 // frame's current pose, so that loop closure moves the map with the
@@ -38,6 +39,9 @@ class LiveView {
   /// `title`: what the page calls the run (e.g. the source).
   LiveView(std::string title, std::string command, const LiveViewOptions& options = {});
 
+  /// A map the run happens in (a localisation's saved map, in the frame of
+  /// the run's poses), shown under the run's own pieces; decimated by the caller.
+  void set_background(const LabelledCloud& map);
   /// The run's next frame: its pose now and its scan (LiDAR frame).
   void add_frame(const Pose& pose, const LabelledCloud& scan);
   /// Loop closure moved earlier frames: the pose of every frame added so
@@ -58,6 +62,9 @@ class LiveView {
   [[nodiscard]] std::string map_chunks(std::size_t first) const;
   /// The newest scan: uint32 frame, then the scan encoding; empty before the first frame.
   [[nodiscard]] std::string latest_scan() const;
+  /// The background map in the map encoding (point_encoding.hpp), its
+  /// origin and step in state_json's "background"; empty when none.
+  [[nodiscard]] std::string background() const;
 
   [[nodiscard]] std::size_t frames() const;
   [[nodiscard]] std::size_t chunks() const;
@@ -84,6 +91,9 @@ class LiveView {
   double travelled_ = 0;       ///< [m] along the poses as added
   double chunk_travelled_ = 0; ///< travelled_ at the last chunk
   std::string latest_scan_;
+  std::string background_;
+  std::vector<double> background_origin_;  ///< x, y, z [m]
+  double background_scale_ = 0;            ///< [m] a step
   LiveRunStatus status_ = LiveRunStatus::kRunning;
 };
 

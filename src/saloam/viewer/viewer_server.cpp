@@ -120,6 +120,9 @@ void ViewerServer::Impl::add_live_routes() {
   server.Get("/live/scan", [this](const httplib::Request&, httplib::Response& response) {
     response.set_content(live->latest_scan(), "application/octet-stream");
   });
+  server.Get("/live/background", [this](const httplib::Request&, httplib::Response& response) {
+    response.set_content(live->background(), "application/octet-stream");
+  });
 }
 
 void ViewerServer::Impl::send_scan(const httplib::Request& request, httplib::Response& response) const {

@@ -9,6 +9,7 @@
 //   /live.json?revision=R&frames=N     LiveView::state_json(R, N)
 //   /live/map?from=K                   LiveView::map_chunks(K)
 //   /live/scan                         LiveView::latest_scan()
+//   /live/background                   LiveView::background()
 // Only requests whose Host names the loopback and the port are answered (DNS
 // rebinding); error bodies are short and name no file.
 
