@@ -39,8 +39,12 @@ std::size_t VelodyneFrameAssembler::count_gap(double packet_us, bool dual) {
 }
 
 void VelodyneFrameAssembler::begin(double time_s, std::size_t block, std::vector<VelodyneFrame>& done) {
+  // Room for as many points as the last frame had (and a little more): a
+  // sweep's 100 000+ points grown one by one cost more than decoding them.
+  const std::size_t expected = current_ ? current_->cloud.size() + current_->cloud.size() / 16 : 0;
   if (current_) done.push_back(std::move(*current_));
   current_ = VelodyneFrame{};
+  current_->cloud.reserve(expected);
   current_->time = time_s;
   ++frames_begun_;
   last_start_block_ = block;
