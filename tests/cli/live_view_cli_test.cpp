@@ -39,24 +39,6 @@ using testing::TempDir;
 
 std::string saloam_cmd(const std::string& args) { return quoted(testing::cli_path()) + " " + args; }
 
-std::vector<float> floats_of(const std::string& base64_text) {
-  static const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string bytes;
-  std::uint32_t buffer = 0;
-  int bits = 0;
-  for (const char c : base64_text) {
-    if (c == '=') break;
-    buffer = (buffer << 6) | static_cast<std::uint32_t>(alphabet.find(c));
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      bytes.push_back(static_cast<char>((buffer >> bits) & 0xFFU));
-    }
-  }
-  std::vector<float> values(bytes.size() / 4);
-  std::memcpy(values.data(), bytes.data(), values.size() * 4);
-  return values;
-}
 
 /// What a client polling as the live page does holds: the poses merged
 /// across revisions, the loops, and the revisions it saw.
@@ -71,7 +53,7 @@ struct Follower {
     const auto answer = client.Get(fmt::format("/live.json?revision={}&frames={}", revision, poses.size() / 12));
     if (!answer || answer->status != 200) return false;
     state = nlohmann::json::parse(answer->body);
-    const std::vector<float> news = floats_of(state["poses"]);
+    const std::vector<float> news = testing::base64_floats(state["poses"]);
     const std::size_t first = state["first"];
     EXPECT_TRUE(first == poses.size() / 12 || first == 0);
     poses.resize(12 * first);

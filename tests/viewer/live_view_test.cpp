@@ -53,25 +53,6 @@ std::vector<Piece> pieces_of(const std::string& bytes) {
   return pieces;
 }
 
-std::vector<float> floats_of(const std::string& base64_text) {
-  std::vector<float> values;
-  static const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string bytes;
-  std::uint32_t buffer = 0;
-  int bits = 0;
-  for (const char c : base64_text) {
-    if (c == '=') break;
-    buffer = (buffer << 6) | static_cast<std::uint32_t>(alphabet.find(c));
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      bytes.push_back(static_cast<char>((buffer >> bits) & 0xFFU));
-    }
-  }
-  values.resize(bytes.size() / 4);
-  std::memcpy(values.data(), bytes.data(), values.size() * 4);
-  return values;
-}
 
 TEST(LiveView, KeepsAPieceOfTheMapEveryFewMetres) {
   LiveViewOptions options;
@@ -120,13 +101,13 @@ TEST(LiveView, GivesThePosesAPageLacksAndAllOfThemAfterLoopClosure) {
   EXPECT_EQ(state["status"], "running");
   EXPECT_EQ(state["frames"], 5);
   EXPECT_EQ(state["first"], 0);
-  std::vector<float> poses = floats_of(state["poses"]);
+  std::vector<float> poses = testing::base64_floats(state["poses"]);
   ASSERT_EQ(poses.size(), 60U);
   EXPECT_EQ(poses[12 * 3 + 3], 3.0F);  // x of frame 3 ([R|t] rows)
   EXPECT_EQ(poses[12 * 3 + 0], 1.0F);
   state = nlohmann::json::parse(view.state_json(0, 3));
   EXPECT_EQ(state["first"], 3);
-  EXPECT_EQ(floats_of(state["poses"]).size(), 24U);
+  EXPECT_EQ(testing::base64_floats(state["poses"]).size(), 24U);
 
   // Loop closure moves every frame: a page of the old revision gets them all.
   std::vector<Pose> moved;
@@ -136,13 +117,13 @@ TEST(LiveView, GivesThePosesAPageLacksAndAllOfThemAfterLoopClosure) {
   state = nlohmann::json::parse(view.state_json(0, 5));
   EXPECT_EQ(state["revision"], 1);
   EXPECT_EQ(state["first"], 0);
-  poses = floats_of(state["poses"]);
+  poses = testing::base64_floats(state["poses"]);
   ASSERT_EQ(poses.size(), 60U);
   EXPECT_EQ(poses[12 * 4 + 3], 4.25F);
   EXPECT_EQ(state["loops"], nlohmann::json::parse("[[4, 0]]"));
   state = nlohmann::json::parse(view.state_json(1, 5));
   EXPECT_EQ(state["first"], 5);
-  EXPECT_TRUE(floats_of(state["poses"]).empty());
+  EXPECT_TRUE(testing::base64_floats(state["poses"]).empty());
   // More frames than the view holds: from its end.
   EXPECT_EQ(nlohmann::json::parse(view.state_json(1, 99))["first"], 5);
 

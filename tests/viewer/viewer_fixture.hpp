@@ -3,6 +3,7 @@
 // summary.json) with the sequence it points at, for the viewer's tests.
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -119,6 +120,26 @@ inline nlohmann::json page_data(const std::string& page) {
   if (begin == std::string::npos) return {};
   const std::size_t end = page.find(";</script>", begin);
   return nlohmann::json::parse(page.substr(begin + start.size(), end - begin - start.size()));
+}
+
+/// Float32 values sent as base64 (the page's poses), decoded as the page decodes them.
+inline std::vector<float> base64_floats(const std::string& text) {
+  static const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string bytes;
+  std::uint32_t buffer = 0;
+  int bits = 0;
+  for (const char c : text) {
+    if (c == '=') break;
+    buffer = (buffer << 6) | static_cast<std::uint32_t>(alphabet.find(c));
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      bytes.push_back(static_cast<char>((buffer >> bits) & 0xFFU));
+    }
+  }
+  std::vector<float> values(bytes.size() / 4);
+  std::memcpy(values.data(), bytes.data(), values.size() * 4);
+  return values;
 }
 
 inline std::string read_text(const std::filesystem::path& file) {
