@@ -63,6 +63,14 @@ struct Follower {
     statuses.insert(state["status"].get<std::string>());
     return true;
   }
+
+  /// Polls twenty times a second until the run is no longer running (two minutes at most).
+  void until_the_run_ends(httplib::Client& client) {
+    for (int i = 0; i < 2400 && state.value("status", "running") == "running"; ++i) {
+      poll(client);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  }
 };
 
 /// Accepted (query, match) of a loops.csv.
@@ -127,10 +135,7 @@ TEST_F(LiveViewCli, SlamShowsItsRunAsItGoesAndKeepsThePageUntilCtrlC) {
   ASSERT_TRUE(port) << testing::read_text(log);
   httplib::Client client("127.0.0.1", *port);
   Follower follower;
-  for (int i = 0; i < 2400 && follower.state.value("status", "running") == "running"; ++i) {
-    follower.poll(client);
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  follower.until_the_run_ends(client);
   ASSERT_EQ(follower.state.value("status", ""), "finished") << testing::read_text(log);
 
   // The poses merged across revisions are the run's loop-closed poses (float32).
@@ -183,10 +188,7 @@ TEST_F(LiveViewCli, LocalizeShowsTheSavedMapAndTheFramesItPlaces) {
   ASSERT_TRUE(port) << testing::read_text(log);
   httplib::Client client("127.0.0.1", *port);
   Follower follower;
-  for (int i = 0; i < 2400 && follower.state.value("status", "running") == "running"; ++i) {
-    follower.poll(client);
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
+  follower.until_the_run_ends(client);
   ASSERT_EQ(follower.state.value("status", ""), "finished") << testing::read_text(log);
   // The page follows the frames placed in the map: those of poses_tum.txt, in the map's frame.
   const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");

@@ -10,6 +10,9 @@ namespace saloam::viewer_assets {
 extern const std::string_view kPageTemplate;
 /// live.html: the page of a run in progress (`--serve`), with the same placeholders.
 extern const std::string_view kLivePageTemplate;
+/// viewer_common.css and viewer_common.js: what both pages share.
+extern const std::string_view kCommonCss;
+extern const std::string_view kCommonJs;
 /// three.min.js and examples/js/controls/OrbitControls.js; empty when
 /// libjs-three was not installed when saloam was configured.
 extern const std::string_view kThreeJs;

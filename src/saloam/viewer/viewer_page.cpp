@@ -181,6 +181,8 @@ std::string fill_page(std::string_view page_template, const json& data) {
   replace_once(page, "/*SALOAM_DATA*/", script_safe(data.dump(-1, ' ', false, json::error_handler_t::replace)));
   replace_once(page, "/*SALOAM_ORBIT_CONTROLS_JS*/", viewer_assets::kOrbitControlsJs);
   replace_once(page, "/*SALOAM_THREE_JS*/", viewer_assets::kThreeJs);
+  replace_once(page, "/*SALOAM_COMMON_JS*/", viewer_assets::kCommonJs);
+  replace_once(page, "/*SALOAM_COMMON_CSS*/", viewer_assets::kCommonCss);
   return page;
 }
 
