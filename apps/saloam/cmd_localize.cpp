@@ -44,6 +44,35 @@ std::optional<Pose> simulated_truth(const PriorMap& map, const SourceInfo& info)
   return orthonormalized(map_pass->origin.inverse() * run_pass->origin);
 }
 
+/// What the run did: how the frames were placed, when it relocalised, and
+/// its errors against the truth when known.
+void print_summary(const LocalizeRunResult& r) {
+  std::cout << fmt::format("{} frames: {} localized, {} on the odometry outside the map, {} not placed; median {:.1f} ms/frame "
+                           "({:.1f} Hz); peak memory {:.0f} MiB; {} map keyframes read\n",
+                           r.frames, r.localized, r.odometry, r.unplaced, r.median_frame_ms,
+                           r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.peak_rss_mib, r.map_loads);
+  if (r.first_placed_m) {
+    std::cout << fmt::format("relocalised after {:.1f} m (frame {}); {} hypotheses, {} refuted; left the map {} times, "
+                             "came back {} times\n",
+                             *r.first_placed_m, r.first_placed_frame.value_or(0), r.hypotheses + r.confirmed, r.refuted,
+                             r.left_map, r.reentered);
+  } else {
+    std::cout << "never relocalised: no frame was placed in the map\n";
+  }
+  if (r.false_relocalizations) {
+    std::cout << fmt::format("against the truth in the map frame: {} false relocalisations; localized frames RMSE {} m (max {} m), "
+                             "all placed frames RMSE {} m\n",
+                             *r.false_relocalizations, r.localized_rmse_m ? fmt::format("{:.3f}", *r.localized_rmse_m) : "-",
+                             r.localized_max_m ? fmt::format("{:.3f}", *r.localized_max_m) : "-",
+                             r.placed_rmse_m ? fmt::format("{:.3f}", *r.placed_rmse_m) : "-");
+  }
+  if (r.map_error_where_localized_m) {
+    std::cout << fmt::format("the map's own error where the frames were localized: RMSE {:.3f} m (the localized frames "
+                             "inherit it)\n", *r.map_error_where_localized_m);
+  }
+  if (r.aligned_ate_m) std::cout << fmt::format("placed frames against the reference: ATE {:.3f} m (SE(3)-aligned)\n", *r.aligned_ate_m);
+}
+
 int run_localize_command(const LocalizeOptions& options) {
   PathRules rules;
   options.source.add_inputs(rules).input("--map", options.map).output("--out", options.out, OutputUse::kFolder).check();
@@ -76,30 +105,7 @@ int run_localize_command(const LocalizeOptions& options) {
   }
   const LocalizeRunResult r = run_localize(*source, config, map, load_loop_network(config), options.out, run_options);
 
-  std::cout << fmt::format("{} frames: {} localized, {} on the odometry outside the map, {} not placed; median {:.1f} ms/frame "
-                           "({:.1f} Hz); peak memory {:.0f} MiB; {} map keyframes read\n",
-                           r.frames, r.localized, r.odometry, r.unplaced, r.median_frame_ms,
-                           r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.peak_rss_mib, r.map_loads);
-  if (r.first_placed_m) {
-    std::cout << fmt::format("relocalised after {:.1f} m (frame {}); {} hypotheses, {} refuted; left the map {} times, "
-                             "came back {} times\n",
-                             *r.first_placed_m, r.first_placed_frame.value_or(0), r.hypotheses + r.confirmed, r.refuted,
-                             r.left_map, r.reentered);
-  } else {
-    std::cout << "never relocalised: no frame was placed in the map\n";
-  }
-  if (r.false_relocalizations) {
-    std::cout << fmt::format("against the truth in the map frame: {} false relocalisations; localized frames RMSE {} m (max {} m), "
-                             "all placed frames RMSE {} m\n",
-                             *r.false_relocalizations, r.localized_rmse_m ? fmt::format("{:.3f}", *r.localized_rmse_m) : "-",
-                             r.localized_max_m ? fmt::format("{:.3f}", *r.localized_max_m) : "-",
-                             r.placed_rmse_m ? fmt::format("{:.3f}", *r.placed_rmse_m) : "-");
-  }
-  if (r.map_error_where_localized_m) {
-    std::cout << fmt::format("the map's own error where the frames were localized: RMSE {:.3f} m (the localized frames "
-                             "inherit it)\n", *r.map_error_where_localized_m);
-  }
-  if (r.aligned_ate_m) std::cout << fmt::format("placed frames against the reference: ATE {:.3f} m (SE(3)-aligned)\n", *r.aligned_ate_m);
+  print_summary(r);
   std::cout << fmt::format("wrote {} ({})\n", options.out, fmt::join(r.files, ", "));
   if (live) live->run_ended(r.interrupted);
   if (r.interrupted) {

@@ -106,12 +106,12 @@ int run_slam_command(const SlamOptions& options) {
   if (sensor.profile) run_options.sensor = sensor.profile->name;
   run_options.join_map = join_map.get();
 
-  OutputFolder folder = open_slam_folder(options.out, source->info());
-  std::unique_ptr<LiveServing> live;
+  std::unique_ptr<LiveServing> live;  // before the folder: a port in use leaves it untouched
   if (options.serve.serve) {
     live = std::make_unique<LiveServing>(options.source.path, "slam", options.serve.port);
     run_options.follow = live->follower();
   }
+  OutputFolder folder = open_slam_folder(options.out, source->info());
   const SlamRunResult result = run_slam(*source, config, load_loop_network(config), folder, run_options);
   print_summary(result);
   if (!result.join.empty()) std::cout << result.join << '\n';

@@ -203,6 +203,25 @@ TEST_F(LiveViewCli, LocalizeShowsTheSavedMapAndTheFramesItPlaces) {
   EXPECT_EQ(run.wait(), 0) << testing::read_text(log);
 }
 
+TEST_F(LiveViewCli, APortInUseIsAClearErrorBeforeAnyOutput) {
+  TempDir tmp;
+  httplib::Server other;  // another program on the port
+  const int port = other.bind_to_any_port("127.0.0.1");
+  ASSERT_GT(port, 0);
+  for (const char* command : {"slam", "odom"}) {
+    std::string output;
+    // (bounded: were the port taken, the run would serve until Ctrl-C)
+    EXPECT_EQ(run_command("timeout 120 " + saloam_cmd(fmt::format("{} {} --out {} --serve --port {}", command,
+                                                                   quoted(sequence()), quoted(tmp / command), port)),
+                          &output),
+              2)
+        << output;
+    EXPECT_NE(output.find(fmt::format("127.0.0.1:{}: cannot listen there (port in use?)", port)), std::string::npos)
+        << output;
+    EXPECT_FALSE(fs::exists(tmp / command)) << command;
+  }
+}
+
 TEST_F(LiveViewCli, CtrlCDuringTheRunEndsTheRunAndItsPage) {
   TempDir tmp;
   const fs::path log = tmp / "run.log", out = tmp / "out";

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "saloam/core/error.hpp"
 #include "saloam/viewer/live_view.hpp"
 #include "saloam/viewer/point_encoding.hpp"
 #include "saloam/viewer/viewer_server.hpp"
@@ -168,6 +169,10 @@ TEST(LiveView, TheServerAnswersThePageItsStateItsMapAndItsScan) {
   const int port = server.bind("127.0.0.1", 0);
   std::thread listener([&server] { server.listen(); });
   while (!server.running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+
+  // A second server on the port is refused (not given half the connections).
+  ViewerServer second(view);
+  EXPECT_THROW(second.bind("127.0.0.1", port), InputError);
 
   httplib::Client client("127.0.0.1", port);
   const auto page = client.Get("/");

@@ -144,6 +144,13 @@ void ViewerServer::Impl::send_scan(const httplib::Request& request, httplib::Res
 
 void ViewerServer::Impl::configure() {
   add_common_routes();
+  // httplib's default adds SO_REUSEPORT, with which a second server binds a
+  // port in use and the kernel splits the connections between the two:
+  // SO_REUSEADDR alone (a port in TIME_WAIT is taken again, one in use is refused).
+  server.set_socket_options([](socket_t socket) {
+    const int yes = 1;
+    setsockopt(socket, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  });
   server.new_task_queue = [] { return new httplib::ThreadPool(kWorkerThreads); };
   server.set_keep_alive_timeout(kKeepAliveSeconds);
   server.set_read_timeout(kReadSeconds, 0);
