@@ -254,7 +254,9 @@ struct LoopClosureConfig {
   double proximity_radius = 0.0;
   /// [m] Beyond the paper: the query keyframe is also described as seen from
   /// this far to either side of the sensor, as localize.lateral_query_offset
-  /// (a reverse revisit in the other lane; 0 = off).
+  /// (a reverse revisit in the other lane; 0 = off). Off by default: it
+  /// closed no revisited stretch more, at two more descriptors per search
+  /// (docs/loop_closure.md).
   double lateral_query_offset = 0.0;
   /// delta_r: threshold on the ICP loss r of Eq. 2 (the weighted sum of
   /// point-to-line and point-to-plane distances [m]) at the registered pose.
