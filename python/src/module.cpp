@@ -267,6 +267,7 @@ struct Slam {
       out.append(py::dict("query_frame"_a = r.query_frame, "match_frame"_a = r.match_frame,
                           "query_keyframe"_a = r.query_keyframe, "match_keyframe"_a = r.match_keyframe,
                           "travelled"_a = r.travelled, "score"_a = r.score.score, "by_proximity"_a = r.by_proximity,
+                          "query_offset"_a = r.query_offset,
                           "accepted"_a = r.verification.accepted, "reason"_a = r.verification.reason,
                           "inlier_fraction"_a = r.verification.inlier_fraction,
                           "mean_residual"_a = r.verification.mean_residual,

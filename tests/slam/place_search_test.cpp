@@ -84,6 +84,21 @@ TEST(PlaceSearch, KeepsOnePerPlaceWhenAskedTo) {
   EXPECT_EQ(keyframes_of(rank_places(set, candidates, {0.5, 3, 0.0})), (std::vector<std::size_t>{0, 1, 2}));
 }
 
+// The live SLAM's queries from the side (loop.lateral_query_offset): with
+// every keyframe its own place, yet a keyframe that two queries propose is
+// verified once, with its best proposal; the best N_loop over all queries.
+TEST(PlaceSearch, MergesQueriesBestFirstEachKeyframeOnce) {
+  const LineOfKeyframes set({0, 10, 20, 30});
+  const PlaceSearchOptions options{0.5, 3, 0.0};
+  std::vector<PlaceProposal> proposed = rank_places(set, scored({0, 1, 2}, {0.7, 0.6, 0.55}), options);
+  for (const PlaceProposal& p : rank_places(set, scored({1, 3}, {0.8, 0.6}), options, 3.2)) proposed.push_back(p);
+  const std::vector<PlaceProposal> merged = merge_proposals(set, proposed, options);
+  ASSERT_EQ(keyframes_of(merged), (std::vector<std::size_t>{1, 0, 3}));  // 1 once; 3 ties with 1's 0.6, comes later
+  EXPECT_DOUBLE_EQ(merged[0].query_offset, 3.2);
+  EXPECT_DOUBLE_EQ(merged[1].query_offset, 0.0);
+  EXPECT_DOUBLE_EQ(merged[2].query_offset, 3.2);
+}
+
 TEST(PlaceSearch, ProposesTheNearestCandidateOnceWhateverItsScore) {
   const LineOfKeyframes set({0, 10, 20});
   const auto candidates = scored({0, 1, 2}, {0.9, 0.1, 0.2});

@@ -252,6 +252,12 @@ struct LoopClosureConfig {
   /// estimate is verified too when nearer than this, whatever its score
   /// (0 = off).
   double proximity_radius = 0.0;
+  /// [m] Beyond the paper: the query keyframe is also described as seen from
+  /// this far to either side of the sensor, as localize.lateral_query_offset
+  /// (a reverse revisit in the other lane; 0 = off). Off by default: it
+  /// closed no revisited stretch more, at two more descriptors per search
+  /// (docs/loop_closure.md).
+  double lateral_query_offset = 0.0;
   /// delta_r: threshold on the ICP loss r of Eq. 2 (the weighted sum of
   /// point-to-line and point-to-plane distances [m]) at the registered pose.
   /// Depends on the number of features per scan; used when
@@ -452,6 +458,8 @@ void visit_fields(LoopClosureConfig& c, Visitor&& v) {
   v("ssc_zeta", c.ssc_zeta, "Semantic Scan Context score threshold", Range{0, 1});
   v("num_loop", c.num_loop, "N_loop: best pairs verified per query", AtLeast{1});
   v("proximity_radius", c.proximity_radius, "[m] also verify the nearest candidate within this (0 = off)", AtLeast{0});
+  v("lateral_query_offset", c.lateral_query_offset,
+    "[m] place recognition also from this far to either side (another lane; 0: off)", Range{0, 20});
   v("delta_r", c.delta_r, "delta_r: ICP loss threshold (Eq. 2 sum) [m]", Above{0});
   v("acceptance", c.acceptance, "verification test", OneOf{"normalized", "loss"});
   v("max_mean_residual", c.max_mean_residual, "[m] normalized test: max mean inlier residual", Above{0});

@@ -37,6 +37,15 @@ std::string pose_numbers(const Pose& T) {
   return fmt::format("{:.6f}", fmt::join(v, v + 12, " "));
 }
 
+// Why a loop was verified: its score (from the sensor, or from the query
+// described to the left or right, loop.lateral_query_offset) or its
+// estimated distance.
+const char* proposed_by(const LoopRecord& loop) {
+  if (loop.by_proximity) return "proximity";
+  if (loop.query_offset > 0) return "score_left";
+  return loop.query_offset < 0 ? "score_right" : "score";
+}
+
 void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, const std::vector<Pose>* gt) {
   AtomicFile out_file(file);
   std::ostream& out = out_file.stream();
@@ -53,7 +62,7 @@ void write_loops_csv(const std::filesystem::path& file, const SlamSystem& slam, 
                        loop.query_frame, loop.match_frame, loop.query_keyframe, loop.match_keyframe, loop.travelled,
                        loop.score.score, loop.score.sgpr_score, loop.score.scancontext_score,
                        loop.score.yaw ? fmt::format("{:.1f}", *loop.score.yaw * 180.0 / M_PI) : std::string(),
-                       loop.by_proximity ? "proximity" : "score", v.guess, v.features, r.correspondences(), r.inliers, v.inlier_fraction, v.mean_residual,
+                       proposed_by(loop), v.guess, v.features, r.correspondences(), r.inliers, v.inlier_fraction, v.mean_residual,
                        r.loss, v.translation_eigenvalue, v.runner_up_inlier_ratio, r.converged, v.passes_loss_test, v.passes_normalized_test,
                        v.accepted, v.reason, pose_numbers(v.relative));
     if (gt) {

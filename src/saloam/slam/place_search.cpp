@@ -28,16 +28,18 @@ std::vector<std::size_t> nearest_ring_keys(const KeyframeSet& set, const PlaceDe
   return nearest;
 }
 
-// The first `count` of `ranked` (best first), skipping any within
-// `distance` of one already taken (distance 0: none skipped).
+// The first `count` of `ranked` (best first), skipping a keyframe already
+// taken (proposed by another query) and any within `distance` of one
+// already taken (distance 0: only the same keyframe skipped).
 std::vector<PlaceProposal> one_per_place(const KeyframeSet& set, const std::vector<PlaceProposal>& ranked,
                                          std::size_t count, double distance) {
   std::vector<PlaceProposal> chosen;
   for (const PlaceProposal& p : ranked) {
     if (chosen.size() >= count) break;
     const Eigen::Vector3d position = set.pose(p.keyframe).translation();
-    const bool same_place = distance > 0 && std::any_of(chosen.begin(), chosen.end(), [&](const PlaceProposal& other) {
-      return (set.pose(other.keyframe).translation() - position).norm() < distance;
+    const bool same_place = std::any_of(chosen.begin(), chosen.end(), [&](const PlaceProposal& other) {
+      return other.keyframe == p.keyframe ||
+             (distance > 0 && (set.pose(other.keyframe).translation() - position).norm() < distance);
     });
     if (!same_place) chosen.push_back(p);
   }
@@ -111,6 +113,14 @@ std::vector<PlaceProposal> rank_places(const KeyframeSet& set, const ScoredCandi
   return one_per_place(set, above, options.count, options.same_place_distance);
 }
 
+std::vector<PlaceProposal> merge_proposals(const KeyframeSet& set, std::vector<PlaceProposal> proposed,
+                                           const PlaceSearchOptions& options) {
+  std::stable_sort(proposed.begin(), proposed.end(), [](const PlaceProposal& a, const PlaceProposal& b) {
+    return a.match.score > b.match.score;
+  });
+  return one_per_place(set, proposed, options.count, options.same_place_distance);
+}
+
 std::vector<PlaceProposal> propose_places(const KeyframeSet& set, const PlaceRecognizer& places,
                                           const std::vector<PlaceQuery>& queries,
                                           const std::vector<std::size_t>& candidates, const PlaceSearchOptions& options) {
@@ -120,21 +130,23 @@ std::vector<PlaceProposal> propose_places(const KeyframeSet& set, const PlaceRec
     const std::vector<PlaceProposal> ranked = rank_places(set, scored, options, query.offset);
     proposed.insert(proposed.end(), ranked.begin(), ranked.end());
   }
-  std::stable_sort(proposed.begin(), proposed.end(), [](const PlaceProposal& a, const PlaceProposal& b) {
-    return a.match.score > b.match.score;
-  });
-  return one_per_place(set, proposed, options.count, options.same_place_distance);
+  return merge_proposals(set, std::move(proposed), options);
 }
 
-std::vector<PlaceQuery> lateral_queries(const PlaceRecognizer& places, const LabelledCloud& scan, double offset) {
-  std::vector<double> sideways{0.0};
-  if (offset > 0) sideways.insert(sideways.end(), {offset, -offset});
+std::vector<PlaceQuery> sideways_queries(const PlaceRecognizer& places, const LabelledCloud& scan, double offset) {
   std::vector<PlaceQuery> queries;
-  for (const double y : sideways) {
+  if (offset <= 0) return queries;
+  for (const double y : {offset, -offset}) {
     LabelledCloud seen_from = scan;  // the points in a frame `y` to the left of the sensor
     for (Eigen::Vector3f& p : seen_from.points) p.y() -= static_cast<float>(y);
     queries.push_back({places.describe(seen_from), y});
   }
+  return queries;
+}
+
+std::vector<PlaceQuery> lateral_queries(const PlaceRecognizer& places, const LabelledCloud& scan, double offset) {
+  std::vector<PlaceQuery> queries{{places.describe(scan), 0.0}};
+  for (PlaceQuery& query : sideways_queries(places, scan, offset)) queries.push_back(std::move(query));
   return queries;
 }
 

@@ -126,15 +126,24 @@ ScoredCandidates score_candidates(const KeyframeSet& set, const PlaceRecognizer&
 std::vector<PlaceProposal> rank_places(const KeyframeSet& set, const ScoredCandidates& scored,
                                        const PlaceSearchOptions& options, double query_offset = 0);
 
-/// Each query scored and ranked, then the best `count` over all queries
-/// (stable: the first query first among equal scores), one per place.
+/// The proposals of several queries (each from rank_places, in query
+/// order) as one: the best `count` (stable: the earlier query first among
+/// equal scores), one per place; a keyframe proposed by two queries keeps
+/// its best proposal.
+std::vector<PlaceProposal> merge_proposals(const KeyframeSet& set, std::vector<PlaceProposal> proposed,
+                                           const PlaceSearchOptions& options);
+
+/// Each query scored and ranked, then merged (merge_proposals).
 std::vector<PlaceProposal> propose_places(const KeyframeSet& set, const PlaceRecognizer& places,
                                           const std::vector<PlaceQuery>& queries,
                                           const std::vector<std::size_t>& candidates, const PlaceSearchOptions& options);
 
-/// The scan described from the sensor and, when `offset` > 0, from `offset`
-/// metres to either side (another lane: Scan Context compares scans taken
-/// from one spot).
+/// The scan described from `offset` metres to its left and to its right
+/// (another lane: Scan Context compares scans taken from one spot); none
+/// when `offset` is 0.
+std::vector<PlaceQuery> sideways_queries(const PlaceRecognizer& places, const LabelledCloud& scan, double offset);
+
+/// The scan described from the sensor, then its sideways_queries.
 std::vector<PlaceQuery> lateral_queries(const PlaceRecognizer& places, const LabelledCloud& scan, double offset);
 
 /// Beyond the paper: the scored candidate nearest to `position` (set frame),

@@ -70,7 +70,7 @@ Pose SlamSystem::process(const LabelledCloud& scan, double timestamp) {
 
   if (keyframe_due(odometry_pose)) {
     add_keyframe(scan, odometry_pose, timestamp, timing);
-    if (search_due()) close_loops(timing);
+    if (search_due()) close_loops(scan, timing);
   }
   frame_keyframe_.push_back(keyframes_.size() - 1);
   timings_.push_back(timing);
@@ -117,11 +117,12 @@ bool SlamSystem::search_due() const {
   return travelled_ - last_loop_travelled_ >= config_.loop.search_interval_after_loop;
 }
 
-void SlamSystem::close_loops(SlamFrameTimings& timing) {
+void SlamSystem::close_loops(const LabelledCloud& scan, SlamFrameTimings& timing) {
   StageTimer timer;
   const std::size_t query = keyframes_.size() - 1;
   const std::vector<std::size_t> candidates = select_candidates(query);
-  const std::vector<PlaceProposal> proposals = propose(query, candidates);
+  const std::vector<PlaceProposal> proposals =
+      propose(query, candidates, sideways_queries(places_, scan, config_.loop.lateral_query_offset));
   timing.search_ms = timer.lap().wall_ms;
 
   bool closed = false;
@@ -149,9 +150,17 @@ std::vector<std::size_t> SlamSystem::select_candidates(std::size_t query) {
   return loop_candidates(keyframe_places_[query], earlier, gate_, rng_);
 }
 
-std::vector<PlaceProposal> SlamSystem::propose(std::size_t query, const std::vector<std::size_t>& candidates) const {
+std::vector<PlaceProposal> SlamSystem::propose(std::size_t query, const std::vector<std::size_t>& candidates,
+                                               const std::vector<PlaceQuery>& sideways) const {
   const ScoredCandidates scored = score_candidates(live_, places_, keyframes_[query].place, candidates);
   std::vector<PlaceProposal> proposals = rank_places(live_, scored, search_);
+  // Beyond the paper (loop.lateral_query_offset): the scan described from a
+  // lane width to either side too, the best N_loop over the three queries
+  // (a reverse revisit in the other lane scores low from the sensor).
+  if (!sideways.empty()) {
+    for (PlaceProposal& p : propose_places(live_, places_, sideways, candidates, search_)) proposals.push_back(p);
+    proposals = merge_proposals(live_, std::move(proposals), search_);
+  }
   // Beyond the paper: the candidate nearest to the query by the current
   // estimate, when nearer than proximity_radius, is verified too, whatever
   // its score (descriptors lose similarity on reverse revisits in the other
@@ -173,8 +182,13 @@ LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) 
   });
   // Initial guesses: the current estimates, and the descriptor's yaw (with
   // its x-y offset when it gives one, SSC's) in place.
+  // A query from the side: the descriptor's guess moved back to the sensor.
   std::vector<Pose> guesses{orthonormalized(graph_.pose(match).inverse() * graph_.pose(query))};
-  if (proposal.match.yaw) add_distinct_guess(guesses, place_match_guess(proposal.match));
+  if (proposal.query_offset != 0) {
+    add_distinct_guess(guesses, proposal.lateral_guess());
+  } else if (proposal.match.yaw) {
+    add_distinct_guess(guesses, place_match_guess(proposal.match));
+  }
   LoopRecord record;
   record.query_keyframe = query;
   record.match_keyframe = match;
@@ -183,6 +197,7 @@ LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) 
   record.travelled = keyframes_[query].travelled - keyframes_[match].travelled;
   record.score = proposal.match;
   record.by_proximity = proposal.by_proximity;
+  record.query_offset = proposal.query_offset;
   record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses, verification_);
   return record;
 }

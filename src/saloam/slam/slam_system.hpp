@@ -6,7 +6,9 @@
 //   if a keyframe is due:   describe the place, keep the features, add a graph node
 //   if a search is due:     the place search (place_search.hpp) over the
 //                           earlier keyframes: candidates (Eq. 3) -> scores
-//                           (> threshold, best N_loop) -> geometric
+//                           of the keyframe's descriptor (and, with
+//                           loop.lateral_query_offset, of the scan seen
+//                           from either side) (> threshold, best N_loop) -> geometric
 //                           verification -> loop edge -> optimise
 //
 // Keyframes (every `slam.keyframe_distance` metres or `keyframe_angle_deg`
@@ -79,6 +81,7 @@ struct LoopRecord {
   double travelled = 0;  ///< [m] between the two
   PlaceMatch score;
   bool by_proximity = false;  ///< proposed because the estimate put it within loop.proximity_radius
+  double query_offset = 0;    ///< [m] proposed for the query described this far to the left (loop.lateral_query_offset)
   LoopVerification verification;
 };
 
@@ -130,9 +133,11 @@ class SlamSystem {
   [[nodiscard]] bool keyframe_due(const Pose& odometry_pose) const;
   void add_keyframe(const LabelledCloud& scan, const Pose& odometry_pose, double timestamp, SlamFrameTimings& timing);
   [[nodiscard]] bool search_due() const;
-  void close_loops(SlamFrameTimings& timing);
+  void close_loops(const LabelledCloud& scan, SlamFrameTimings& timing);
   [[nodiscard]] std::vector<std::size_t> select_candidates(std::size_t query);
-  [[nodiscard]] std::vector<PlaceProposal> propose(std::size_t query, const std::vector<std::size_t>& candidates) const;
+  /// `sideways`: the query scan described from either side (none: the keyframe's descriptor only).
+  [[nodiscard]] std::vector<PlaceProposal> propose(std::size_t query, const std::vector<std::size_t>& candidates,
+                                                   const std::vector<PlaceQuery>& sideways) const;
   [[nodiscard]] LoopRecord verify(std::size_t query, const PlaceProposal& proposal) const;
   void add_loop_edge(const LoopRecord& record);
   void optimize();
