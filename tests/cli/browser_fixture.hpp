@@ -10,7 +10,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <optional>
-#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -70,12 +69,16 @@ inline pid_t spawn_saloam(const std::vector<std::string>& args, const std::files
 /// The port of the first http://127.0.0.1:PORT/ that `log` names, waiting up
 /// to `seconds` for it; nullopt when none appears.
 inline std::optional<int> served_port(const std::filesystem::path& log, double seconds = 15) {
-  const std::regex url(R"(http://127\.0\.0\.1:(\d+)/)");
+  const std::string prefix = "http://127.0.0.1:";
   const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
   while (true) {
-    std::smatch match;
     const std::string text = read_text(log);
-    if (std::regex_search(text, match, url)) return std::stoi(match[1].str());
+    const std::size_t at = text.find(prefix);
+    if (at != std::string::npos) {
+      const std::size_t digits = at + prefix.size();
+      const std::size_t end = text.find_first_not_of("0123456789", digits);
+      if (end != std::string::npos && end > digits && text[end] == '/') return std::stoi(text.substr(digits, end - digits));
+    }
     if (std::chrono::steady_clock::now() > until) return std::nullopt;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }

@@ -138,7 +138,7 @@ inline std::vector<float> base64_floats(const std::string& text) {
     }
   }
   std::vector<float> values(bytes.size() / 4);
-  std::memcpy(values.data(), bytes.data(), values.size() * 4);
+  if (!values.empty()) std::memcpy(values.data(), bytes.data(), values.size() * 4);  // data() may be null when empty
   return values;
 }
 
