@@ -37,10 +37,6 @@ std::vector<OutputFolder*>& registry() {
   return folders;
 }
 
-// The folder itself, with its links resolved, for comparing paths (the
-// path rule's resolution: a link after a missing folder and `..` too).
-fs::path resolved(const fs::path& path) { return comparable_path(path); }
-
 // `path` relative to `root` when it lies inside it (both resolved); empty otherwise.
 fs::path inside(const fs::path& path, const fs::path& root) {
   const auto [r, p] = std::mismatch(root.begin(), root.end(), path.begin(), path.end());
@@ -137,7 +133,7 @@ OutputFolder OutputFolder::join(fs::path dir, std::string command) {
 OutputFolder::OutputFolder(fs::path dir, std::string command, const std::vector<std::string>& own_names, Mode mode)
     : dir_(std::move(dir)), command_(std::move(command)), joined_(mode == Mode::kJoin) {
   create_folder(dir_);
-  absolute_ = resolved(dir_);
+  absolute_ = comparable_path(dir_);  // links resolved, as the path rule compares
   lock(mode);
   if (mode == Mode::kNewRun) {
     std::vector<std::string> earlier = listed_files(read_record(fd_));
@@ -229,7 +225,7 @@ void OutputFolder::append(const std::string& line) {
 }
 
 void record_output(const fs::path& file) {
-  const fs::path path = resolved(file.parent_path().empty() ? fs::path(".") : file.parent_path()) / file.filename();
+  const fs::path path = comparable_path(file.parent_path().empty() ? fs::path(".") : file.parent_path()) / file.filename();
   const std::lock_guard lock(registry_mutex());
   OutputFolder* holder = nullptr;  // the innermost folder: a run inside another run's folder keeps its own record
   fs::path name;

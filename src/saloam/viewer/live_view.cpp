@@ -35,18 +35,6 @@ LabelledCloud strided_subset(const LabelledCloud& cloud, std::size_t budget) {
   return subset;
 }
 
-/// [R|t] rows of poses[first...] as float32, base64.
-std::string poses_base64(const std::vector<Pose>& poses, std::size_t first) {
-  std::vector<float> values;
-  values.reserve((poses.size() - first) * 12);
-  for (std::size_t i = first; i < poses.size(); ++i) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) values.push_back(static_cast<float>(poses[i].matrix()(r, c)));
-    }
-  }
-  return base64(encode_floats(values));
-}
-
 }  // namespace
 
 LiveView::LiveView(std::string title, std::string command, const LiveViewOptions& options)

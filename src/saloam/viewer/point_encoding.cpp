@@ -110,4 +110,15 @@ std::string base64(std::string_view bytes) {
   return out;
 }
 
+std::string poses_base64(const std::vector<Pose>& poses, std::size_t first) {
+  std::vector<float> values;
+  values.reserve((poses.size() - std::min(first, poses.size())) * 12);
+  for (std::size_t i = first; i < poses.size(); ++i) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 4; ++c) values.push_back(static_cast<float>(poses[i].matrix()(r, c)));
+    }
+  }
+  return base64(encode_floats(values));
+}
+
 }  // namespace saloam

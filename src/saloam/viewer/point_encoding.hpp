@@ -36,6 +36,8 @@ std::string encode_map(const LabelledCloud& cloud, const MapQuantization& quanti
 std::string encode_scan(const LabelledCloud& scan);
 /// Float32 values as bytes (little-endian, as the browser reads them).
 std::string encode_floats(const std::vector<float>& values);
+/// Poses from `first` on as float32 [R|t] rows (12 a pose), base64, as the pages read them.
+std::string poses_base64(const std::vector<Pose>& poses, std::size_t first = 0);
 
 /// Standard base64 (RFC 4648, with padding).
 std::string base64(std::string_view bytes);

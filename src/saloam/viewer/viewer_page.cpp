@@ -61,18 +61,6 @@ std::string positions_base64(const std::vector<Pose>& poses) {
   return base64(encode_floats(xyz));
 }
 
-/// 3x4 row-major [R|t] per pose.
-std::string poses_base64(const std::vector<Pose>& poses) {
-  std::vector<float> values;
-  values.reserve(poses.size() * 12);
-  for (const Pose& p : poses) {
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 4; ++c) values.push_back(static_cast<float>(p.matrix()(r, c)));
-    }
-  }
-  return base64(encode_floats(values));
-}
-
 // Session colours, apart from the loop edges' cyan and magenta and the slider's yellow.
 constexpr const char* kSessionColors[] = {"#3b9cff", "#ff9800", "#8bc34a", "#7c4dff", "#f44336", "#00bfa5", "#a1887f"};
 
