@@ -2,7 +2,6 @@
 // run, or the sessions of a saved map, in the browser. Writes one self-contained page (src/saloam/viewer/), or
 // with --serve serves it from 127.0.0.1 and loads scans on demand.
 
-#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <iostream>
@@ -84,19 +83,10 @@ int write_page(const ViewOptions& options) {
 int serve(const ViewOptions& options) {
   const ViewerOptions viewer = viewer_options(options);
   ViewerServer server(load_viewer_scene(options.run_dir, viewer), viewer);
-  const int port = server.bind("127.0.0.1", options.port);
+  const int port = server.start("127.0.0.1", options.port);
   std::cout << fmt::format("serving {} at http://127.0.0.1:{}/ (Ctrl-C stops)\n", options.run_dir, port) << std::flush;
-  std::atomic<bool> done{false};
-  std::thread listener([&server, &done] {
-    server.listen();
-    done = true;
-  });
-  while (!stop_requested() && !done) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  while (!done) {  // stop() does nothing until listen() runs
-    server.stop();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  listener.join();
+  while (!stop_requested() && server.running()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  server.stop();
   stop_flag().store(false);  // Ctrl-C is how a server ends: not an interruption
   std::cout << "server stopped\n";
   return 0;

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <iostream>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -19,17 +20,12 @@ void ServeOptions::add_to(CLI::App& app) {
 
 LiveServing::LiveServing(const std::string& title, const std::string& command, int port)
     : view_(std::make_shared<LiveView>(title, command)), server_(view_) {
-  port_ = server_.bind("127.0.0.1", port);
-  listener_ = std::thread([this] {
-    server_.listen();
-    listen_returned_ = true;
-  });
+  port_ = server_.start("127.0.0.1", port);
   std::cout << fmt::format("following the run at http://127.0.0.1:{}/\n", port_) << std::flush;
 }
 
 LiveServing::~LiveServing() {
   if (!ended_) view_->finish(LiveRunStatus::kFailed);
-  stop();
 }
 
 void LiveServing::show_map(const std::filesystem::path& folder) {
@@ -47,23 +43,13 @@ FrameFollower LiveServing::follower() const {
 void LiveServing::run_ended(bool interrupted) {
   ended_ = true;
   view_->finish(interrupted ? LiveRunStatus::kInterrupted : LiveRunStatus::kFinished);
-  if (interrupted) return stop();
+  if (interrupted) return server_.stop();
   std::cout << fmt::format("the run is done; its page stays at http://127.0.0.1:{}/ until Ctrl-C\n", port_)
             << std::flush;
   while (!stop_requested()) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  stop();
+  server_.stop();
   clear_stop();  // Ctrl-C is how the page ends after a complete run: not an interruption
   std::cout << "server stopped\n";
-}
-
-void LiveServing::stop() {
-  if (!listener_.joinable()) return;
-  // ViewerServer::stop() does nothing until listen() runs: repeat it until listen() returns.
-  while (!listen_returned_) {
-    server_.stop();
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  listener_.join();
 }
 
 }  // namespace saloam::cli

@@ -5,11 +5,9 @@
 // A run that ends by itself keeps its page until Ctrl-C (as `saloam view
 // --serve`); one that Ctrl-C or an error ended stops the server at once.
 
-#include <atomic>
 #include <filesystem>
 #include <memory>
 #include <string>
-#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -47,13 +45,9 @@ class LiveServing {
   void run_ended(bool interrupted);
 
  private:
-  void stop();
-
   std::shared_ptr<LiveView> view_;
-  ViewerServer server_;
+  ViewerServer server_;  ///< stops when destroyed
   int port_ = 0;
-  std::atomic<bool> listen_returned_{false};
-  std::thread listener_;
   bool ended_ = false;
 };
 

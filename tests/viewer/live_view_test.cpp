@@ -4,10 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cstring>
 #include <set>
-#include <thread>
 #include <tuple>
 
 #include <nlohmann/json.hpp>
@@ -166,13 +164,12 @@ TEST(LiveView, TheServerAnswersThePageItsStateItsMapAndItsScan) {
   const LabelledCloud scan = testing::fake_scan(2000);
   for (int f = 0; f < 10; ++f) view->add_frame(at_x(f), scan);
   ViewerServer server(view);
-  const int port = server.bind("127.0.0.1", 0);
-  std::thread listener([&server] { server.listen(); });
-  while (!server.running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const int port = server.start("127.0.0.1", 0);
 
   // A second server on the port is refused (not given half the connections).
   ViewerServer second(view);
-  EXPECT_THROW(second.bind("127.0.0.1", port), InputError);
+  EXPECT_THROW(second.start("127.0.0.1", port), InputError);
+  EXPECT_FALSE(second.running());
 
   httplib::Client client("127.0.0.1", port);
   const auto page = client.Get("/");
@@ -203,11 +200,6 @@ TEST(LiveView, TheServerAnswersThePageItsStateItsMapAndItsScan) {
   ASSERT_TRUE(rebound);
   EXPECT_EQ(rebound->status, 403);
 
-  while (server.running()) {
-    server.stop();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  listener.join();
 }
 
 }  // namespace

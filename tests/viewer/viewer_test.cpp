@@ -210,10 +210,10 @@ TEST(Viewer, ServerSendsThePageTheMapAndScansOnDemand) {
   ViewerOptions options;
   options.points_per_scan = 600;
   ViewerServer server(load_viewer_scene(run.run_dir, options), options);
-  const int port = server.bind("127.0.0.1", 0);
+  const int port = server.start("127.0.0.1", 0);
   ASSERT_GT(port, 0);
-  std::thread listener([&server] { server.listen(); });
-  while (!server.running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(server.running());
+  EXPECT_THROW(server.start("127.0.0.1", 0), std::logic_error);
 
   httplib::Client client("127.0.0.1", port);
   const auto page = client.Get("/");
@@ -243,28 +243,22 @@ TEST(Viewer, ServerSendsThePageTheMapAndScansOnDemand) {
   EXPECT_LT(huge->body.size(), 100u) << huge->body;
 
   server.stop();
-  listener.join();
   EXPECT_FALSE(server.running());
+  EXPECT_FALSE(client.Get("/"));  // nothing answers any more
+  server.stop();  // again: nothing
 }
 
 // A server on a fake run, listening on 127.0.0.1 until the fixture ends.
 struct ServingRun {
   TempDir tmp;
   std::unique_ptr<ViewerServer> server;
-  std::thread listener;
   int port = 0;
 
   ServingRun() {
     const auto run = testing::write_fake_run(tmp.path(), 500, 5, 200);
     const ViewerOptions options;
     server = std::make_unique<ViewerServer>(load_viewer_scene(run.run_dir, options), options);
-    port = server->bind("127.0.0.1", 0);
-    listener = std::thread([this] { server->listen(); });
-    while (!server->running()) std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  ~ServingRun() {
-    server->stop();
-    listener.join();
+    port = server->start("127.0.0.1", 0);
   }
 };
 

@@ -1,12 +1,15 @@
 #include "saloam/viewer/viewer_server.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cctype>
 #include <charconv>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string_view>
+#include <thread>
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -43,6 +46,8 @@ struct ViewerServer::Impl {
   std::string map_bytes;
   httplib::Server server;
   int port = 0;  ///< bound port, for the Host check
+  std::thread listener;  ///< runs server.listen_after_bind() from start() to stop()
+  std::atomic<bool> listen_returned{false};
 
   void configure();
   void add_common_routes();
@@ -177,17 +182,28 @@ ViewerServer::ViewerServer(std::shared_ptr<const LiveView> live) : impl_(std::ma
 
 ViewerServer::~ViewerServer() { stop(); }
 
-int ViewerServer::bind(const std::string& host, int port) {
+int ViewerServer::start(const std::string& host, int port) {
+  if (impl_->listener.joinable()) throw std::logic_error("ViewerServer::start: already started");
   const int bound =
       port == 0 ? impl_->server.bind_to_any_port(host) : (impl_->server.bind_to_port(host, port) ? port : -1);
   if (bound <= 0) throw InputError(fmt::format("{}:{}", host, port), "cannot listen there (port in use?)");
   impl_->port = bound;
+  impl_->listener = std::thread([impl = impl_.get()] {
+    impl->server.listen_after_bind();
+    impl->listen_returned = true;
+  });
+  // httplib's stop() does nothing before its listening loop runs: wait for it,
+  // so that stop() always ends what start() began.
+  while (!impl_->server.is_running() && !impl_->listen_returned)
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
   return bound;
 }
 
-void ViewerServer::listen() { impl_->server.listen_after_bind(); }
-
-void ViewerServer::stop() { impl_->server.stop(); }
+void ViewerServer::stop() {
+  if (!impl_->listener.joinable()) return;
+  impl_->server.stop();
+  impl_->listener.join();
+}
 
 bool ViewerServer::running() const { return impl_->server.is_running(); }
 

@@ -38,14 +38,14 @@ class ViewerServer {
   ViewerServer(const ViewerServer&) = delete;
   ViewerServer& operator=(const ViewerServer&) = delete;
 
-  /// Binds `host`:`port` (port 0: any free port) and returns the port;
-  /// InputError naming the address when it is taken.
-  int bind(const std::string& host, int port);
-  /// Serves until stop() (from another thread); call after bind().
-  void listen();
-  /// Ends listen() from another thread. Before listen() runs (running()
-  /// false) it does nothing: callers repeat it until listen() returns.
+  /// Binds `host`:`port` (port 0: any free port), answers from its own
+  /// threads from now until stop(), and returns the port. InputError naming
+  /// the address when it is taken; std::logic_error when already started.
+  int start(const std::string& host, int port);
+  /// Stops answering and waits until the server's threads are done; nothing
+  /// when not started. The destructor stops it too.
   void stop();
+  /// Between start() and stop(), unless listening failed.
   [[nodiscard]] bool running() const;
   [[nodiscard]] std::size_t page_bytes() const;
 
