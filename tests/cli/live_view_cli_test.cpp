@@ -11,6 +11,8 @@
 #include <chrono>
 #include <cstring>
 #include <fstream>
+#include <memory>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -38,7 +40,6 @@ using testing::run_command;
 using testing::TempDir;
 
 std::string saloam_cmd(const std::string& args) { return quoted(testing::cli_path()) + " " + args; }
-
 
 /// What a client polling as the live page does holds: the poses merged
 /// across revisions, the loops, and the revisions it saw.
@@ -105,6 +106,30 @@ class Child {
   pid_t pid_ = -1;
 };
 
+/// `saloam ARGS --serve --port 0` in `tmp` (its log: tmp/run.log) and a client of its page, once the log names the
+/// port (`client` null when the run did not start or name it).
+struct ServedRun {
+  fs::path log;
+  Child child;
+  int port = 0;
+  std::unique_ptr<httplib::Client> client;
+
+  ServedRun(const TempDir& tmp, std::vector<std::string> args)
+      : log(tmp / "run.log"), child(serving(std::move(args)), log) {
+    const std::optional<int> served = child.started() ? testing::served_port(log) : std::nullopt;
+    if (!served) return;
+    port = *served;
+    client = std::make_unique<httplib::Client>("127.0.0.1", port);
+  }
+  [[nodiscard]] std::string log_text() const { return testing::read_text(log); }
+
+ private:
+  static std::vector<std::string> serving(std::vector<std::string> args) {
+    args.insert(args.end(), {"--serve", "--port", "0"});
+    return args;
+  }
+};
+
 /// A figure eight at 16 beams: 407 frames, a few seconds, loops closed.
 class LiveViewCli : public ::testing::Test {
  protected:
@@ -128,15 +153,12 @@ TempDir* LiveViewCli::dir_ = nullptr;
 
 TEST_F(LiveViewCli, SlamShowsItsRunAsItGoesAndKeepsThePageUntilCtrlC) {
   TempDir tmp;
-  const fs::path log = tmp / "run.log", out = tmp / "out";
-  Child run({"slam", sequence().string(), "--out", out.string(), "--no-map", "--serve", "--port", "0"}, log);
-  ASSERT_TRUE(run.started());
-  const std::optional<int> port = testing::served_port(log);
-  ASSERT_TRUE(port) << testing::read_text(log);
-  httplib::Client client("127.0.0.1", *port);
+  const fs::path out = tmp / "out";
+  ServedRun run(tmp, {"slam", sequence().string(), "--out", out.string(), "--no-map"});
+  ASSERT_TRUE(run.client) << run.log_text();
   Follower follower;
-  follower.until_the_run_ends(client);
-  ASSERT_EQ(follower.state.value("status", ""), "finished") << testing::read_text(log);
+  follower.until_the_run_ends(*run.client);
+  ASSERT_EQ(follower.state.value("status", ""), "finished") << run.log_text();
 
   // The poses merged across revisions are the run's loop-closed poses (float32).
   const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");
@@ -153,20 +175,20 @@ TEST_F(LiveViewCli, SlamShowsItsRunAsItGoesAndKeepsThePageUntilCtrlC) {
   EXPECT_EQ(shown, accepted_loops(out / "loops.csv"));
   EXPECT_GE(shown.size(), 1U);
   EXPECT_GE(follower.state["revision"].get<int>(), 1);  // loop closure moved the trajectory
-  const auto map = client.Get("/live/map?from=0");
+  const auto map = run.client->Get("/live/map?from=0");
   ASSERT_TRUE(map);
   EXPECT_GT(map->body.size(), 8U * follower.state["chunks"].get<std::size_t>());
 
   SALOAM_REQUIRE_CHROMIUM();
   const std::string dom = testing::chromium_url(tmp, "--virtual-time-budget=5000 --dump-dom",
-                                                fmt::format("http://127.0.0.1:{}/", *port));
+                                                fmt::format("http://127.0.0.1:{}/", run.port));
   EXPECT_NE(dom.find(fmt::format("<title>live:finished frames:{} ", written.poses.size())), std::string::npos)
       << dom.substr(0, 2000);
   EXPECT_EQ(dom.find("<title>error"), std::string::npos) << dom.substr(0, 2000);  // the page's errors go to its title
 
-  run.interrupt();
-  EXPECT_EQ(run.wait(), 0) << testing::read_text(log);
-  const std::string text = testing::read_text(log);
+  run.child.interrupt();
+  EXPECT_EQ(run.child.wait(), 0) << run.log_text();
+  const std::string text = run.log_text();
   EXPECT_NE(text.find("its page stays at"), std::string::npos) << text;
   EXPECT_NE(text.find("server stopped"), std::string::npos) << text;
 }
@@ -179,28 +201,24 @@ TEST_F(LiveViewCli, LocalizeShowsTheSavedMapAndTheFramesItPlaces) {
                         &output),
             0)
       << output;
-  const fs::path log = tmp / "run.log", out = tmp / "out";
-  Child run({"localize", sequence().string(), "--frames", "100:300", "--map", (tmp / "map").string(), "--out",
-             out.string(), "--serve", "--port", "0"},
-            log);
-  ASSERT_TRUE(run.started());
-  const std::optional<int> port = testing::served_port(log);
-  ASSERT_TRUE(port) << testing::read_text(log);
-  httplib::Client client("127.0.0.1", *port);
+  const fs::path out = tmp / "out";
+  ServedRun run(tmp, {"localize", sequence().string(), "--frames", "100:300", "--map", (tmp / "map").string(),
+                      "--out", out.string()});
+  ASSERT_TRUE(run.client) << run.log_text();
   Follower follower;
-  follower.until_the_run_ends(client);
-  ASSERT_EQ(follower.state.value("status", ""), "finished") << testing::read_text(log);
+  follower.until_the_run_ends(*run.client);
+  ASSERT_EQ(follower.state.value("status", ""), "finished") << run.log_text();
   // The page follows the frames placed in the map: those of poses_tum.txt, in the map's frame.
   const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");
   ASSERT_GT(written.poses.size(), 50U);
   ASSERT_EQ(follower.poses.size(), 12 * written.poses.size());
   EXPECT_NEAR(follower.poses[12 * 10 + 3], written.poses[10].translation().x(), 1e-3);
   EXPECT_GT(follower.state["background"]["points"].get<std::size_t>(), 1000U);
-  const auto background = client.Get("/live/background");
+  const auto background = run.client->Get("/live/background");
   ASSERT_TRUE(background);
   EXPECT_EQ(background->body.size(), 7 * follower.state["background"]["points"].get<std::size_t>());
-  run.interrupt();
-  EXPECT_EQ(run.wait(), 0) << testing::read_text(log);
+  run.child.interrupt();
+  EXPECT_EQ(run.child.wait(), 0) << run.log_text();
 }
 
 TEST_F(LiveViewCli, APortInUseIsAClearErrorBeforeAnyOutput) {
@@ -224,20 +242,17 @@ TEST_F(LiveViewCli, APortInUseIsAClearErrorBeforeAnyOutput) {
 
 TEST_F(LiveViewCli, CtrlCDuringTheRunEndsTheRunAndItsPage) {
   TempDir tmp;
-  const fs::path log = tmp / "run.log", out = tmp / "out";
-  Child run({"odom", sequence().string(), "--out", out.string(), "--serve", "--port", "0"}, log);
-  ASSERT_TRUE(run.started());
-  const std::optional<int> port = testing::served_port(log);
-  ASSERT_TRUE(port) << testing::read_text(log);
-  httplib::Client client("127.0.0.1", *port);
+  const fs::path out = tmp / "out";
+  ServedRun run(tmp, {"odom", sequence().string(), "--out", out.string()});
+  ASSERT_TRUE(run.client) << run.log_text();
   Follower follower;
-  while (follower.poll(client) && follower.state["frames"].get<std::size_t>() < 20 &&
+  while (follower.poll(*run.client) && follower.state["frames"].get<std::size_t>() < 20 &&
          follower.state["status"] == "running") {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  run.interrupt();
-  const int code = run.wait();
-  const std::string text = testing::read_text(log);
+  run.child.interrupt();
+  const int code = run.child.wait();
+  const std::string text = run.log_text();
   if (follower.state.value("status", "") == "finished") {
     EXPECT_EQ(code, 0) << text;
     GTEST_SKIP() << "the run ended before it could be interrupted (" << follower.state["frames"] << " frames)";
@@ -247,7 +262,7 @@ TEST_F(LiveViewCli, CtrlCDuringTheRunEndsTheRunAndItsPage) {
   const Trajectory written = read_tum_trajectory(out / "poses_tum.txt");
   EXPECT_GE(written.poses.size(), 20U);
   EXPECT_LT(written.poses.size(), 407U);
-  EXPECT_FALSE(client.Get("/live.json"));  // the server is gone with the run
+  EXPECT_FALSE(run.client->Get("/live.json"));  // the server is gone with the run
 }
 
 }  // namespace
