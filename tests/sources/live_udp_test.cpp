@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <string>
 #include <thread>
 
 #include "saloam/core/error.hpp"
@@ -15,6 +17,7 @@
 #include "saloam/sources/frame_queue.hpp"
 #include "saloam/sources/live_udp_source.hpp"
 #include "saloam/sources/open_source.hpp"
+#include "saloam/sources/udp_socket.hpp"
 #include "saloam/sources/velodyne_capture_writer.hpp"
 #include "testing/test_support.hpp"
 
@@ -41,6 +44,24 @@ TEST(UdpUrl, ReadsTheThreeFormsAndNamesAMalformedOne) {
 }
 
 QueuedFrame frame_at(double time) { return {SourceFrame{LabelledCloud{}, time}, std::chrono::steady_clock::now()}; }
+
+/// Whether this process may pass net.core.rmem_max (CAP_NET_ADMIN in /proc/self/status's CapEff).
+bool may_force_receive_buffer() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("CapEff:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> 12) & 1U;
+  }
+  return false;
+}
+
+TEST(UdpReceiver, GetsTheBufferAskedForWhereTheProcessMayPassTheKernelsCap) {
+  if (!may_force_receive_buffer()) GTEST_SKIP() << "no CAP_NET_ADMIN: the kernel caps the buffer at net.core.rmem_max";
+  // 64 MiB, past a default rmem_max (208 KiB; 4 MiB on the development machine); reported twice over.
+  const int asked = 64 << 20;
+  const UdpReceiver receiver(parse_udp_url("udp://127.0.0.1:0"), asked);
+  EXPECT_GE(receiver.buffer_bytes(), asked);
+}
 
 TEST(FrameQueue, DropsTheOldestWholeFrameWhenFullAndCountsIt) {
   FrameQueue queue(2);

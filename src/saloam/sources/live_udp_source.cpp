@@ -90,6 +90,13 @@ LiveUdpSource::LiveUdpSource(const std::string& url, const SourceOptions& option
   describe(std::move(notes));
   spdlog::info("listening on {} (receive buffer {:.1f} MiB, as the kernel reports it)", info_.name,
                receiver_.buffer_bytes() / 1048576.0);
+  if (receiver_.buffer_bytes() < options.live.receive_buffer_bytes) {
+    spdlog::warn("{}: the kernel granted a receive buffer of {:.1f} MiB, not the {:.0f} MiB asked (net.core.rmem_max "
+                 "caps it; raise it with `sysctl -w net.core.rmem_max={}`, or run as root): packets that arrive while "
+                 "the receiver is busy may be lost (frames then dropped as incomplete)",
+                 info_.name, receiver_.buffer_bytes() / 1048576.0, options.live.receive_buffer_bytes / 1048576.0,
+                 options.live.receive_buffer_bytes);
+  }
   thread_ = std::thread([this] { receive_loop(); });
 }
 
@@ -216,7 +223,7 @@ void LiveUdpSource::queue(std::vector<PacketFrame>& made) {
       }
       last_time_ = frame.time;
     }
-      intensity_.apply(frame.cloud);
+    intensity_.apply(frame.cloud);
     queue_.push({SourceFrame{std::move(frame.cloud), frame.time}, now});
   }
   made.clear();

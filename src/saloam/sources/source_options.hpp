@@ -51,7 +51,8 @@ struct LiveOptions {
   /// --queue: frames held for a run that falls behind; beyond, the oldest
   /// whole frame is dropped (and counted).
   std::size_t queue_frames = 4;
-  /// SO_RCVBUF asked for [bytes] (the kernel may grant less: said in the log).
+  /// The socket's receive buffer asked for [bytes]: past net.core.rmem_max where the process may (root); a warning
+  /// in the log when the kernel grants less.
   int receive_buffer_bytes = 64 << 20;
 };
 

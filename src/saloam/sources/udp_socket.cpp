@@ -74,9 +74,13 @@ UdpReceiver::UdpReceiver(const UdpAddress& address, int buffer_bytes) : bound_(a
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   if (fd_ < 0) throw InputError(address.url(), fmt::format("cannot open a UDP socket: {}", std::strerror(errno)));
   // Sensors send 10-20 frames a second in bursts of packets: a large buffer
-  // holds them while this reader is busy. The kernel caps the size at
-  // net.core.rmem_max (it reports twice what it keeps for its bookkeeping).
-  ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer_bytes, sizeof buffer_bytes);
+  // holds them while this reader is busy. The kernel caps SO_RCVBUF at
+  // net.core.rmem_max (208 KiB unless raised: an HDL-64E's 25 ms); with
+  // CAP_NET_ADMIN (root) SO_RCVBUFFORCE passes the cap. The kernel reports
+  // twice what it keeps, for its bookkeeping.
+  if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &buffer_bytes, sizeof buffer_bytes) != 0) {
+    ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer_bytes, sizeof buffer_bytes);
+  }
   socklen_t length = sizeof buffer_bytes_;
   ::getsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer_bytes_, &length);
   const sockaddr_in s = socket_address(address);

@@ -34,7 +34,8 @@ struct UdpAddress {
 
 class UdpReceiver {
  public:
-  /// Binds `address` and asks for a receive buffer of `buffer_bytes`;
+  /// Binds `address` and asks for a receive buffer of `buffer_bytes` (past
+  /// net.core.rmem_max where the process may: root);
   /// InputError naming the URL when the socket cannot be bound (the port in
   /// use, an address of no interface here, a port below 1024 without rights).
   UdpReceiver(const UdpAddress& address, int buffer_bytes);
@@ -50,7 +51,8 @@ class UdpReceiver {
 
   /// The address bound (the port the system chose for port 0).
   [[nodiscard]] const UdpAddress& address() const { return bound_; }
-  /// The receive buffer the kernel granted [bytes].
+  /// The receive buffer the kernel granted, as it reports it: twice what it
+  /// keeps for packets [bytes].
   [[nodiscard]] int buffer_bytes() const { return buffer_bytes_; }
 
  private:
