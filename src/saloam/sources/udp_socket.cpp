@@ -75,9 +75,9 @@ UdpReceiver::UdpReceiver(const UdpAddress& address, int buffer_bytes) : bound_(a
   if (fd_ < 0) throw InputError(address.url(), fmt::format("cannot open a UDP socket: {}", std::strerror(errno)));
   // Sensors send 10-20 frames a second in bursts of packets: a large buffer
   // holds them while this reader is busy. The kernel caps SO_RCVBUF at
-  // net.core.rmem_max (208 KiB unless raised: an HDL-64E's 25 ms); with
-  // CAP_NET_ADMIN (root) SO_RCVBUFFORCE passes the cap. The kernel reports
-  // twice what it keeps, for its bookkeeping.
+  // net.core.rmem_max (208 KiB unless raised: some 50 ms of an HDL-64E's
+  // packets); with CAP_NET_ADMIN (root) SO_RCVBUFFORCE passes the cap. The
+  // kernel reports twice what it keeps, for its bookkeeping.
   if (::setsockopt(fd_, SOL_SOCKET, SO_RCVBUFFORCE, &buffer_bytes, sizeof buffer_bytes) != 0) {
     ::setsockopt(fd_, SOL_SOCKET, SO_RCVBUF, &buffer_bytes, sizeof buffer_bytes);
   }
