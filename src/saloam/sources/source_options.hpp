@@ -51,8 +51,7 @@ struct LiveOptions {
   /// --queue: frames held for a run that falls behind; beyond, the oldest
   /// whole frame is dropped (and counted).
   std::size_t queue_frames = 4;
-  /// The socket's receive buffer asked for [bytes]: past net.core.rmem_max where the process may (root); a warning
-  /// in the log when the kernel grants less.
+  /// Receive buffer asked for [bytes], past net.core.rmem_max as root (the log warns when the kernel grants less).
   int receive_buffer_bytes = 64 << 20;
 };
 
