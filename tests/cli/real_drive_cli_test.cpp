@@ -53,7 +53,8 @@ fs::path unpack_kitti_folder(const fs::path& dir) {
   for (int i = 0; i < kScans; ++i) members += fmt::format(" velodyne/{:06d}.bin", i);
   EXPECT_EQ(run_command(fmt::format("tar -xJf {} -C {}{}", quoted(data), quoted(kitti), members)), 0);
   for (const char* name : {"poses.txt", "times.txt"}) {
-    std::ofstream(kitti / name) << first_lines(testing::shared_file(std::string("data/kitti_raw_0005/") + name), kScans);
+    const fs::path whole = testing::shared_file(std::string("data/kitti_raw_0005/") + name);
+    std::ofstream(kitti / name) << first_lines(whole, kScans);
   }
   fs::copy_file(testing::shared_file("data/kitti_raw_0005/calib.txt"), kitti / "calib.txt");
   return kitti;

@@ -199,7 +199,6 @@ TEST(LiveView, TheServerAnswersThePageItsStateItsMapAndItsScan) {
   const auto rebound = client.Get("/live.json", {{"Host", "attacker.example:" + std::to_string(port)}});
   ASSERT_TRUE(rebound);
   EXPECT_EQ(rebound->status, 403);
-
 }
 
 }  // namespace

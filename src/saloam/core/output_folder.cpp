@@ -225,7 +225,8 @@ void OutputFolder::append(const std::string& line) {
 }
 
 void record_output(const fs::path& file) {
-  const fs::path path = comparable_path(file.parent_path().empty() ? fs::path(".") : file.parent_path()) / file.filename();
+  const fs::path folder = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  const fs::path path = comparable_path(folder) / file.filename();
   const std::lock_guard lock(registry_mutex());
   OutputFolder* holder = nullptr;  // the innermost folder: a run inside another run's folder keeps its own record
   fs::path name;
