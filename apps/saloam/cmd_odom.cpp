@@ -44,6 +44,7 @@ int run_odom(const OdomOptions& options) {
   std::cout << fmt::format("{} frames, {} registration failures, {} degenerate frames, median {:.1f} ms/frame ({:.1f} Hz)\n",
                            result.frames, result.registration_failures, result.degenerate_frames, median_ms,
                            median_ms > 0 ? 1000.0 / median_ms : 0.0);
+  std::cout << result.gravity.describe() << "\n";
   std::cout << fmt::format("wrote {} ({})\n", out_dir.string(), fmt::join(result.files, ", "));
   if (live) live->run_ended(result.interrupted);
   if (result.interrupted) {

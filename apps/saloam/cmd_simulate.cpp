@@ -5,6 +5,8 @@
 // Velodyne packet capture.
 
 #include <cctype>
+#include <cmath>
+#include <sstream>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -41,7 +43,36 @@ struct SimulateArgs {
   bool no_dynamic = false;
   bool stats = false;
   std::vector<std::string> passes;  ///< --passes A:B[:reverse],...
+  std::vector<std::string> mount_rpy;        ///< --mount-rpy "R P Y" [deg]
+  std::vector<std::string> cloud_frame_rpy;  ///< --cloud-frame-rpy "R P Y" [deg]
 };
+
+/// Roll, pitch, yaw [deg] of an option given as three numbers, one word or
+/// three ("0 20 0" or 0 20 0).
+Eigen::Vector3d rpy_option(const std::vector<std::string>& words, const char* option) {
+  if (words.empty()) return Eigen::Vector3d::Zero();
+  std::string text;
+  for (const auto& w : words) text += w + " ";
+  std::istringstream in(text);
+  std::vector<double> values;
+  for (std::string number; in >> number;) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+      v = std::stod(number, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != number.size() || !std::isfinite(v) || std::abs(v) > 360.0) {
+      throw ConfigError(fmt::format("{} '{}': '{}' is no angle in [-360, 360] deg", option, text.substr(0, text.size() - 1), number));
+    }
+    values.push_back(v);
+  }
+  if (values.size() != 3) {
+    throw ConfigError(fmt::format("{} '{}': give three angles, roll pitch yaw [deg]", option, text.substr(0, text.size() - 1)));
+  }
+  return {values[0], values[1], values[2]};
+}
 
 // Tr from a KITTI calib.txt (`Tr:` line) or from the per-sequence list
 // (`NN: ...` lines), picking the sequence from the pose file's name (00.txt).
@@ -84,6 +115,8 @@ SimulationOptions simulation_options(const SimulateArgs& args) {
   }
   for (const auto& pass : args.passes) options.passes.push_back(parse_route_pass(pass));
   if (options.pass > 0 && options.passes.empty()) throw ConfigError("--pass needs --passes");
+  options.mount_rpy_deg = rpy_option(args.mount_rpy, "--mount-rpy");
+  options.cloud_frame_rpy_deg = rpy_option(args.cloud_frame_rpy, "--cloud-frame-rpy");
   options.skew = !args.no_skew;
   options.world.dynamic_objects = !args.no_dynamic;
   options.show_progress = spdlog::get_level() <= spdlog::level::info;
@@ -206,6 +239,14 @@ const CommandRegistration kRegistration{Command{
                      "Columns per turn (HDL-64E: about 2083; with --sensor the profile's)")
           ->check(CLI::Range(16, 8000))
           ->each([args](const std::string&) { args->azimuth_steps_given = true; });
+      app.add_option("--mount-rpy", args->mount_rpy,
+                     "The sensor tilted on the vehicle: roll pitch yaw [deg] (R_vehicle<-sensor, URDF rpy; \"0 20 0\": "
+                     "the front looks down 20 deg); scans in the sensor's frame, Tr in calib.txt to the level camera")
+          ->expected(1, 3);
+      app.add_option("--cloud-frame-rpy", args->cloud_frame_rpy,
+                     "The scans written in a frame turned against the sensor's: roll pitch yaw [deg] (R_cloud<-sensor), "
+                     "as a driver publishing in a robot's base link; Tr in calib.txt follows")
+          ->expected(1, 3);
       app.add_flag("--no-skew", args->no_skew, "Take each scan at one instant (no motion distortion)");
       app.add_flag("--no-dynamic", args->no_dynamic, "No moving cars or pedestrians");
       app.add_flag("--stats", args->stats,

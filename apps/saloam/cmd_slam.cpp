@@ -52,6 +52,7 @@ void print_summary(const SlamRunResult& r) {
                            r.median_frame_ms > 0 ? 1000.0 / r.median_frame_ms : 0.0, r.mean_loop_ms, r.peak_rss_mib);
   std::cout << fmt::format("odometry: {} registration failures, {} degenerate frames\n", r.registration_failures,
                            r.degenerate_frames);
+  std::cout << r.gravity.describe() << "\n";
   if (r.loop_summary) {
     const auto& s = *r.loop_summary;
     std::cout << fmt::format("loops vs ground truth ({}): {} true, {} false ({} reverse); revisit stretches {} "

@@ -240,6 +240,12 @@ void check_consistency(const SaloamConfig& config, const std::string& origin) {
                                   "[0, 'odometry.features.sweep_duration' = {}]",
                                   origin, number_text(f.pose_time_in_sweep), number_text(f.sweep_duration)));
   }
+  const std::size_t mount_values = config.odometry.gravity.mount_rpy_deg.size();
+  if (mount_values != 0 && mount_values != 3) {
+    throw ConfigError(fmt::format("{}: 'odometry.gravity.mount_rpy_deg' has {} values: give roll, pitch and yaw [deg] "
+                                  "(3 values), or [] for no mount",
+                                  origin, mount_values));
+  }
   const SscConfig& ssc = config.loop.ssc;
   if (!(ssc.inner_radius < ssc.outer_radius)) {
     throw ConfigError(fmt::format("{}: 'loop.ssc.inner_radius' = {} must be less than 'loop.ssc.outer_radius' = {}",

@@ -116,9 +116,33 @@ struct FeatureConfig {
   bool sweep_clockwise = true;
 };
 
+/// Which way is up: the direction of gravity in the sensor frame, which
+/// every rule meaning "horizontal" or "vertical" uses (the plane constraint,
+/// level lines, the ground below which no edges are taken, the place
+/// descriptors, the loop guesses). In order of trust: the mount given here,
+/// else estimated from the scans (the ground's normal, upright walls, poles
+/// and trunks over the first scans, refined as the run goes), else the
+/// sensor's z. The outputs' world frame stays the first scan's sensor frame.
+struct GravityConfig {
+  /// The sensor's orientation on the robot, R_base<-sensor as roll, pitch,
+  /// yaw [deg] (R = Rz(yaw) Ry(pitch) Rx(roll), the URDF / ROS convention), as
+  /// a `base_link` robot publishes it; the base's z is up. Empty: not given.
+  std::vector<double> mount_rpy_deg;
+  /// Without a mount: estimate up from the scans (true) or take the sensor's
+  /// z as up (false).
+  bool estimate = true;
+  /// Scans are looked at every this many frames to refine the estimate (or,
+  /// with a mount, to check it).
+  int refine_every_frames = 10;
+  /// [deg] A given mount whose up the scans contradict by more than this is
+  /// warned about (both directions named); the mount is still used.
+  double mount_warning_deg = 8.0;
+};
+
 /// Scan-to-local-map registration (paper Sec. III-B, Eq. 2).
 struct OdometryConfig {
   FeatureConfig features;
+  GravityConfig gravity;
   /// N_m: a map voxel that none of the last N_m frames observed leaves the
   /// map. Table I has 20 (config/paper.yaml); 40 frames, about 40 m of road,
   /// drift less with first points kept (measured in docs/odometry.md).
@@ -131,11 +155,12 @@ struct OdometryConfig {
   int planar_neighbours = 5;     ///< N_np: map points fitted to a plane per planar feature
   /// Tolerance of the semantic plane constraint (not a Table I parameter;
   /// Table I's sigma is the drift rate loop.sigma). A plane of a ground class
-  /// is kept only if |n . z| >= 1 - tolerance (normal near vertical), one of
-  /// building/fence only if |n . z| <= tolerance (normal near horizontal).
+  /// is kept only if |n . up| >= 1 - tolerance (normal near vertical), one of
+  /// building/fence only if |n . up| <= tolerance (normal near horizontal);
+  /// up is gravity's (odometry.gravity).
   double plane_normal_tolerance = 0.05;
   /// A map line (edge feature's fitted neighbours) whose unit direction d
-  /// rises less than this, |d . z| < level_line_max_rise, is a level line and
+  /// rises less than this, |d . up| < level_line_max_rise, is a level line and
   /// constrains the feature only across it horizontally (the vertical plane
   /// through it), not in height. A level line is mostly one ring's footprint
   /// seen by several frames, whose height moves with the sensor
@@ -421,14 +446,24 @@ void visit_fields(FeatureConfig& c, Visitor&& v) {
 }
 
 template <class Visitor>
+void visit_fields(GravityConfig& c, Visitor&& v) {
+  v("mount_rpy_deg", c.mount_rpy_deg, "[deg] R_base<-sensor as roll pitch yaw ([] = not given: estimate or assume)",
+    Range{-360, 360});
+  v("estimate", c.estimate, "without a mount, estimate up from the scans (false: the sensor's z is up)");
+  v("refine_every_frames", c.refine_every_frames, "scans looked at every this many frames to refine up", AtLeast{1});
+  v("mount_warning_deg", c.mount_warning_deg, "[deg] warn when the scans' up differs from the mount's by more",
+    Range{0, 180});
+}
+
+template <class Visitor>
 void visit_fields(OdometryConfig& c, Visitor&& v) {
   v("local_map_frames", c.local_map_frames, "N_m: frames in the local map", AtLeast{1});
   v("local_map_point", c.local_map_point, "point a map voxel keeps when observed again", OneOf{"first", "newest"});
   v("edge_neighbours", c.edge_neighbours, "N_ne: neighbours per edge feature", Range{2, kMaxFitNeighbours});
   v("planar_neighbours", c.planar_neighbours, "N_np: neighbours per planar feature", Range{3, kMaxFitNeighbours});
-  v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . z|", Range{0, 1});
+  v("plane_normal_tolerance", c.plane_normal_tolerance, "plane constraint: tolerance on |n . up|", Range{0, 1});
   v("level_line_max_rise", c.level_line_max_rise,
-    "map lines with |d . z| below this constrain only horizontally (0: off)", Range{0, 1});
+    "map lines with |d . up| below this constrain only horizontally (0: off)", Range{0, 1});
   v("use_semantics", c.use_semantics, "semantic assistance on/off");
   v("match_class_groups", c.match_class_groups, "match within class groups instead of single classes");
   v("deskew", c.deskew, "constant-velocity de-skewing");
@@ -532,6 +567,7 @@ template <class Visitor>
 void visit_sections(SaloamConfig& c, Visitor&& v) {
   v("odometry", c.odometry);
   v("odometry.features", c.odometry.features);
+  v("odometry.gravity", c.odometry.gravity);
   v("loop", c.loop);
   v("loop.ssc", c.loop.ssc);
   v("slam", c.slam);
@@ -543,6 +579,7 @@ void visit_sections(SaloamConfig& c, Visitor&& v) {
 /// its declared range (NaN never passes) or the first contradicting pair:
 /// odometry.features.min_range < max_range, loop.delta_min <= delta_max,
 /// odometry.features.pose_time_in_sweep <= sweep_duration,
+/// odometry.gravity.mount_rpy_deg has 3 values or none,
 /// loop.ssc.inner_radius < outer_radius.
 void validate_config(const SaloamConfig& config, std::string_view origin = "configuration");
 /// A configuration file may have at most this many bytes (config/saloam.yaml,

@@ -162,4 +162,15 @@ void pose_to_3x4(const Pose& T, double* v) {
   }
 }
 
+Eigen::Matrix3d rotation_from_rpy(double roll, double pitch, double yaw) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+Eigen::Matrix3d rotation_from_rpy_deg(const Eigen::Vector3d& rpy_deg) {
+  const Eigen::Vector3d r = rpy_deg * (M_PI / 180.0);
+  return rotation_from_rpy(r.x(), r.y(), r.z());
+}
+
 }  // namespace saloam

@@ -45,6 +45,12 @@ Pose interpolate(const Pose& a, const Pose& b, double s);
 /// Rotation angle of T in radians, in [0, pi].
 double rotation_angle(const Pose& T);
 
+/// R = Rz(yaw) Ry(pitch) Rx(roll) [rad]: the URDF / ROS `rpy` convention
+/// (roll about x, then pitch about y, then yaw about z, all fixed axes).
+Eigen::Matrix3d rotation_from_rpy(double roll, double pitch, double yaw);
+/// The same from [roll, pitch, yaw] in degrees.
+Eigen::Matrix3d rotation_from_rpy_deg(const Eigen::Vector3d& rpy_deg);
+
 /// Builds a pose from a row-major 3x4 [R | t] array (KITTI text layout).
 Pose pose_from_3x4(const double* values12);
 /// Writes the row-major 3x4 block of T into values12.

@@ -15,6 +15,7 @@
 #include "saloam/core/semantic_classes.hpp"
 #include "saloam/core/parallel.hpp"
 #include "saloam/scan/rings.hpp"
+#include "saloam/odometry/gravity.hpp"
 
 namespace saloam {
 
@@ -402,19 +403,21 @@ constexpr double kGroundEstimateRange = 20.0;
 /// Fewer of them measure nothing.
 constexpr std::size_t kMinGroundReturns = 20;
 
-/// The ground's height in the sensor frame [m]: the median z of the lowest
+/// The ground's height below the sensor [m], along up (`level` turns the
+/// sensor frame level: level * p has z up): the median height of the lowest
 /// ring's returns within kGroundEstimateRange (that ring looks down most
 /// steeply, so near the car it mostly hits the road), or nothing when too
 /// few are there.
-std::optional<double> ground_height(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& rings) {
+std::optional<double> ground_height(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& rings,
+                                    const Eigen::Matrix3f& level) {
   const std::vector<std::uint32_t>* lowest = nullptr;
   double lowest_slope = kInf;
   for (const auto& ring : rings) {
     if (ring.size() < kMinGroundReturns) continue;
-    double slope = 0.0;  // mean z / horizontal range, over a sample of the ring
+    double slope = 0.0;  // mean height / horizontal range, over a sample of the ring
     std::size_t n = 0;
     for (std::size_t k = 0; k < ring.size(); k += 8, ++n) {
-      const Eigen::Vector3f& p = cloud.points[ring[k]];
+      const Eigen::Vector3f p = level * cloud.points[ring[k]];
       slope += p.z() / std::max(1e-3f, p.head<2>().norm());
     }
     slope /= static_cast<double>(n);
@@ -426,7 +429,7 @@ std::optional<double> ground_height(const LabelledCloud& cloud, const std::vecto
   if (lowest == nullptr) return std::nullopt;
   std::vector<double> heights;
   for (const auto i : *lowest) {
-    const Eigen::Vector3f& p = cloud.points[i];
+    const Eigen::Vector3f p = level * cloud.points[i];
     if (p.head<2>().norm() < kGroundEstimateRange) heights.push_back(p.z());
   }
   if (heights.size() < kMinGroundReturns) return std::nullopt;
@@ -444,7 +447,10 @@ struct RingInputs {
   const FeatureConfig& config;
   const OdometryClassTable& class_table;
   bool use_labels;
-  std::optional<double> no_edges_below;  ///< [m] sensor-frame height, without labels
+  std::optional<double> no_edges_below;  ///< [m] height along up, without labels
+  /// The sensor frame turned level (level * p has z up), when up is not the
+  /// sensor's z: heights and a thin object's axis are taken along up.
+  std::optional<Eigen::Matrix3d> level;
 };
 
 /// With labels: points of classes odometry does not use are made unreliable
@@ -471,8 +477,8 @@ PointMask apply_labels(const RingInputs& in, const std::vector<std::uint32_t>& r
 /// The selected ring points `indices` into `target` with class and sweep
 /// time; an edge of a thin round object stands for its axis (ThinObjectAxis).
 void emit_features(const RingInputs& in, const std::vector<std::uint32_t>& ring,
-                   const std::vector<Eigen::Vector3d>& ring_points, const std::vector<int>& indices, bool edges,
-                   FeatureCloud& target) {
+                   const std::vector<Eigen::Vector3d>& ring_points, const std::vector<Eigen::Vector3d>& level_points,
+                   const std::vector<int>& indices, bool edges, FeatureCloud& target) {
   const bool axes = in.use_labels && in.config.thin_object_axes;
   for (const int k : indices) {
     const std::uint32_t i = ring[k];
@@ -482,10 +488,12 @@ void emit_features(const RingInputs& in, const std::vector<std::uint32_t>& ring,
       if (c < 0) continue;
     }
     if (edges && axes && is_thin_round(static_class(in.cloud.label[i]))) {
-      const auto axis = thin_object_axis(ring_points, k, in.config.thin_object_max_radius);
+      // Poles and trunks stand upright: the axis is found in the level frame.
+      const auto axis = thin_object_axis(level_points, k, in.config.thin_object_max_radius);
       if (!axis) continue;
       const std::uint32_t central = ring[static_cast<std::size_t>(axis->central)];
-      target.push_back(axis->point, static_cast<ClassIndex>(c), in.sweep_times[central]);
+      const Eigen::Vector3d point = in.level ? Eigen::Vector3d(in.level->transpose() * axis->point) : axis->point;
+      target.push_back(point, static_cast<ClassIndex>(c), in.sweep_times[central]);
       continue;
     }
     target.push_back(ring_points[k], static_cast<ClassIndex>(c), in.sweep_times[i]);
@@ -501,16 +509,23 @@ ScanFeatures ring_features(const RingInputs& in, const std::vector<std::uint32_t
   const auto gap_sq = squared_gaps(ring_points);
   auto unreliable =
       unreliable_points(ring_points, gap_sq, config.roughness_half_window, config.min_range, config.max_range);
+  // The ring turned level where up is not the sensor's z (heights, axes).
+  std::vector<Eigen::Vector3d> turned;
+  if (in.level) {
+    turned.resize(ring_points.size());
+    for (std::size_t k = 0; k < ring_points.size(); ++k) turned[k] = *in.level * ring_points[k];
+  }
+  const std::vector<Eigen::Vector3d>& level_points = in.level ? turned : ring_points;
   PointMask not_edge;
   if (in.use_labels) not_edge = apply_labels(in, ring, roughness, unreliable);
   if (in.no_edges_below) {
     not_edge.assign(ring.size(), 0);
-    for (std::size_t k = 0; k < ring.size(); ++k) not_edge[k] = ring_points[k].z() < *in.no_edges_below;
+    for (std::size_t k = 0; k < ring.size(); ++k) not_edge[k] = level_points[k].z() < *in.no_edges_below;
   }
   const auto selection = select_ring_features(gap_sq, roughness, unreliable, config, not_edge);
   ScanFeatures out;
-  emit_features(in, ring, ring_points, selection.edges, true, out.edges);
-  emit_features(in, ring, ring_points, selection.planars, false, out.planars);
+  emit_features(in, ring, ring_points, level_points, selection.edges, true, out.edges);
+  emit_features(in, ring, ring_points, level_points, selection.planars, false, out.planars);
   return out;
 }
 
@@ -522,7 +537,7 @@ void append(FeatureCloud& to, const FeatureCloud& from) {
 }  // namespace
 
 ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
-                              bool parallel) {
+                              bool parallel, const Eigen::Vector3d& up) {
   // Rings (point indices in azimuth order) from the point order when the scan
   // is stored ring by ring (exact even for scans whose points were moved by
   // motion compensation), else from the elevation angle.
@@ -530,10 +545,16 @@ ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& c
   const std::vector<std::vector<std::uint32_t>> rings = rings_from_times(cloud, times, config);
   // De-skewing takes the points' own times when the scan has them
   // (relative to the scan's timestamp), else the sweep model's.
-  RingInputs inputs{cloud, cloud.has_times() ? cloud.time : times, config, odometry_class_table(), use_labels, {}};
+  RingInputs inputs{cloud, cloud.has_times() ? cloud.time : times, config, odometry_class_table(), use_labels, {}, {}};
+  // Heights are along up (odometry/gravity.hpp): the sensor's z only when it points up.
+  const Eigen::Vector3d unit_up = up.normalized();
+  if (!points_up(unit_up)) inputs.level = level_rotation(unit_up);
   // Without labels, the ground is what lies near the lowest ring's height.
   if (!use_labels && config.unlabelled_ground_margin > 0.0) {
-    if (const auto ground = ground_height(cloud, rings)) inputs.no_edges_below = *ground + config.unlabelled_ground_margin;
+    const Eigen::Matrix3f level = inputs.level ? Eigen::Matrix3f(inputs.level->cast<float>()) : Eigen::Matrix3f::Identity();
+    if (const auto ground = ground_height(cloud, rings, level)) {
+      inputs.no_edges_below = *ground + config.unlabelled_ground_margin;
+    }
   }
   // Rings are independent: with `parallel`, one task per ring; the results
   // are concatenated in ring order so the output does not depend on threads.

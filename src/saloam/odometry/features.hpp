@@ -133,10 +133,12 @@ ClassIndex class_group(ClassIndex c);
 /// unlabeled points are dropped from the features (after the roughness, which
 /// is pure geometry: removing them first would create false edges).
 /// With `parallel`, rings are processed as TBB tasks (same result).
+/// `up` (sensor frame, odometry/gravity.hpp) is what heights are measured
+/// along: the ground below which no edges are taken, a pole's axis.
+ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
+                              bool parallel = false, const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
+
 /// The cloud with every point mapped by T (classes and sweep times kept).
 FeatureCloud transformed(const FeatureCloud& cloud, const Pose& T);
-
-ScanFeatures extract_features(const LabelledCloud& cloud, const FeatureConfig& config, bool use_labels,
-                              bool parallel = false);
 
 }  // namespace saloam

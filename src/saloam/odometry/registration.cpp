@@ -156,9 +156,9 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
     const Eigen::Vector3d q = T * edges.points[i];
     if (gather(map.edges(), q, edges.classes[i], ne, settings.max_correspondence_distance, nb)) {
       if (auto line = fit_line(std::span<const Eigen::Vector3d>(nb.data(), ne))) {
-        // d x z is horizontal and across d; it vanishes only for an upright line.
-        if (std::abs(line->direction.z()) < settings.level_line_max_rise) {
-          m.fit = PointToPlane{Plane{line->point, line->direction.cross(Eigen::Vector3d::UnitZ()).normalized()}};
+        // d x up is horizontal and across d; it vanishes only for an upright line.
+        if (std::abs(line->direction.dot(settings.up)) < settings.level_line_max_rise) {
+          m.fit = PointToPlane{Plane{line->point, line->direction.cross(settings.up).normalized()}};
         } else {
           m.fit = PointToLine{*line};
         }
@@ -173,7 +173,8 @@ void associate(const FeatureCloud& edges, const FeatureCloud& planars, const Sem
     const ClassIndex c = planars.classes[i];
     if (gather(map.planars(), q, c, np, settings.max_correspondence_distance, nb)) {
       if (auto plane = fit_plane(std::span<const Eigen::Vector3d>(nb.data(), np))) {
-        if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.plane_normal_tolerance)) {
+        if (plane_satisfies_constraint(plane->normal, settings.orientation[c], settings.plane_normal_tolerance,
+                                       settings.up)) {
           m.fit = PointToPlane{*plane};
         } else {
           m.rejected_by_constraint = true;

@@ -40,11 +40,14 @@ struct RegistrationSettings {
   /// An outer round that moved the pose less than this ends the re-association.
   double reassociation_min_translation{};  ///< [m] (0: always all rounds)
   double reassociation_min_rotation{};     ///< [rad]
-  double plane_normal_tolerance{};         ///< plane constraint: tolerance on |n . z|
-  /// A fitted line with |direction . z| below this is matched as the vertical
+  double plane_normal_tolerance{};         ///< plane constraint: tolerance on |n . up|
+  /// A fitted line with |direction . up| below this is matched as the vertical
   /// plane through it (a 1-D residual across it, horizontal); 0: every line
   /// is a line (OdometryConfig::level_line_max_rise).
   double level_line_max_rise{};
+  /// Up in the map's frame (unit; odometry/gravity.hpp): what "vertical" and
+  /// "horizontal" mean to the plane constraint and the level lines.
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   std::array<double, kNumClassIndices> class_weight{};          ///< w^l
   std::array<PlaneOrientation, kNumClassIndices> orientation{};  ///< plane constraint per class
   bool parallel{};  ///< associate and sum the normal equations with TBB (inside the caller's task arena); same result

@@ -63,8 +63,9 @@ PlaneOrientation plane_orientation(std::uint16_t raw_class) {
   return PlaneOrientation::kAny;
 }
 
-bool plane_satisfies_constraint(const Eigen::Vector3d& normal, PlaneOrientation orientation, double sigma) {
-  const double up = std::abs(normal.z());
+bool plane_satisfies_constraint(const Eigen::Vector3d& normal, PlaneOrientation orientation, double sigma,
+                                const Eigen::Vector3d& up_direction) {
+  const double up = std::abs(normal.dot(up_direction));
   switch (orientation) {
     case PlaneOrientation::kHorizontal: return up >= 1.0 - sigma;
     case PlaneOrientation::kVertical: return up <= sigma;

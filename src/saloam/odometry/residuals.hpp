@@ -50,9 +50,11 @@ enum class PlaneOrientation { kAny, kHorizontal /* ground: normal near vertical 
 /// normal, building and fence a near-horizontal one, others anything.
 PlaneOrientation plane_orientation(std::uint16_t raw_class);
 
-/// The plane constraint with tolerance sigma on |n . up| (up = world z):
-/// horizontal planes need |n_z| >= 1 - sigma, vertical ones |n_z| <= sigma.
-bool plane_satisfies_constraint(const Eigen::Vector3d& normal, PlaneOrientation orientation, double sigma);
+/// The plane constraint with tolerance sigma on |n . up| (up: the unit
+/// direction against gravity in the map's frame, odometry/gravity.hpp):
+/// horizontal planes need |n . up| >= 1 - sigma, vertical ones |n . up| <= sigma.
+bool plane_satisfies_constraint(const Eigen::Vector3d& normal, PlaneOrientation orientation, double sigma,
+                                const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ());
 
 /// Point-to-plane residual n . (T p - c) and its 1x6 Jacobian w.r.t. delta.
 double point_to_plane_residual(const Pose& T, const Eigen::Vector3d& p, const Plane& plane,

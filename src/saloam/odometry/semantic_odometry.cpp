@@ -29,7 +29,8 @@ SemanticOdometry::SemanticOdometry(OdometryConfig config)
       settings_(RegistrationSettings::from_config(config_)),
       voxel_sizes_(class_voxel_sizes(config_)),
       map_(SemanticLocalMap::from_config(config_)),
-      start_up_(std::in_place, config_, voxel_sizes_) {
+      start_up_(std::in_place, config_, voxel_sizes_),
+      gravity_(config_.gravity) {
   configured_weights_ = settings_.class_weight;
   if (config_.threads != 1) {
     const int threads = config_.threads > 0 ? config_.threads
@@ -48,24 +49,27 @@ Pose SemanticOdometry::register_frame(const LabelledCloud& cloud, double timesta
 
 Pose SemanticOdometry::process(const LabelledCloud& cloud, double timestamp) {
   StageTimer timer;
-  ScanFeatures measured = extract_frame_features(cloud);
-  const StageTime features_time = timer.lap();
+  if (!gravity_.started()) gravity_.start(cloud, uses_labels(cloud));
+  settings_.up = gravity_.up();
   const MotionPrediction prediction = predict_motion(timestamp);
+  ScanFeatures measured = extract_frame_features(cloud, prediction.pose.linear().transpose() * gravity_.up());
+  const StageTime features_time = timer.lap();
   ScanFeatures features = downsample_and_deskew(measured, prediction);
   const StageTime deskew_time = timer.lap();
   const Pose sweep_pose = register_to_map(features, measured, prediction);
   if (config_.adaptive_class_weights && config_.use_semantics) update_class_weights(last_stats_.registration);
   const StageTime registration_time = timer.lap();
   update_map(features, sweep_pose);
+  if (!sweep_poses_.empty()) gravity_.observe(cloud, uses_labels(cloud), sweep_pose.linear(), sweep_poses_.size());
   const StageTime map_time = timer.lap();
   return record_frame(std::move(features), sweep_pose, timestamp,
                       {features_time.wall_ms, deskew_time.wall_ms, registration_time.wall_ms, map_time.wall_ms},
                       {features_time.cpu_ms, deskew_time.cpu_ms, registration_time.cpu_ms, map_time.cpu_ms});
 }
 
-ScanFeatures SemanticOdometry::extract_frame_features(const LabelledCloud& cloud) const {
-  const bool use_labels = config_.use_semantics && cloud.has_labels;
-  ScanFeatures features = extract_features(cloud, config_.features, use_labels, settings_.parallel);
+ScanFeatures SemanticOdometry::extract_frame_features(const LabelledCloud& cloud, const Eigen::Vector3d& up) const {
+  const bool use_labels = uses_labels(cloud);
+  ScanFeatures features = extract_features(cloud, config_.features, use_labels, settings_.parallel, up);
   if (use_labels && config_.match_class_groups) {
     for (auto& c : features.edges.classes) c = class_group(c);
     for (auto& c : features.planars.classes) c = class_group(c);
@@ -147,6 +151,16 @@ FeatureRefresh SemanticOdometry::deskew_refresh(const ScanFeatures& measured, co
     scan = deskewed(measured, deskew_motion, period, mid);
     return true;
   };
+}
+
+Eigen::Vector3d SemanticOdometry::up() const { return world_from_first_sweep_.linear() * gravity_.up(); }
+
+GravityReport SemanticOdometry::gravity() const {
+  GravityReport report = gravity_.report();
+  const Eigen::Matrix3d to_world = world_from_first_sweep_.linear();
+  report.up = to_world * report.up;
+  if (report.scans_up) report.scans_up = to_world * *report.scans_up;
+  return report;
 }
 
 void SemanticOdometry::update_map(const ScanFeatures& features, const Pose& sweep_pose) {

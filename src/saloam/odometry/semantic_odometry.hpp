@@ -1,10 +1,12 @@
 #pragma once
 // The semantic-assisted odometry (paper Sec. III-B). Per frame, a few named
-// steps: extract LOAM features with their classes; predict the motion
-// (constant velocity); downsample per class and de-skew; register to the
-// local map (semantic ICP, de-skewing again as the estimate moves); add the
-// frame to the local map; report the pose at the scan's pose instant. The
-// first two frames, before a motion is known, are the start-up's (start_up.hpp).
+// steps: predict the motion (constant velocity); extract LOAM features with
+// their classes, heights along up; downsample per class and de-skew;
+// register to the local map (semantic ICP, de-skewing again as the estimate
+// moves); add the frame to the local map; report the pose at the scan's pose
+// instant; let the scan refine up. The first two frames, before a motion is
+// known, are the start-up's (start_up.hpp); up is set at the first frame
+// (gravity.hpp).
 // The SLAM system feeds it frames and reads its poses and features.
 
 #include <memory>
@@ -17,6 +19,7 @@
 #include "saloam/core/lie.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/odometry/features.hpp"
+#include "saloam/odometry/gravity.hpp"
 #include "saloam/odometry/local_map.hpp"
 #include "saloam/odometry/registration.hpp"
 #include "saloam/odometry/start_up.hpp"
@@ -72,6 +75,10 @@ class SemanticOdometry {
   /// the group's index): the configured weights, scaled when
   /// adaptive_class_weights is on.
   [[nodiscard]] const std::array<double, kNumClassIndices>& class_weights() const { return settings_.class_weight; }
+  /// Up in the world frame (the first scan's sensor frame at its pose
+  /// instant; the sensor's z before the first frame), and where it came from.
+  [[nodiscard]] Eigen::Vector3d up() const;
+  [[nodiscard]] GravityReport gravity() const;
 
  private:
   /// Constant-velocity prediction of the next mid-sweep pose.
@@ -83,7 +90,9 @@ class SemanticOdometry {
   };
 
   Pose process(const LabelledCloud& cloud, double timestamp);
-  ScanFeatures extract_frame_features(const LabelledCloud& cloud) const;
+  /// Features with heights along `up` (sensor frame).
+  ScanFeatures extract_frame_features(const LabelledCloud& cloud, const Eigen::Vector3d& up) const;
+  [[nodiscard]] bool uses_labels(const LabelledCloud& cloud) const { return config_.use_semantics && cloud.has_labels; }
   MotionPrediction predict_motion(double timestamp) const;
   /// Downsamples `measured` in place and returns it de-skewed with the predicted motion.
   ScanFeatures downsample_and_deskew(ScanFeatures& measured, const MotionPrediction& prediction) const;
@@ -117,6 +126,9 @@ class SemanticOdometry {
   FrameStats last_stats_;
   ScanFeatures last_features_;
   std::optional<StartUp> start_up_;  ///< frames 0 and 1
+  /// Up in the internal world (the first scan's mid-sweep frame, where
+  /// sweep_poses_ live); up() turns it into the reported world.
+  GravityTracker gravity_;
 };
 
 }  // namespace saloam

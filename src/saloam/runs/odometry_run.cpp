@@ -100,12 +100,23 @@ nlohmann::json odometry_summary(const SourceInfo& info, const OdometryConfig& co
                          {"semantics", config.use_semantics && info.has_labels},
                          {"camera_frame", result.camera_frame},
                          {"registration_failures", result.registration_failures},
-                         {"degenerate_frames", result.degenerate_frames}};
+                         {"degenerate_frames", result.degenerate_frames},
+                         {"gravity", gravity_json(result.gravity)}};
   if (info.folder) put_summary_path(summary, "sequence", std::filesystem::absolute(*info.folder).lexically_normal());
   return summary;
 }
 
 }  // namespace
+
+nlohmann::json gravity_json(const GravityReport& g) {
+  nlohmann::json out{{"up", {g.up.x(), g.up.y(), g.up.z()}},
+                     {"source", g.source == UpSource::kMount ? "mount" : g.source == UpSource::kScans ? "scans" : "sensor_z"},
+                     {"tilt_deg", g.tilt_deg()},
+                     {"votes", g.votes},
+                     {"spread_deg", g.spread_deg}};
+  if (g.scans_up) out["scans_up_off_deg"] = angle_deg(*g.scans_up, g.up);
+  return out;
+}
 
 OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config, const std::filesystem::path& out_dir,
                                const OdometryRunOptions& options) {
@@ -135,6 +146,7 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
   run.commit();
   OdometryRunResult result = run.result();
   result.timings = run.odometry().timings();
+  result.gravity = run.odometry().gravity();
   result.interrupted = stop_requested();
   write_timing_json(out_dir / "timing.json", result.timings, source.stage_times());
   nlohmann::json summary = odometry_summary(info, config, result);

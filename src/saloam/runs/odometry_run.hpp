@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "saloam/core/config.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/io/frame_source.hpp"
@@ -32,6 +34,9 @@ struct OdometryRunOptions {
   /// Called with every frame after the odometry has registered it (e.g. the live viewer).
   FrameFollower follow;
 };
+
+/// What summary.json says of up ("gravity": up, source, tilt, votes, spread).
+nlohmann::json gravity_json(const GravityReport& gravity);
 
 /// How the frames' registrations went: failures (too few correspondences:
 /// the frame kept the prediction) and degenerate frames (some directions
@@ -59,6 +64,7 @@ struct OdometryRunResult {
   std::size_t frames = 0;
   std::size_t registration_failures = 0;
   std::size_t degenerate_frames = 0;  ///< RegistrationHealth
+  GravityReport gravity;             ///< which way was up, and from what
   bool camera_frame = false;         ///< poses.txt uses the camera convention
   bool interrupted = false;
   std::vector<std::string> files;    ///< written into the output folder, in order

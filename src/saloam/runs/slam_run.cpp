@@ -227,7 +227,8 @@ nlohmann::json evaluate_run(const SlamSystem& slam, const SaloamConfig& config, 
                          {"loops_verified", result.loops_verified},
                          {"loops_accepted", result.loops_accepted},
                          {"registration_failures", result.registration_failures},
-                         {"degenerate_frames", result.degenerate_frames}};
+                         {"degenerate_frames", result.degenerate_frames},
+                         {"gravity", gravity_json(result.gravity)}};
   if (truth.camera && result.frames >= 2) {
     result.odometry_evaluation = evaluate_trajectories(*truth.camera, odometry_out);
     result.slam_evaluation = evaluate_trajectories(*truth.camera, slam_out);
@@ -277,6 +278,7 @@ SlamRunResult summarize_run(const SlamSystem& slam, double seconds) {
   result.loops_accepted = slam.accepted_loops();
   result.loops_verified = slam.loops().size();
   result.peak_rss_mib = peak_rss_mib();
+  result.gravity = slam.odometry().gravity();
   result.median_frame_ms = summarize(column(slam.timings(), &SlamFrameTimings::total_ms)).median;
   result.mean_loop_ms = summarize(column(slam.timings(), &SlamFrameTimings::loop_ms)).mean;
   return result;

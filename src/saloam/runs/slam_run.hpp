@@ -62,6 +62,7 @@ struct SlamRunResult {
   std::size_t loops_verified = 0;
   std::size_t registration_failures = 0;  ///< odometry frames that kept the prediction (RegistrationHealth)
   std::size_t degenerate_frames = 0;      ///< odometry frames with unconstrained directions (RegistrationHealth)
+  GravityReport gravity;                  ///< which way was up, and from what
   bool interrupted = false;
   std::vector<std::string> files;    ///< written into the output folder, in order (summary.json last)
   double seconds = 0;                ///< wall time of the frame loop

@@ -83,7 +83,7 @@ std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const Li
   return out;
 }
 
-SweepRays::SweepRays(const LidarModel& lidar) : columns(lidar.azimuth_steps) {
+SweepRays::SweepRays(const LidarModel& lidar, const Eigen::Matrix3d& mount) : columns(lidar.azimuth_steps) {
   const int beams = lidar.beams();
   if (columns <= 0 || beams <= 0) throw ConfigError("lidar model needs beams and azimuth steps");
   for (int b = 0; b < beams; ++b) {
@@ -100,7 +100,7 @@ SweepRays::SweepRays(const LidarModel& lidar) : columns(lidar.azimuth_steps) {
   for (int b = 0; b < beams && !lidar.ego_body.empty(); ++b) {
     for (int c = 0; c < columns; ++c) {
       blocked[static_cast<std::size_t>(b) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)] =
-          lidar.hits_ego_body(direction(b, c)) ? 1 : 0;
+          lidar.hits_ego_body(mount * direction(b, c)) ? 1 : 0;
     }
   }
 }
@@ -120,19 +120,28 @@ struct CellReturn {
   bool valid = false;
 };
 
-/// The moving objects `agents` near a column's vertical plane: not behind the
-/// sensor at `origin` looking along `heading`, and within their footprint
-/// radius of the plane.
+/// [m] How far above or below the sensor a moving object's parts reach at most.
+constexpr double kAgentVerticalReach = 6.0;
+
+/// The moving objects `agents` near the plane of a column's rays (the plane
+/// through the sensor at `origin` with unit normal `normal`, which is
+/// vertical for a level sensor): not behind the sensor looking along
+/// `heading`, and within their footprint radius of the plane (widened by
+/// how far a tilted plane leans over their height).
 void agents_near_plane(const std::vector<Primitive>& agents, const Eigen::Vector2d& origin,
-                       const Eigen::Vector3d& heading, std::vector<Primitive>& near) {
+                       const Eigen::Vector3d& heading, const Eigen::Vector3d& normal, std::vector<Primitive>& near) {
   Eigen::Vector2d h2 = heading.head<2>();
   if (h2.norm() > 1e-9) h2.normalize();
+  const double level = normal.head<2>().norm();
+  const Eigen::Vector2d n2 = level > 1e-9 ? Eigen::Vector2d(normal.head<2>() / level) : Eigen::Vector2d::Zero();
+  const double lean = level > 1e-9 ? std::abs(normal.z()) / level * kAgentVerticalReach
+                                   : std::numeric_limits<double>::infinity();
   near.clear();
   for (const auto& p : agents) {
     const Eigen::Vector2d rel = p.center.cast<double>() - origin;
-    const double along = rel.dot(h2), across = std::abs(rel.x() * h2.y() - rel.y() * h2.x());
+    const double along = rel.dot(h2), across = std::abs(rel.dot(n2));
     const double radius = p.footprint_radius();
-    if (along > -radius && across < radius + 0.05) near.push_back(p);
+    if (along > -radius - lean && across < radius + 0.05 + lean) near.push_back(p);
   }
 }
 
@@ -200,7 +209,8 @@ float render_column(const World& world, const LidarModel& lidar, const SweepRays
   const Eigen::Vector3d& origin = rays_from.position;
   // Moving objects at this column's time, kept only near the column's vertical plane.
   world.agents_at(t, origin.head<2>(), lidar.max_range + 10.0, agents);
-  agents_near_plane(agents, origin.head<2>(), sensor.linear() * Eigen::Vector3d(cos_az, sin_az, 0.0), near);
+  agents_near_plane(agents, origin.head<2>(), sensor.linear() * Eigen::Vector3d(cos_az, sin_az, 0.0),
+                    sensor.linear() * Eigen::Vector3d(-sin_az, cos_az, 0.0), near);
   Rng rng(hash3(sweep.seed, 0x5ca7ull, static_cast<std::uint64_t>(c)));
   for (int b = 0; b < grid.beams(); ++b) {
     CellReturn& out = grid.at(b, c);

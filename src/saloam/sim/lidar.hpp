@@ -100,7 +100,9 @@ std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const Li
 /// beam elevations, column azimuths and the rays that the car's own body
 /// stops. Computed once per LiDAR instead of once per scan.
 struct SweepRays {
-  explicit SweepRays(const LidarModel& lidar);
+  /// `mount`: the sensor's orientation on the vehicle (R_vehicle<-sensor),
+  /// which turns the rays against the car body the lidar model holds.
+  explicit SweepRays(const LidarModel& lidar, const Eigen::Matrix3d& mount = Eigen::Matrix3d::Identity());
   std::vector<double> sin_el, cos_el;  ///< per beam
   std::vector<double> cos_az, sin_az;  ///< per column (LidarModel::column_azimuth)
   std::vector<std::uint8_t> blocked;   ///< beam-major, beams x columns: 1 = the ego body stops the ray

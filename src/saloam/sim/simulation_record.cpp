@@ -40,6 +40,11 @@ std::string simulation_record(const SimulationOptions& o) {
                       o.first_frame, end, o.stride, o.seed, o.beams, o.azimuth_steps);
   text += fmt::format("labels: {}\nskew: {}\ndynamic_objects: {}\n", o.labels == LabelMode::kNoisy ? "noisy" : "gt",
                       o.skew, o.world.dynamic_objects);
+  // A tilted sensor or turned scans only (records of level ones stay as they were).
+  if (!o.mount_rpy_deg.isZero()) text += fmt::format("mount_rpy_deg: {:.6g}\n", fmt::join(o.mount_rpy_deg, " "));
+  if (!o.cloud_frame_rpy_deg.isZero()) {
+    text += fmt::format("cloud_frame_rpy_deg: {:.6g}\n", fmt::join(o.cloud_frame_rpy_deg, " "));
+  }
   if (!o.passes.empty()) {
     // Passes of one world: the pass drawn and where its first frame lies in
     // the world (T_world<-L0, 3x4 row-major), so that two passes' poses

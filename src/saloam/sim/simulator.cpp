@@ -205,10 +205,18 @@ SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
     : options_(options),
       trajectory_(source_lidar_trajectory(options)),
       frames_(selected_frames(options, trajectory_.size())),
+      mount_(rotation_from_rpy_deg(options.mount_rpy_deg)),
+      cloud_frame_(rotation_from_rpy_deg(options.cloud_frame_rpy_deg)),
       lidar_(lidar_for(options)),
-      rays_(lidar_),
+      rays_(lidar_, mount_),
       world_(world_for(trajectory_, options)),
-      velo_to_cam_(output_velo_to_cam(options)) {
+      // The scans' frame to the camera: camera <- vehicle's lidar <- sensor <- scans.
+      velo_to_cam_(orthonormalized(output_velo_to_cam(options) * Pose(mount_ * cloud_frame_.transpose()))) {
+  if (!options.mount_rpy_deg.allFinite() || !options.cloud_frame_rpy_deg.allFinite()) {
+    throw ConfigError("the mount's and the cloud frame's roll, pitch and yaw must be finite numbers [deg]");
+  }
+  // poses.txt is the vehicle's camera, whatever the sensor's tilt.
+  const Pose vehicle_to_cam = output_velo_to_cam(options);
   // Re-based so that the first selected frame is the origin.
   const Pose base_inv = trajectory_[frames_.front()].inverse();
   std::vector<Pose> lidar_out, sensor_out;
@@ -221,12 +229,20 @@ SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
     sensor_out.push_back(orthonormalized(base_inv * sensor));
     times_.push_back(static_cast<double>(i - frames_.front()) * options.frame_period);
   }
-  camera_poses_ = lidar_to_camera_poses(lidar_out, velo_to_cam_);
-  sensor_camera_poses_ = lidar_to_camera_poses(sensor_out, velo_to_cam_);
+  camera_poses_ = lidar_to_camera_poses(lidar_out, vehicle_to_cam);
+  sensor_camera_poses_ = lidar_to_camera_poses(sensor_out, vehicle_to_cam);
+}
+
+Eigen::Vector3d SimulatedSequence::first_scan_up() const {
+  // The vehicle's lidar frame at the first frame in the route's world (z up).
+  const Eigen::Matrix3d world_from_scan = trajectory_[frames_.front()].linear() * mount_ * cloud_frame_.transpose();
+  return world_from_scan.transpose() * Eigen::Vector3d::UnitZ();
 }
 
 SimulatedFrame SimulatedSequence::render(std::size_t k) const {
-  const SweepSpec sweep = sweep_for_frame(trajectory_, frames_.at(k), options_);
+  SweepSpec sweep = sweep_for_frame(trajectory_, frames_.at(k), options_);
+  sweep.start = sweep.start * Pose(mount_);
+  sweep.end = sweep.end * Pose(mount_);
   SimulatedScan scan = simulate_scan(world_, lidar_, rays_, sweep);
   if (scan.cloud.size() == 0) {
     const Eigen::Vector3d p = sweep.start.translation();
@@ -243,6 +259,10 @@ SimulatedFrame SimulatedSequence::render(std::size_t k) const {
     std::fill(scan.cloud.instance.begin(), scan.cloud.instance.end(), 0);
   }
   frame.cloud = std::move(scan.cloud);
+  if (!cloud_frame_.isIdentity()) {
+    const Eigen::Matrix3f R = cloud_frame_.cast<float>();
+    for (Eigen::Vector3f& p : frame.cloud.points) p = R * p;
+  }
   return frame;
 }
 

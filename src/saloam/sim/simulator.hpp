@@ -77,6 +77,16 @@ struct SimulationOptions {
   /// Firing positions per turn (the CLI takes a profile's
   /// simulation.azimuth_steps unless --azimuth-steps is given).
   int azimuth_steps = 2083;
+  /// The sensor's tilt on the vehicle, R_vehicle<-sensor as roll, pitch, yaw
+  /// [deg] (URDF rpy; pitch 20: the front looks down 20 deg): its rays and
+  /// the car body it sees turn with it. The scans are in its own frame;
+  /// calib.txt's Tr maps them to the (level) camera, poses.txt is the
+  /// vehicle's motion as without a tilt.
+  Eigen::Vector3d mount_rpy_deg = Eigen::Vector3d::Zero();
+  /// The frame the scans are written in, R_cloud<-sensor as roll, pitch, yaw
+  /// [deg]: the same scans handed over in a turned frame (as a driver that
+  /// publishes in a robot's base link). Only the points turn; Tr follows.
+  Eigen::Vector3d cloud_frame_rpy_deg = Eigen::Vector3d::Zero();
   bool skew = true;
   bool show_progress = true;
   double frame_period = 0.1;
@@ -153,11 +163,15 @@ class SimulatedSequence {
   [[nodiscard]] const Pose& origin() const { return trajectory_[frames_.front()]; }
   /// Where each sweep really started (poses_sensor.txt's content, camera frame).
   [[nodiscard]] const std::vector<Pose>& sensor_camera_poses() const { return sensor_camera_poses_; }
+  /// Up in the written scans' frame at the first frame (against gravity).
+  [[nodiscard]] Eigen::Vector3d first_scan_up() const;
 
  private:
   SimulationOptions options_;
   std::vector<Pose> trajectory_;  ///< source trajectory, LiDAR frame
   std::vector<std::size_t> frames_;
+  Eigen::Matrix3d mount_;        ///< R_vehicle<-sensor
+  Eigen::Matrix3d cloud_frame_;  ///< R_cloud<-sensor
   LidarModel lidar_;
   SweepRays rays_;
   World world_;

@@ -98,7 +98,10 @@ Surface on_rolling_hills(const Eigen::Vector2d& p, const Eigen::Vector2d& dir, d
 // Times the route with a curvature-limited speed profile and samples poses:
 // the LiDAR sensor_height above the road, pitched with its grade and rolled
 // with its cross-slope.
-std::vector<Pose> drive(const Route& route, double v_max, double frame_period, const Relief& relief = on_rolling_hills) {
+// World = the first LiDAR frame, or with `keep_level` its position and
+// heading only (z stays up: a route that starts tilted keeps its world level).
+std::vector<Pose> drive(const Route& route, double v_max, double frame_period, const Relief& relief = on_rolling_hills,
+                        bool keep_level = false) {
   const std::size_t n = route.size();
   std::vector<double> s(n, 0.0), kappa(n, 0.0), v(n, v_max);
   for (std::size_t i = 1; i < n; ++i) s[i] = s[i - 1] + (route[i] - route[i - 1]).norm();
@@ -140,8 +143,12 @@ std::vector<Pose> drive(const Route& route, double v_max, double frame_period, c
     T.translation() = Eigen::Vector3d(p.x(), p.y(), road.height + sensor_height);
     poses.push_back(orthonormalized(T));
   }
-  // World = first LiDAR frame.
-  const Pose first_inv = poses.front().inverse();
+  Pose first = poses.front();
+  if (keep_level) {
+    const Eigen::Vector3d forward = first.linear().col(0);
+    first.linear() = Eigen::AngleAxisd(std::atan2(forward.y(), forward.x()), Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  }
+  const Pose first_inv = first.inverse();
   for (auto& P : poses) P = orthonormalized(first_inv * P);
   return poses;
 }
@@ -340,9 +347,45 @@ std::vector<Pose> hill_climb(double frame_period) {
   return drive(route, 12.0, frame_period, profile);
 }
 
+// The "ramp-start" preset: a car that starts on a garage ramp of 20 deg
+// (36 % grade: steep, as garage ramps are) and drives up it for 30 m, levels
+// out over the next 40 m (the grade falls linearly: a crest of ~110 m
+// radius) and drives 1.3 km through town on level ground. Its world keeps z
+// up, so the first scan is tilted 20 deg against gravity.
+Route ramp_start_plan() {
+  Route r;
+  Turtle t{{0.0, 0.0}, 0.0};
+  r.push_back(t.pos);
+  t.straight(r, 160);
+  t.arc(r, 40, -kPi / 2);
+  t.straight(r, 220);
+  t.arc(r, 60, kPi / 2);
+  t.straight(r, 260);
+  t.arc(r, 50, kPi / 3);
+  t.straight(r, 180);
+  t.arc(r, 45, -kPi / 2);
+  t.straight(r, 200);
+  return wander(smooth(r, 30), 0.2, 150.0);
+}
+
+std::vector<Pose> ramp_start(double frame_period) {
+  constexpr double kRampGrade = 0.36397;  // tan 20 deg
+  constexpr double kRampLength = 30.0, kLevelling = 40.0;  // [m]
+  const auto grade = [&](double s) { return kRampGrade * std::clamp(1.0 - (s - kRampLength) / kLevelling, 0.0, 1.0); };
+  const auto height = [&](double s) {
+    const double ramp = std::min(s, kRampLength);
+    const double u = std::clamp(s - kRampLength, 0.0, kLevelling);
+    return kRampGrade * (ramp + u - 0.5 * u * u / kLevelling);
+  };
+  const Relief relief = [&](const Eigen::Vector2d&, const Eigen::Vector2d&, double s) {
+    return Surface{height(s), grade(s), 0.0};
+  };
+  return drive(ramp_start_plan(), 10.0, frame_period, relief, true);
+}
+
 }  // namespace
 
-std::vector<std::string> preset_names() { return {"urban-loop", "figure-eight", "straight", "hill-climb"}; }
+std::vector<std::string> preset_names() { return {"urban-loop", "figure-eight", "straight", "hill-climb", "ramp-start"}; }
 
 bool preset_on_hillside(const std::string& name) { return name == "hill-climb"; }
 
@@ -352,6 +395,7 @@ std::vector<Pose> preset_trajectory(const std::string& name, double frame_period
   if (name == "figure-eight") return drive(figure_eight(), 11.5, frame_period);
   if (name == "straight") return drive(straight_road(), 10.0, frame_period);
   if (name == "hill-climb") return hill_climb(frame_period);
+  if (name == "ramp-start") return ramp_start(frame_period);
   throw ConfigError(fmt::format("unknown preset '{}' (choose one of: {})", name, fmt::join(preset_names(), ", ")));
 }
 

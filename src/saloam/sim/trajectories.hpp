@@ -1,6 +1,7 @@
 #pragma once
 // Built-in driving routes for the simulator, as LiDAR trajectories
-// Q_i = T_L0<-Li at 10 Hz (world = first LiDAR frame, z up), with realistic
+// Q_i = T_L0<-Li at 10 Hz (world = first LiDAR frame, z up; "ramp-start":
+// the first frame's position and heading, z up), with realistic
 // speeds (about 8-12 m/s on straights, slower in curves) and smooth curvature.
 
 #include <string>
@@ -19,6 +20,10 @@ namespace saloam {
 ///  - "hill-climb": 2.7 km of mountain road, no revisit: grades of 8-15 %,
 ///    about 170 m of height range, two crests and a sag, three hairpins,
 ///    cross-slopes of 2.5-6 % (issue #43).
+///  - "ramp-start": a garage ramp of 20 deg for 30 m, levelling out over
+///    40 m, then 1.3 km through town on level ground: the first frame is
+///    tilted 20 deg against gravity (its world keeps z up, not the first
+///    frame's orientation).
 std::vector<std::string> preset_names();
 
 /// Whether the preset's road lies on a hillside whose ground the simulated

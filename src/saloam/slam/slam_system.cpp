@@ -94,7 +94,15 @@ void SlamSystem::add_keyframe(const LabelledCloud& scan, const Pose& odometry_po
   kf.travelled = travelled_;
   kf.odometry_pose = odometry_pose;
   kf.features = StoredFeatures::from(odometry_.last_features());
-  kf.place = places_.describe(scan);
+  // Described level (gravity.hpp): a tilted sensor's rings and sectors then
+  // lie as a level one's, and a revisit in the other direction matches.
+  const Eigen::Vector3d up = odometry_pose.linear().transpose() * odometry_.up();
+  if (points_up(up)) {
+    kf.place = places_.describe(scan);
+  } else {
+    kf.level = level_rotation(up);
+    kf.place = places_.describe(turned(scan, kf.level));
+  }
 
   if (keyframes_.empty()) {
     graph_.add_node(odometry_pose);
@@ -121,8 +129,11 @@ void SlamSystem::close_loops(const LabelledCloud& scan, SlamFrameTimings& timing
   StageTimer timer;
   const std::size_t query = keyframes_.size() - 1;
   const std::vector<std::size_t> candidates = select_candidates(query);
-  const std::vector<PlaceProposal> proposals =
-      propose(query, candidates, sideways_queries(places_, scan, config_.loop.lateral_query_offset));
+  const Eigen::Matrix3d& level = keyframes_[query].level;
+  const std::vector<PlaceQuery> sideways =
+      level.isIdentity() ? sideways_queries(places_, scan, config_.loop.lateral_query_offset)
+                         : sideways_queries(places_, turned(scan, level), config_.loop.lateral_query_offset);
+  const std::vector<PlaceProposal> proposals = propose(query, candidates, sideways);
   timing.search_ms = timer.lap().wall_ms;
 
   bool closed = false;
@@ -183,11 +194,15 @@ LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) 
   // Initial guesses: the current estimates, and the descriptor's yaw (with
   // its x-y offset when it gives one, SSC's) in place.
   // A query from the side: the descriptor's guess moved back to the sensor.
+  // The descriptors' guesses are between the level frames: turned back.
   std::vector<Pose> guesses{orthonormalized(graph_.pose(match).inverse() * graph_.pose(query))};
+  const auto sensor_guess = [&](const Pose& level_guess) {
+    return orthonormalized(Pose(keyframes_[match].level.transpose()) * level_guess * Pose(keyframes_[query].level));
+  };
   if (proposal.query_offset != 0) {
-    add_distinct_guess(guesses, proposal.lateral_guess());
+    add_distinct_guess(guesses, sensor_guess(proposal.lateral_guess()));
   } else if (proposal.match.yaw) {
-    add_distinct_guess(guesses, place_match_guess(proposal.match));
+    add_distinct_guess(guesses, sensor_guess(place_match_guess(proposal.match)));
   }
   LoopRecord record;
   record.query_keyframe = query;
@@ -198,7 +213,10 @@ LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) 
   record.score = proposal.match;
   record.by_proximity = proposal.by_proximity;
   record.query_offset = proposal.query_offset;
-  record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses, verification_);
+  // Up in the match's frame for the plane constraint and the level lines.
+  LoopVerificationSettings settings = verification_;
+  settings.coarse.up = settings.fine.up = keyframes_[match].odometry_pose.linear().transpose() * odometry_.up();
+  record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses, settings);
   return record;
 }
 

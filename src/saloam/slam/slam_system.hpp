@@ -53,6 +53,9 @@ struct Keyframe {
   double travelled = 0;        ///< [m] odometry path length up to this frame
   Pose odometry_pose = Pose::Identity();
   StoredFeatures features;
+  /// The keyframe's scan turned level (level_rotation of up in its frame):
+  /// `place` describes it so, and a place match's guess is turned back.
+  Eigen::Matrix3d level = Eigen::Matrix3d::Identity();
   PlaceDescriptor place;
 };
 

@@ -6,6 +6,8 @@
 #include <numbers>
 #include <optional>
 
+#include <Eigen/Eigenvalues>
+
 namespace saloam {
 namespace {
 
@@ -16,16 +18,62 @@ double elevation_deg(const Eigen::Vector3f& p) {
          180.0 / std::numbers::pi;
 }
 
+/// Elevation [deg] above the plane normal to a unit `axis`.
+double elevation_deg(const Eigen::Vector3f& p, const Eigen::Vector3d& axis) {
+  const Eigen::Vector3d d = p.cast<double>().normalized();
+  return std::asin(std::clamp(d.dot(axis), -1.0, 1.0)) * 180.0 / std::numbers::pi;
+}
+
+/// A spin axis closer than this to the cloud's z is the cloud's z [deg].
+constexpr double kAxisTolerance = 1.0;
+
+/// The axis the lasers spin about: each laser's returns lie on a cone about
+/// it (d . axis = sin of the laser's elevation), so it is the direction in
+/// which the lasers' unit directions vary least about their means (the
+/// smallest eigenvector of the summed covariances), on the side of the
+/// cloud's z. The cloud's z when that is within kAxisTolerance, or when
+/// too few lasers tell.
+Eigen::Vector3d spin_axis(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& lasers) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  std::size_t used = 0;
+  for (const auto& laser : lasers) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    std::size_t n = 0;
+    for (const std::uint32_t i : laser) {
+      const Eigen::Vector3d p = cloud.points[i].cast<double>();
+      if (p.norm() <= kNearHorizontal || !p.allFinite()) continue;
+      const Eigen::Vector3d d = p.normalized();
+      sum += d;
+      outer.noalias() += d * d.transpose();
+      ++n;
+    }
+    if (n < 10) continue;
+    const Eigen::Vector3d mean = sum / static_cast<double>(n);
+    scatter += outer - static_cast<double>(n) * mean * mean.transpose();
+    ++used;
+  }
+  if (used < 2) return Eigen::Vector3d::UnitZ();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(scatter);
+  Eigen::Vector3d axis = eig.eigenvectors().col(0).normalized();
+  if (axis.z() < 0) axis = -axis;
+  if (!axis.allFinite() || std::acos(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / std::numbers::pi < kAxisTolerance) {
+    return Eigen::Vector3d::UnitZ();
+  }
+  return axis;
+}
+
 double azimuth(const Eigen::Vector3f& p) { return std::atan2(static_cast<double>(p.y()), static_cast<double>(p.x())); }
 
-/// Median elevation of each group's points beyond kNearHorizontal (all of them when none is).
-std::vector<double> median_elevations(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& groups) {
+/// Median elevation (about `axis`) of each group's points beyond kNearHorizontal (all of them when none is).
+std::vector<double> median_elevations(const LabelledCloud& cloud, const std::vector<std::vector<std::uint32_t>>& groups,
+                                      const Eigen::Vector3d& axis) {
   std::vector<double> out;
   for (const auto& group : groups) {
     std::vector<double> far, all;
     for (const std::uint32_t i : group) {
       const auto& p = cloud.points[i];
-      const double e = elevation_deg(p);
+      const double e = axis.z() == 1.0 ? elevation_deg(p) : elevation_deg(p, axis);
       all.push_back(e);
       if (std::hypot(p.x(), p.y()) > kNearHorizontal) far.push_back(e);
     }
@@ -115,7 +163,8 @@ FoundLasers find_lasers(const LabelledCloud& cloud) {
   for (auto& [l, m] : groups) {
     if (m.size() >= min_points) members.push_back(std::move(m));
   }
-  found.elevation_deg = median_elevations(cloud, members);
+  found.spin_axis = spin_axis(cloud, members);
+  found.elevation_deg = median_elevations(cloud, members, found.spin_axis);
   return found;
 }
 

@@ -17,9 +17,14 @@
 //                  HDL-64E scans, whose lasers' elevations blur into each other
 // Elevations [deg] are atan2(z, hypot(x, y)) in the LiDAR frame; a laser's is
 // the median of its points beyond 2 m (all of its points when none is).
+// When the lasers are told apart exactly, elevations are taken about the
+// axis they spin about, found from the lasers' cones: a scan handed over in
+// a turned frame (a robot's base link) shows the sensor's own lasers.
 
 #include <cstddef>
 #include <vector>
+
+#include <Eigen/Core>
 
 #include "saloam/core/types.hpp"
 
@@ -34,6 +39,9 @@ enum class BeamMethod {
 struct FoundLasers {
   BeamMethod method = BeamMethod::kElevation;
   std::vector<double> elevation_deg;  ///< one per laser, top first
+  /// The lasers' spin axis in the cloud's frame: its z unless the lasers,
+  /// told apart exactly, spin about an axis more than 1 deg away.
+  Eigen::Vector3d spin_axis = Eigen::Vector3d::UnitZ();
   [[nodiscard]] std::size_t count() const { return elevation_deg.size(); }
   /// Whether the lasers were told apart exactly (ring field or storage order).
   [[nodiscard]] bool exact() const { return method != BeamMethod::kElevation; }

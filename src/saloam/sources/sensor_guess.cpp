@@ -29,8 +29,14 @@ double mean_residual(const std::vector<double>& found, const std::vector<double>
 
 std::string SensorGuess::found() const {
   if (lasers.elevation_deg.empty()) return fmt::format("no laser found ({})", beam_method_text(lasers.method));
-  return fmt::format("{} lasers ({}) from {:+.1f} to {:+.1f} deg", lasers.count(), beam_method_text(lasers.method),
-                     lasers.elevation_deg.front(), lasers.elevation_deg.back());
+  std::string text = fmt::format("{} lasers ({}) from {:+.1f} to {:+.1f} deg", lasers.count(),
+                                 beam_method_text(lasers.method), lasers.elevation_deg.front(), lasers.elevation_deg.back());
+  const Eigen::Vector3d& axis = lasers.spin_axis;
+  if (axis.z() < 1.0) {
+    text += fmt::format(" about their spin axis ({:.3f}, {:.3f}, {:.3f}), {:.1f} deg from the cloud's z", axis.x(), axis.y(),
+                        axis.z(), std::acos(std::clamp(axis.z(), -1.0, 1.0)) * 180.0 / M_PI);
+  }
+  return text;
 }
 
 double sensor_score(const SensorProfile& profile, const FoundLasers& lasers) {
