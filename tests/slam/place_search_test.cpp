@@ -30,6 +30,7 @@ class LineOfKeyframes final : public KeyframeSet {
   [[nodiscard]] std::uint32_t session(std::size_t k) const override { return sessions_[k]; }
   [[nodiscard]] bool in_frame(std::size_t k) const override { return sessions_[k] != kUnlinked; }
   [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const override { return places_[k]; }
+  [[nodiscard]] Eigen::Matrix3d level(std::size_t) const override { return Eigen::Matrix3d::Identity(); }
   [[nodiscard]] ScanFeatures scan_features(std::size_t k) const override {
     ++features_read;
     ScanFeatures f;

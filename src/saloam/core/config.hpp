@@ -16,9 +16,12 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include <Eigen/Core>
 
 namespace saloam {
 
@@ -123,6 +126,8 @@ struct FeatureConfig {
 /// else estimated from the scans (the ground's normal, upright walls, poles
 /// and trunks over the first scans, refined as the run goes), else the
 /// sensor's z. The outputs' world frame stays the first scan's sensor frame.
+/// Between the mount and the scans ranks the sensor's own IMU at rest, when
+/// the source has one (an Ouster capture).
 struct GravityConfig {
   /// The sensor's orientation on the robot, R_base<-sensor as roll, pitch,
   /// yaw [deg] (R = Rz(yaw) Ry(pitch) Rx(roll), the URDF / ROS convention), as
@@ -137,6 +142,9 @@ struct GravityConfig {
   /// [deg] A given mount whose up the scans contradict by more than this is
   /// warned about (both directions named); the mount is still used.
   double mount_warning_deg = 8.0;
+  /// Up in the first scan's frame from the sensor's own IMU (SourceInfo::imu_up):
+  /// set by a run from its source, not a parameter (not in the YAML).
+  std::optional<Eigen::Vector3d> imu_up;
 };
 
 /// Scan-to-local-map registration (paper Sec. III-B, Eq. 2).

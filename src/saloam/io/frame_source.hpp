@@ -77,6 +77,10 @@ struct SourceInfo {
   /// each ("times: times.txt", "reference: oxts/ (GPS/INS) ..."): what
   /// `saloam info` shows beside the numbers.
   std::vector<std::string> notes;
+  /// Up (against gravity, unit) in the scans' frame from the sensor's own
+  /// IMU, when the source has one and it was still at the start: the mean
+  /// of its accelerometer over the still samples (odometry/gravity.hpp).
+  std::optional<Eigen::Vector3d> imu_up;
 
   [[nodiscard]] std::size_t size() const { return times.size(); }
 };

@@ -30,6 +30,7 @@ struct Localizer::Submap {
   LoopSubmap features;
   Eigen::Vector3d built_at = Eigen::Vector3d::Zero();
   std::vector<std::size_t> keyframes;
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  ///< in the map frame, as its first keyframe sees it
 };
 
 Localizer::Localizer(const SaloamConfig& config, const PriorMap& map, std::optional<SgprNetwork> network)
@@ -102,6 +103,7 @@ const Localizer::Submap& Localizer::submap_near(const Eigen::Vector3d& position)
   // Keyframes near the place, thinned to submap_spacing (the map's overlap a lot).
   submap->keyframes = thinned_near(map_, position, lc.track_radius, lc.submap_spacing);
   for (const std::size_t k : submap->keyframes) submap->features.add(map_.features(k)->expand(), map_.pose(k));
+  if (!submap->keyframes.empty()) submap->up = set_up(map_, submap->keyframes.front());
   submap_ = std::move(submap);
   return *submap_;
 }
@@ -114,7 +116,7 @@ LoopVerification Localizer::verify_near(const Pose& predicted) {
     return v;
   }
   const std::vector<Pose> guesses{predicted};
-  return verify_loop(odometry_.last_features(), submap.features, guesses, verification_);
+  return verify_loop(odometry_.last_features(), submap.features, guesses, with_up(verification_, submap.up));
 }
 
 void Localizer::track(LocalizedFrame& out) {
@@ -128,8 +130,10 @@ void Localizer::track(LocalizedFrame& out) {
     out.submap_keyframes = submap.keyframes.size();
     if (!submap.keyframes.empty()) {
       const ScanFeatures& features = odometry_.last_features();
+      RegistrationSettings tracking = tracking_;
+      tracking.up = submap.up;
       const RegistrationResult fit =
-          register_scan(features.edges, features.planars, submap.features.fine(), predicted, tracking_);
+          register_scan(features.edges, features.planars, submap.features.fine(), predicted, tracking);
       const double total = static_cast<double>(features.edges.size() + features.planars.size());
       out.inlier_fraction = total > 0 ? fit.inliers / total : 0.0;
       out.mean_residual = fit.mean_inlier_residual();
@@ -190,7 +194,7 @@ void Localizer::confirm(LocalizedFrame& out) {
   out.mean_residual = record.verification.mean_residual;
   if (record.verification.accepted && small_correction(predicted, record.verification.relative, lc)) {
     require_measured_motion(record.verification, odometry_.last_features(), submap_->features, h.last_pose,
-                            verification_);
+                            with_up(verification_, submap_->up));
   }
   const bool agrees = record.verification.accepted && small_correction(predicted, record.verification.relative, lc);
   if (!agrees) {
@@ -233,10 +237,14 @@ std::vector<std::size_t> Localizer::relocalization_candidates(const LocalizedFra
 void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
   last_relocalization_ = travelled_;
   const StageTimer timer;
-  // The scan described from the sensor and a lane width to either side.
-  const std::vector<PlaceProposal> chosen =
-      propose_places(map_, places_, lateral_queries(places_, scan, config_.localize.lateral_query_offset),
-                     relocalization_candidates(out), search_);
+  // The scan described level (as the map's keyframes were), from the
+  // sensor and a lane width to either side.
+  const Eigen::Vector3d up = out.odometry_pose.linear().transpose() * odometry_.up();
+  const Eigen::Matrix3d level = points_up(up) ? Eigen::Matrix3d::Identity() : level_rotation(up);
+  const double offset = config_.localize.lateral_query_offset;
+  const std::vector<PlaceQuery> queries =
+      level.isIdentity() ? lateral_queries(places_, scan, offset) : lateral_queries(places_, turned(scan, level), offset);
+  const std::vector<PlaceProposal> chosen = propose_places(map_, places_, queries, relocalization_candidates(out), search_);
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
   // With no prior (the whole map searched) the fit must also be unique.
   const LoopVerificationSettings& settings = state_ == State::kOdometry ? verification_ : unique_verification_;
@@ -244,7 +252,7 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
     const std::size_t match = proposal.keyframe;
     const LoopSubmap submap = submap_around(map_, match, w, verification_, map_.size());
     // Guesses: the descriptor's (its yaw, SSC's offset, the query's side); on the odometry also where it says we are.
-    std::vector<Pose> guesses{proposal.lateral_guess()};
+    std::vector<Pose> guesses{sensor_frame_guess(proposal.lateral_guess(), map_.level(match), level)};
     if (state_ == State::kOdometry) {
       add_distinct_guess(guesses, orthonormalized(map_.pose(match).inverse() * map_from_odometry_ * out.odometry_pose));
     }
@@ -253,7 +261,7 @@ void Localizer::relocalize(const LabelledCloud& scan, LocalizedFrame& out) {
     record.travelled = travelled_;
     record.keyframe = match;
     record.score = proposal.match;
-    record.verification = verify_loop(odometry_.last_features(), submap, guesses, settings);
+    record.verification = verify_loop(odometry_.last_features(), submap, guesses, with_up(settings, keyframe_up(map_, match)));
     record.pose = orthonormalized(map_.pose(match) * record.verification.relative);
     const bool accepted = record.verification.accepted;
     if (accepted) {

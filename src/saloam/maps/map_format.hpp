@@ -84,6 +84,12 @@ struct MapSession {
   /// (session 0 always is); false: in its own frame (the LiDAR frame of its
   /// first keyframe), a component of the pose graph of its own.
   bool linked = true;
+  /// Up (against gravity, unit) in the frame of its odometry poses
+  /// (MapKeyframe::odometry_pose), as its run measured or was told it
+  /// (odometry/gravity.hpp): its keyframes were described level, turned by
+  /// level_rotation(odometry_pose^T up). The sensor's z for maps saved
+  /// before up was recorded.
+  Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
 };
 
 /// The manifest (map.json).

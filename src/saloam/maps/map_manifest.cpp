@@ -2,6 +2,7 @@
 // parser that checks every field; the tables are map_format.cpp.
 #include "saloam/maps/map_format.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -41,6 +42,17 @@ Pose parse_velo_to_cam(const nlohmann::json& tr, const fs::path& origin) {
   return orthonormalized(tr_pose);
 }
 
+// A session's "up": three finite numbers of unit length (within 1e-3).
+template <class Bad>
+Eigen::Vector3d parse_up(const nlohmann::json& up, const Bad& bad) {
+  if (!up.is_array() || up.size() != 3 || !std::all_of(up.begin(), up.end(), [](const auto& v) { return v.is_number(); })) {
+    throw bad("\"up\" is not three numbers");
+  }
+  const Eigen::Vector3d u(up[0].get<double>(), up[1].get<double>(), up[2].get<double>());
+  if (!u.allFinite() || std::abs(u.norm() - 1.0) > 1e-3) throw bad("\"up\" is not a unit vector");
+  return u.normalized();
+}
+
 // Version 2's "sessions" (each with source, first_frame, keyframes, linked;
 // the first linked; keyframes summing to the map's) and "cross_session_loops".
 void parse_sessions(const nlohmann::json& j, MapManifest& m, const fs::path& origin) {
@@ -67,6 +79,8 @@ void parse_sessions(const nlohmann::json& j, MapManifest& m, const fs::path& ori
     if (i == 0 && !linked->get<bool>()) throw bad("the first session defines the map frame: it is linked");
     m.sessions.push_back({source->get<std::string>(), first->get<std::uint64_t>(), count->get<std::uint64_t>(),
                           linked->get<bool>()});
+    // "up": optional (maps saved before it was recorded: the sensor's z).
+    if (const auto up = s.find("up"); up != s.end()) m.sessions.back().up = parse_up(*up, bad);
     keyframes += m.sessions.back().keyframes;
   }
   if (keyframes != m.keyframes) {
@@ -98,7 +112,8 @@ std::string encode_map_manifest(const MapManifest& m) {
   j["sessions"] = nlohmann::ordered_json::array();
   for (const MapSession& s : m.sessions) {
     j["sessions"].push_back(
-        {{"source", s.source}, {"first_frame", s.first_frame}, {"keyframes", s.keyframes}, {"linked", s.linked}});
+        {{"source", s.source}, {"first_frame", s.first_frame}, {"keyframes", s.keyframes}, {"linked", s.linked},
+         {"up", {s.up.x(), s.up.y(), s.up.z()}}});
   }
   j["cross_session_loops"] = m.cross_session_loops;
   j["files"] = {{"config", "config.yaml"},

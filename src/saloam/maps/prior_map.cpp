@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "saloam/odometry/gravity.hpp"
+
 namespace saloam {
 
 namespace {
@@ -11,6 +13,13 @@ std::int64_t cell_key(std::int64_t x, std::int64_t y) { return (x << 32) ^ (y & 
 
 PriorMap::PriorMap(SavedMap map, std::function<StoredFeatures(std::size_t)> load_features, std::size_t cached)
     : map_(std::move(map)), load_(std::move(load_features)), capacity_(std::max<std::size_t>(1, cached)) {
+  const std::vector<MapSession> sessions = map_sessions(map_);
+  levels_.reserve(map_.keyframes.size());
+  for (const MapKeyframe& kf : map_.keyframes) {
+    const Eigen::Vector3d up = kf.session < sessions.size() ? sessions[kf.session].up : Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d sensor_up = kf.odometry_pose.linear().transpose() * up;
+    levels_.push_back(points_up(sensor_up) ? Eigen::Matrix3d::Identity() : level_rotation(sensor_up));
+  }
   for (std::size_t k = 0; k < map_.keyframes.size(); ++k) {
     const Eigen::Vector3d& p = map_.keyframes[k].pose.translation();
     grid_[cell_key(static_cast<std::int64_t>(std::floor(p.x() / cell_)), static_cast<std::int64_t>(std::floor(p.y() / cell_)))]

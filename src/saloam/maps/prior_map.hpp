@@ -40,6 +40,8 @@ class PriorMap : public KeyframeSet {
   /// True unless keyframe k's session was not linked to the first (its poses in a frame of their own).
   [[nodiscard]] bool in_frame(std::size_t k) const override;
   [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const override { return map_.places[k]; }
+  /// From its session's up (MapSession::up) and its odometry pose.
+  [[nodiscard]] Eigen::Matrix3d level(std::size_t k) const override { return levels_[k]; }
   /// Keyframe k's features (read when not cached).
   [[nodiscard]] std::shared_ptr<const StoredFeatures> features(std::size_t k) const;
   [[nodiscard]] ScanFeatures scan_features(std::size_t k) const override { return features(k)->expand(); }
@@ -54,6 +56,7 @@ class PriorMap : public KeyframeSet {
 
  private:
   SavedMap map_;
+  std::vector<Eigen::Matrix3d> levels_;
   std::function<StoredFeatures(std::size_t)> load_;
   std::size_t capacity_;
   double cell_ = 20.0;

@@ -119,13 +119,15 @@ CrossSessionRecord SessionJoiner::verify(std::size_t q, const PlaceProposal& can
                                          const LoopVerificationSettings& settings) const {
   const std::size_t w = static_cast<std::size_t>(std::max(0, config_.loop.submap_half_width));
   const LoopSubmap submap = submap_around(base_, candidate.keyframe, w, verification_, base_.size());
-  add_distinct_guess(guesses, place_match_guess(candidate.match));
+  add_distinct_guess(guesses, sensor_frame_guess(place_match_guess(candidate.match), base_.level(candidate.keyframe),
+                                                joining_.level(q)));
   CrossSessionRecord r;
   r.query = q;
   r.match = candidate.keyframe;
   r.travelled = path_[q];
   r.score = candidate.match;
-  r.verification = verify_loop(joining_.features(q)->expand(), submap, guesses, settings);
+  r.verification =
+      verify_loop(joining_.features(q)->expand(), submap, guesses, with_up(settings, keyframe_up(base_, candidate.keyframe)));
   r.pose = orthonormalized(base_.pose(candidate.keyframe) * r.verification.relative);
   return r;
 }
@@ -169,9 +171,10 @@ CrossSessionRecord SessionJoiner::fit_near(std::size_t q, const Pose& predicted,
   for (const std::size_t k : near) submap.add(base_.features(k)->expand(), match_inverse * base_.pose(k));
   const std::vector<Pose> guesses{orthonormalized(match_inverse * predicted)};
   const ScanFeatures query = joining_.features(q)->expand();
-  r.verification = verify_loop(query, submap, guesses, verification_);
+  const LoopVerificationSettings settings = with_up(verification_, keyframe_up(base_, r.match));
+  r.verification = verify_loop(query, submap, guesses, settings);
   r.pose = orthonormalized(base_.pose(r.match) * r.verification.relative);
-  require_measured_motion(r.verification, query, submap, match_inverse * last_fix, verification_);
+  require_measured_motion(r.verification, query, submap, match_inverse * last_fix, settings);
   return r;
 }
 

@@ -21,6 +21,10 @@ SavedMap saved_map_of(const SlamSystem& slam, const SaloamConfig& config, const 
     map.places.push_back(keyframes[k].place);
   }
   map.edges = slam.graph().edges();
+  // One session, described level with the run's up (in its odometry frame).
+  MapSession session = map_sessions(map).front();
+  session.up = slam.odometry().up();
+  map.manifest.sessions = {session};
   return map;
 }
 

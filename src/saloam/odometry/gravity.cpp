@@ -42,8 +42,16 @@ constexpr double kBelowSensor = 0.5;
 constexpr std::size_t kMinPlanarVotes = 20;
 /// scan_up() tries at most this many of the planar votes' normals.
 constexpr std::size_t kMaxCandidates = 96;
+/// Weight of a vote of upright structure (a wall's level normal, a pole's
+/// axis) against a ground vote's: walls and poles are built plumb, while
+/// roads have grades, cambers and ramps (a start on a 20 deg garage ramp
+/// whose ground votes weighed as much as the walls still saw up 6 deg off
+/// gravity 150 m later).
+constexpr double kUprightWeight = 3.0;
 /// Refinement rounds of a scan's up (votes re-classified each round).
 constexpr int kRefineRounds = 4;
+/// The scans contradict a given mount only with this many votes behind them.
+constexpr double kMinVotesToContradict = 200;
 
 enum class VoteKind : std::uint8_t { kNone, kGround, kWall, kPole };
 
@@ -123,11 +131,11 @@ UpEvidence classify(const std::vector<VoxelShape>& shapes, bool use_labels, cons
         e.along_up.noalias() += s.normal * s.normal.transpose();
         e.along_up_votes += 1;
       } else if (s.kind == VoteKind::kWall && s.planar && std::abs(s.normal.dot(up)) < sin_label) {
-        e.level.noalias() += s.normal * s.normal.transpose();
-        e.level_votes += 1;
+        e.level.noalias() += kUprightWeight * s.normal * s.normal.transpose();
+        e.level_votes += kUprightWeight;
       } else if (s.kind == VoteKind::kPole && s.linear && std::abs(s.direction.dot(up)) > cos_label) {
-        e.along_up.noalias() += s.direction * s.direction.transpose();
-        e.along_up_votes += 1;
+        e.along_up.noalias() += kUprightWeight * s.direction * s.direction.transpose();
+        e.along_up_votes += kUprightWeight;
       }
       continue;
     }
@@ -137,8 +145,8 @@ UpEvidence classify(const std::vector<VoxelShape>& shapes, bool use_labels, cons
       e.along_up.noalias() += s.normal * s.normal.transpose();
       e.along_up_votes += 1;
     } else if (n_up < sin_geometry) {
-      e.level.noalias() += s.normal * s.normal.transpose();
-      e.level_votes += 1;
+      e.level.noalias() += kUprightWeight * s.normal * s.normal.transpose();
+      e.level_votes += kUprightWeight;
     }
   }
   return e;
@@ -277,8 +285,19 @@ Eigen::Vector3d mount_up(const std::vector<double>& rpy) {
 const char* up_source_name(UpSource source) {
   switch (source) {
     case UpSource::kMount: return "the mount (odometry.gravity.mount_rpy_deg)";
+    case UpSource::kImu: return "the sensor's IMU at rest";
     case UpSource::kScans: return "the scans";
     case UpSource::kSensorAxis: return "the sensor's z (assumed)";
+  }
+  return "?";
+}
+
+const char* up_source_key(UpSource source) {
+  switch (source) {
+    case UpSource::kMount: return "mount";
+    case UpSource::kImu: return "imu";
+    case UpSource::kScans: return "scans";
+    case UpSource::kSensorAxis: return "sensor_z";
   }
   return "?";
 }
@@ -295,9 +314,13 @@ std::string GravityReport::describe() const {
 void GravityTracker::start(const LabelledCloud& first_scan, bool use_labels) {
   started_ = true;
   const bool mount = config_.mount_rpy_deg.size() == 3;
+  const bool given = mount || config_.imu_up.has_value();
   if (mount) {
     source_ = UpSource::kMount;
     up_ = mount_up(config_.mount_rpy_deg);
+  } else if (config_.imu_up) {
+    source_ = UpSource::kImu;
+    up_ = config_.imu_up->normalized();
   } else if (!config_.estimate) {
     source_ = UpSource::kSensorAxis;
     up_ = Eigen::Vector3d::UnitZ();
@@ -308,10 +331,23 @@ void GravityTracker::start(const LabelledCloud& first_scan, bool use_labels) {
   evidence_ = scan_up_evidence(first_scan, use_labels, *from_scan);
   scans_up_ = *from_scan;
   scans_up_known_ = true;
-  if (!mount) {
+  if (!given) {
     source_ = UpSource::kScans;
     up_ = *from_scan;
   }
+  check_mount();
+}
+
+void GravityTracker::check_mount() {
+  if (source_ != UpSource::kMount || !scans_up_known_ || warned_ || evidence_.votes() < kMinVotesToContradict) return;
+  // (An IMU's up is measured, not stated: the scans' is reported beside it, not warned about.)
+  const double off = angle_deg(scans_up_, up_);
+  if (off <= config_.mount_warning_deg) return;
+  warned_ = true;
+  spdlog::warn("the mount's up ({:.3f}, {:.3f}, {:.3f}) and the scans' up ({:.3f}, {:.3f}, {:.3f}) differ by {:.1f} deg "
+               "(odometry.gravity.mount_warning_deg {}): the mount's is used; check odometry.gravity.mount_rpy_deg "
+               "(R_base<-sensor as roll, pitch, yaw)",
+               up_.x(), up_.y(), up_.z(), scans_up_.x(), scans_up_.y(), scans_up_.z(), off, config_.mount_warning_deg);
 }
 
 void GravityTracker::observe(const LabelledCloud& scan, bool use_labels, const Eigen::Matrix3d& world_from_sensor,
@@ -324,16 +360,11 @@ void GravityTracker::observe(const LabelledCloud& scan, bool use_labels, const E
   if (!refined) return;
   scans_up_ = *refined;
   scans_up_known_ = true;
-  if (source_ != UpSource::kMount) {
+  if (source_ == UpSource::kScans || source_ == UpSource::kSensorAxis) {
     source_ = UpSource::kScans;
     up_ = scans_up_;
-  } else if (!warned_ && evidence_.votes() >= 200 && angle_deg(scans_up_, up_) > config_.mount_warning_deg) {
-    warned_ = true;
-    spdlog::warn("the mount's up ({:.3f}, {:.3f}, {:.3f}) and the scans' up ({:.3f}, {:.3f}, {:.3f}) differ by {:.1f} deg "
-                 "(odometry.gravity.mount_warning_deg {}): the mount is used; check odometry.gravity.mount_rpy_deg",
-                 up_.x(), up_.y(), up_.z(), scans_up_.x(), scans_up_.y(), scans_up_.z(), angle_deg(scans_up_, up_),
-                 config_.mount_warning_deg);
   }
+  check_mount();
 }
 
 GravityReport GravityTracker::report() const {
@@ -342,7 +373,7 @@ GravityReport GravityTracker::report() const {
   r.source = source_;
   r.votes = evidence_.votes();
   if (r.votes > 0) r.spread_deg = up_spread_deg(evidence_, scans_up_known_ ? scans_up_ : up_);
-  if (source_ == UpSource::kMount && scans_up_known_) r.scans_up = scans_up_;
+  if ((source_ == UpSource::kMount || source_ == UpSource::kImu) && scans_up_known_) r.scans_up = scans_up_;
   return r;
 }
 

@@ -15,8 +15,10 @@
 // (or a line) gives its normal (or direction) as one vote. With labels the
 // votes' classes say which is which (ground classes, building and fence,
 // pole/trunk/traffic-sign); without, their angle to the current estimate
-// does. Up is the unit u minimising
-//     sum_level (n . u)^2 - sum_up (d . u)^2,
+// does. Upright structure's votes weigh 3, the ground's 1 (walls and poles
+// are built plumb; roads have grades, cambers and ramps). Up is the unit u
+// minimising
+//     sum_level w (n . u)^2 - sum_up w (d . u)^2,
 // the eigenvector of the smallest eigenvalue of sum_level n n^T - sum_up d d^T:
 // one linear solve, no angle wrap. The first scan's up is searched among
 // every planar vote's normal (so a sensor tilted by any angle, even
@@ -35,12 +37,15 @@
 
 namespace saloam {
 
-/// Votes for the up direction, in one frame: sums of outer products.
+/// Votes for the up direction, in one frame: weighted sums of outer
+/// products (a vote of upright structure, a wall or a pole, weighs 3, one
+/// of the ground 1: walls and poles are built plumb, roads have grades and
+/// ramps).
 struct UpEvidence {
-  Eigen::Matrix3d along_up = Eigen::Matrix3d::Zero();  ///< sum d d^T of directions that point up (ground normals, pole axes)
-  Eigen::Matrix3d level = Eigen::Matrix3d::Zero();     ///< sum n n^T of normals that lie level (upright walls)
-  double along_up_votes = 0;
-  double level_votes = 0;
+  Eigen::Matrix3d along_up = Eigen::Matrix3d::Zero();  ///< sum w d d^T of directions that point up (ground normals, pole axes)
+  Eigen::Matrix3d level = Eigen::Matrix3d::Zero();     ///< sum w n n^T of normals that lie level (upright walls)
+  double along_up_votes = 0;  ///< sum of their weights
+  double level_votes = 0;     ///< sum of their weights
 
   UpEvidence& operator+=(const UpEvidence& other);
   /// The same votes seen from another frame: R * evidence * R^T for R = R_to<-from.
@@ -87,8 +92,10 @@ double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b);
 Eigen::Vector3d mount_up(const std::vector<double>& mount_rpy_deg);
 
 /// Where a run's up came from.
-enum class UpSource { kMount, kScans, kSensorAxis };
+enum class UpSource { kMount, kImu, kScans, kSensorAxis };
 const char* up_source_name(UpSource source);
+/// One word for files: "mount", "imu", "scans", "sensor_z".
+const char* up_source_key(UpSource source);
 
 /// What the summary says about up.
 struct GravityReport {
@@ -96,7 +103,7 @@ struct GravityReport {
   UpSource source = UpSource::kSensorAxis;
   double votes = 0;          ///< scan votes behind the scans' estimate
   double spread_deg = 0;     ///< up_spread_deg of those votes about the estimate
-  /// The scans' own estimate when up is the mount's (to check it).
+  /// The scans' own estimate when up is the mount's or the IMU's (to check it).
   std::optional<Eigen::Vector3d> scans_up;
   /// [deg] angle between up and the sensor's z at the first scan.
   [[nodiscard]] double tilt_deg() const { return angle_deg(up, Eigen::Vector3d::UnitZ()); }
@@ -121,6 +128,9 @@ class GravityTracker {
   [[nodiscard]] GravityReport report() const;
 
  private:
+  /// Warns once when the scans' up contradicts a given mount (mount_warning_deg).
+  void check_mount();
+
   GravityConfig config_;
   bool started_ = false;
   UpSource source_ = UpSource::kSensorAxis;

@@ -282,7 +282,7 @@ LocalizeRunResult run_localize(FrameSource& source, const SaloamConfig& config, 
   const std::optional<Pose> tr = output_velo_to_cam(info);
   TrajectoryWriter writer(folder / "poses.txt", folder / "poses_tum.txt", tr, info.live);
 
-  Localizer localizer(config, map, std::move(network));
+  Localizer localizer(with_source_up(config, info), map, std::move(network));
   LocalizeRunResult result;
   result.seconds = localize_frames(source, localizer, writer, options);
   result.interrupted = stop_requested();

@@ -108,9 +108,19 @@ nlohmann::json odometry_summary(const SourceInfo& info, const OdometryConfig& co
 
 }  // namespace
 
+OdometryConfig with_source_up(OdometryConfig config, const SourceInfo& info) {
+  if (info.imu_up) config.gravity.imu_up = info.imu_up;
+  return config;
+}
+
+SaloamConfig with_source_up(SaloamConfig config, const SourceInfo& info) {
+  config.odometry = with_source_up(std::move(config.odometry), info);
+  return config;
+}
+
 nlohmann::json gravity_json(const GravityReport& g) {
   nlohmann::json out{{"up", {g.up.x(), g.up.y(), g.up.z()}},
-                     {"source", g.source == UpSource::kMount ? "mount" : g.source == UpSource::kScans ? "scans" : "sensor_z"},
+                     {"source", up_source_key(g.source)},
                      {"tilt_deg", g.tilt_deg()},
                      {"votes", g.votes},
                      {"spread_deg", g.spread_deg}};
@@ -124,7 +134,7 @@ OdometryRunResult run_odometry(FrameSource& source, const OdometryConfig& config
   if (config.use_semantics && !info.has_labels) warn_no_labels(info);
   const std::optional<Pose> tr = output_velo_to_cam(info);
   OutputFolder folder = open_run_folder(out_dir, info.folder, "odom", kOdometryOutputs);
-  OdometryRun run(config, out_dir, tr, info.live);
+  OdometryRun run(with_source_up(config, info), out_dir, tr, info.live);
   ProgressBar progress(info.size(), options.progress_label, options.show_progress && !info.live);
   for (std::size_t i = 0; !stop_requested(); ++i) {
     std::optional<SourceFrame> frame = source.next_frame(i);

@@ -35,6 +35,11 @@ struct OdometryRunOptions {
   FrameFollower follow;
 };
 
+/// The configuration with up from the source's own IMU (SourceInfo::imu_up),
+/// when it has one: odometry/gravity.hpp ranks it after a given mount.
+OdometryConfig with_source_up(OdometryConfig config, const SourceInfo& info);
+SaloamConfig with_source_up(SaloamConfig config, const SourceInfo& info);
+
 /// What summary.json says of up ("gravity": up, source, tilt, votes, spread).
 nlohmann::json gravity_json(const GravityReport& gravity);
 

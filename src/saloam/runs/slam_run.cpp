@@ -437,7 +437,7 @@ SlamRunResult run_slam(FrameSource& source, const SaloamConfig& config, std::opt
   std::optional<MapScanStore> map_scans;
   if (options.write_map && !info.rereadable) map_scans.emplace(map_options, map_step);
 
-  SlamSystem slam(config, std::move(network));
+  SlamSystem slam(with_source_up(config, info), std::move(network));
   // A live run's odometry poses grow in place, for a process that follows them.
   TrajectoryWriter odometry_writer(out_dir / "poses_odometry.txt", out_dir / "poses_odometry_tum.txt", tr, info.live);
   TrajectoryWriter slam_writer(out_dir / "poses.txt", out_dir / "poses_tum.txt", tr);

@@ -47,6 +47,21 @@ std::vector<PlaceProposal> one_per_place(const KeyframeSet& set, const std::vect
 }
 }  // namespace
 
+Eigen::Vector3d keyframe_up(const KeyframeSet& set, std::size_t k) {
+  return set.level(k).transpose() * Eigen::Vector3d::UnitZ();
+}
+
+Eigen::Vector3d set_up(const KeyframeSet& set, std::size_t k) { return set.pose(k).linear() * keyframe_up(set, k); }
+
+Pose sensor_frame_guess(const Pose& level_guess, const Eigen::Matrix3d& match_level, const Eigen::Matrix3d& query_level) {
+  return orthonormalized(Pose(match_level.transpose()) * level_guess * Pose(query_level));
+}
+
+LoopVerificationSettings with_up(LoopVerificationSettings settings, const Eigen::Vector3d& up) {
+  settings.coarse.up = settings.fine.up = up.normalized();
+  return settings;
+}
+
 Pose PlaceProposal::lateral_guess() const {
   Pose query_from_sensor = Pose::Identity();
   query_from_sensor.translation().y() = -query_offset;

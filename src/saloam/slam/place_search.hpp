@@ -56,6 +56,9 @@ class KeyframeSet {
   /// the first); the others are never proposed.
   [[nodiscard]] virtual bool in_frame(std::size_t k) const = 0;
   [[nodiscard]] virtual const PlaceDescriptor& place(std::size_t k) const = 0;
+  /// The rotation that turned keyframe k's scan level (odometry/gravity.hpp)
+  /// before place(k) described it: R * up_k = z, up_k = R^T z in its sensor frame.
+  [[nodiscard]] virtual Eigen::Matrix3d level(std::size_t k) const = 0;
   /// Keyframe k's odometry features in its sensor frame (a saved map reads
   /// them on demand).
   [[nodiscard]] virtual ScanFeatures scan_features(std::size_t k) const = 0;
@@ -69,6 +72,18 @@ class KeyframeSet {
   KeyframeSet& operator=(const KeyframeSet&) = default;
   KeyframeSet& operator=(KeyframeSet&&) = default;
 };
+
+/// Up in keyframe k's sensor frame (level(k)^T z).
+Eigen::Vector3d keyframe_up(const KeyframeSet& set, std::size_t k);
+/// Up in the set's frame, as keyframe k sees it.
+Eigen::Vector3d set_up(const KeyframeSet& set, std::size_t k);
+/// A guess between two level frames (a descriptor's: yaw about up, SSC's
+/// offset, a query from the side), T_match_level<-query_level, turned into
+/// T_match<-query between the sensor frames.
+Pose sensor_frame_guess(const Pose& level_guess, const Eigen::Matrix3d& match_level, const Eigen::Matrix3d& query_level);
+/// `settings` with up in the frame of keyframe `match` of `set` (a submap
+/// around it is in its frame).
+LoopVerificationSettings with_up(LoopVerificationSettings settings, const Eigen::Vector3d& up);
 
 /// A keyframe proposed for verification: the one proposal type of the three callers.
 struct PlaceProposal {

@@ -197,7 +197,7 @@ LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) 
   // The descriptors' guesses are between the level frames: turned back.
   std::vector<Pose> guesses{orthonormalized(graph_.pose(match).inverse() * graph_.pose(query))};
   const auto sensor_guess = [&](const Pose& level_guess) {
-    return orthonormalized(Pose(keyframes_[match].level.transpose()) * level_guess * Pose(keyframes_[query].level));
+    return sensor_frame_guess(level_guess, keyframes_[match].level, keyframes_[query].level);
   };
   if (proposal.query_offset != 0) {
     add_distinct_guess(guesses, sensor_guess(proposal.lateral_guess()));
@@ -214,9 +214,8 @@ LoopRecord SlamSystem::verify(std::size_t query, const PlaceProposal& proposal) 
   record.by_proximity = proposal.by_proximity;
   record.query_offset = proposal.query_offset;
   // Up in the match's frame for the plane constraint and the level lines.
-  LoopVerificationSettings settings = verification_;
-  settings.coarse.up = settings.fine.up = keyframes_[match].odometry_pose.linear().transpose() * odometry_.up();
-  record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses, settings);
+  record.verification = verify_loop(keyframes_[query].features.expand(), submap, guesses,
+                                    with_up(verification_, keyframes_[match].odometry_pose.linear().transpose() * odometry_.up()));
   return record;
 }
 

@@ -69,6 +69,7 @@ class LiveKeyframes final : public KeyframeSet {
   [[nodiscard]] std::uint32_t session(std::size_t /*k*/) const override { return 0; }
   [[nodiscard]] bool in_frame(std::size_t /*k*/) const override { return true; }
   [[nodiscard]] const PlaceDescriptor& place(std::size_t k) const override { return keyframes_[k].place; }
+  [[nodiscard]] Eigen::Matrix3d level(std::size_t k) const override { return keyframes_[k].level; }
   [[nodiscard]] ScanFeatures scan_features(std::size_t k) const override { return keyframes_[k].features.expand(); }
   [[nodiscard]] std::vector<std::size_t> near(const Eigen::Vector3d& position, double radius) const override;
 

@@ -1,6 +1,7 @@
 #include "saloam/sources/pcap_source.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 
 #include <fmt/format.h>
@@ -8,6 +9,7 @@
 
 #include "saloam/core/error.hpp"
 #include "saloam/sensors/ouster_frame.hpp"
+#include "saloam/sensors/ouster_imu.hpp"
 #include "saloam/sensors/packet_frames.hpp"
 #include "saloam/sensors/velodyne_frame.hpp"
 
@@ -325,6 +327,30 @@ PcapSource::PcapSource(fs::path capture, const SourceOptions& options)
   notes.push_back(intensity_.note());
   notes.emplace_back("extrinsics: none (a packet capture runs in the LiDAR frame)");
   info_.notes.insert(info_.notes.begin(), notes.begin(), notes.end());
+  if (metadata && is_json(*metadata)) read_imu(*metadata);
+}
+
+// The Ouster's own IMU (sensors/ouster_imu.hpp): its stream described in the
+// notes, and up from its accelerometer when it was still at the start.
+void PcapSource::read_imu(const fs::path& metadata) {
+  const OusterImuCalibration calibration = read_ouster_imu_calibration(metadata);
+  const std::vector<ImuSample> samples = read_ouster_imu(capture_, calibration.udp_port_imu);
+  if (samples.empty()) {
+    info_.notes.push_back(fmt::format("IMU: no packets on port {}", calibration.udp_port_imu));
+    return;
+  }
+  const ImuStreamStats stats = imu_stream_stats(samples);
+  info_.notes.push_back(fmt::format("IMU: {} samples on port {}, {:.0f} Hz, largest gap {:.3f} s; at rest ({} samples) "
+                                    "|a| {:.3f} m/s^2 ({:.3f} g), gyroscope noise {:.2f} deg/s",
+                                    stats.samples, calibration.udp_port_imu, stats.rate_hz, stats.largest_gap_s,
+                                    stats.rest_samples, stats.gravity_at_rest, stats.gravity_at_rest / kStandardGravity,
+                                    stats.gyro_noise_dps));
+  for (const std::string& problem : imu_stream_problems(stats)) info_.notes.push_back("IMU: " + problem);
+  if (const auto up = imu_up_at_rest(samples, calibration.imu_to_lidar_rotation())) {
+    info_.imu_up = *up;
+    info_.notes.push_back(fmt::format("IMU: up ({:.3f}, {:.3f}, {:.3f}) in the lidar frame, {:.1f} deg from its z",
+                                      up->x(), up->y(), up->z(), std::acos(std::clamp(up->z(), -1.0, 1.0)) * 180.0 / M_PI));
+  }
 }
 
 PcapSource::~PcapSource() = default;

@@ -94,6 +94,8 @@ class PcapSource final : public FrameSource {
  private:
   void index_capture();
 
+  void read_imu(const std::filesystem::path& metadata);
+
   std::filesystem::path capture_;
   std::unique_ptr<PcapReader> reader_;
   std::unique_ptr<CaptureDecoder> decoder_;

@@ -1,0 +1,288 @@
+#include "saloam/sensors/ouster_imu.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <initializer_list>
+#include <numbers>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "saloam/core/error.hpp"
+#include "saloam/io/text_input.hpp"
+#include "saloam/sensors/pcap_reader.hpp"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace saloam {
+namespace {
+
+constexpr double kDegToRad = std::numbers::pi / 180.0;
+
+/// The little-endian unsigned integer of `bytes` bytes at `offset`.
+std::uint64_t read_le(std::span<const std::byte> p, std::size_t offset, std::size_t bytes) {
+  std::uint64_t v = 0;
+  for (std::size_t i = 0; i < bytes; ++i) v |= std::to_integer<std::uint64_t>(p[offset + i]) << (8 * i);
+  return v;
+}
+
+double read_f32(std::span<const std::byte> p, std::size_t offset) {
+  return static_cast<double>(std::bit_cast<float>(static_cast<std::uint32_t>(read_le(p, offset, 4))));
+}
+
+/// The node at a "/"-separated path, or nullptr (null counts as absent).
+const json* find(const json& root, std::string_view path) {
+  const json* node = &root;
+  std::size_t start = 0;
+  while (start <= path.size()) {
+    const std::size_t slash = std::min(path.find('/', start), path.size());
+    const std::string key(path.substr(start, slash - start));
+    if (!node->is_object() || !node->contains(key)) return nullptr;
+    node = &(*node)[key];
+    start = slash + 1;
+  }
+  return node->is_null() ? nullptr : node;
+}
+
+/// The first of `paths` present, or nullptr.
+const json* find_any(const json& root, std::initializer_list<std::string_view> paths) {
+  for (const auto path : paths) {
+    if (const json* node = find(root, path)) return node;
+  }
+  return nullptr;
+}
+
+/// A 4x4 row-major rigid transform at `path`, checked.
+Eigen::Matrix4d read_transform(const json& root, std::string_view path, const fs::path& file) {
+  const json* node = find(root, path);
+  if (!node) throw InputError(file, fmt::format("Ouster metadata without \"{}\"", path));
+  if (!node->is_array() || node->size() != 16) {
+    throw InputError(file, fmt::format("Ouster metadata \"{}\": expected a list of 16 numbers", path));
+  }
+  Eigen::Matrix4d m;
+  for (int i = 0; i < 16; ++i) {
+    const json& v = (*node)[static_cast<std::size_t>(i)];
+    if (!v.is_number() || !std::isfinite(v.get<double>())) {
+      throw InputError(file, fmt::format("Ouster metadata \"{}\": unexpected value {}", path,
+                                         plain_error_text(v.dump(), 80)));
+    }
+    m(i / 4, i % 4) = v.get<double>();
+  }
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  const double off_orthogonal = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm();
+  if (off_orthogonal > 1e-3 || r.determinant() < 0.0) {
+    throw InputError(file, fmt::format("Ouster metadata \"{}\": its rotation is not one (|R^T R - I| = {:.3g}, "
+                                       "det {:.3g})", path, off_orthogonal, r.determinant()));
+  }
+  if (m.row(3) != Eigen::RowVector4d(0, 0, 0, 1)) {
+    throw InputError(file, fmt::format("Ouster metadata \"{}\": last row is not 0 0 0 1", path));
+  }
+  return m;
+}
+
+std::uint16_t read_port(const json* node, std::string_view key, const fs::path& file) {
+  if (!node) return 7503;
+  if (!node->is_number_integer() || node->get<std::int64_t>() < 1 || node->get<std::int64_t>() > 65535) {
+    throw InputError(file, fmt::format("Ouster metadata \"{}\": {} is not a port (1..65535)", key,
+                                       plain_error_text(node->dump(), 40)));
+  }
+  return static_cast<std::uint16_t>(node->get<std::int64_t>());
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// rate, periods, gaps, backwards and repeated steps.
+void time_stats(const std::vector<ImuSample>& samples, ImuStreamStats& s) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < samples.size(); ++i) {
+    const double dt = samples[i].time - samples[i - 1].time;
+    if (dt < 0.0) ++s.backwards_steps;
+    if (dt == 0.0) ++s.repeated_times;
+    if (dt > 0.0) steps.push_back(dt);
+  }
+  double forward = 0.0;
+  for (const double dt : steps) forward += dt;
+  s.rate_hz = forward > 0.0 ? static_cast<double>(steps.size()) / forward : 0.0;
+  s.median_period_s = median(steps);
+  s.largest_gap_s = steps.empty() ? 0.0 : *std::max_element(steps.begin(), steps.end());
+}
+
+/// The at-rest figures and the means over all samples.
+void motion_stats(const std::vector<ImuSample>& samples, ImuStreamStats& s) {
+  std::vector<double> gyro_norms;
+  Eigen::Vector3d gyro_sum = Eigen::Vector3d::Zero(), gyro_sq = Eigen::Vector3d::Zero();
+  double rest_norm_sum = 0.0, norm_sum = 0.0;
+  for (const auto& sample : samples) {
+    const double w = sample.angular_velocity.norm();
+    gyro_norms.push_back(w);
+    norm_sum += sample.acceleration.norm();
+    s.mean_acceleration += sample.acceleration;
+    if (!(w < kImuRestGyroRadS)) continue;
+    ++s.rest_samples;
+    rest_norm_sum += sample.acceleration.norm();
+    gyro_sum += sample.angular_velocity;
+    gyro_sq += sample.angular_velocity.cwiseAbs2();
+  }
+  if (samples.empty()) return;
+  const auto n = static_cast<double>(samples.size());
+  s.mean_acceleration /= n;
+  s.mean_acceleration_norm = norm_sum / n;
+  s.median_gyro_rad_s = median(gyro_norms);
+  s.largest_gyro_rad_s = *std::max_element(gyro_norms.begin(), gyro_norms.end());
+  const auto r = static_cast<double>(s.rest_samples);
+  if (s.rest_samples > 0) s.gravity_at_rest = rest_norm_sum / r;
+  if (s.rest_samples > 1) {
+    // Per-axis sample variance (n - 1), then the mean over the axes.
+    const Eigen::Vector3d variance = ((gyro_sq - gyro_sum.cwiseAbs2() / r) / (r - 1.0)).cwiseMax(0.0);
+    s.gyro_noise_dps = std::sqrt(variance.mean()) / kDegToRad;
+  }
+}
+
+void acceleration_problems(const ImuStreamStats& s, std::vector<std::string>& out) {
+  const bool rest = s.rest_samples > 0;
+  const double a = rest ? s.gravity_at_rest : s.mean_acceleration_norm;
+  const std::string what = rest ? "at rest" : "over all samples (none at rest)";
+  if (a > 0.7 && a < 1.5) {
+    out.push_back(fmt::format("mean |a| {} is {:.3f}: about 1, acceleration read in g, not m/s^2 "
+                              "(times {} wanted)", what, a, kStandardGravity));
+  } else if (a < 0.9 * kStandardGravity || a > 1.2 * kStandardGravity) {
+    out.push_back(fmt::format("mean |a| {} is {:.3f} m/s^2, far from gravity ({} m/s^2): wrong units or scale",
+                              what, a, kStandardGravity));
+  }
+}
+
+void gyro_problems(const ImuStreamStats& s, std::vector<std::string>& out) {
+  if (s.largest_gyro_rad_s > 20.0) {
+    out.push_back(fmt::format("angular velocity up to {:.1f} rad/s (over 20 rad/s): deg/s read as rad/s?",
+                              s.largest_gyro_rad_s));
+  }
+  if (s.rest_samples == 0 && s.median_gyro_rad_s > 10.0 * kImuRestGyroRadS) {
+    out.push_back(fmt::format("no sample with |w| under {} rad/s (median {:.2f} rad/s): the sensor never still, "
+                              "or deg/s read as rad/s", kImuRestGyroRadS, s.median_gyro_rad_s));
+  }
+}
+
+void time_problems(const ImuStreamStats& s, std::vector<std::string>& out) {
+  if (s.backwards_steps > 0) out.push_back(fmt::format("time goes backwards {} times", s.backwards_steps));
+  if (s.repeated_times > 0) {
+    out.push_back(fmt::format("{} samples repeat the time before them (duplicated packets?)", s.repeated_times));
+  }
+  if (s.median_period_s > 0.0 && s.largest_gap_s > 3.0 * s.median_period_s) {
+    out.push_back(fmt::format("a gap of {:.4f} s, {:.1f} times the median period {:.4f} s (samples lost)",
+                              s.largest_gap_s, s.largest_gap_s / s.median_period_s, s.median_period_s));
+  }
+}
+
+}  // namespace
+
+std::optional<ImuSample> decode_ouster_imu_packet(std::span<const std::byte> payload) {
+  if (payload.size() != kOusterImuPacketBytes) return std::nullopt;
+  ImuSample s;
+  s.time = static_cast<double>(read_le(payload, 8, 8)) * 1e-9;
+  for (int i = 0; i < 3; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    s.acceleration[i] = read_f32(payload, 24 + 4 * k) * kStandardGravity;
+    s.angular_velocity[i] = read_f32(payload, 36 + 4 * k) * kDegToRad;
+  }
+  if (!s.acceleration.allFinite() || !s.angular_velocity.allFinite()) return std::nullopt;
+  return s;
+}
+
+std::vector<ImuSample> read_ouster_imu(const fs::path& pcap, std::uint16_t imu_port, ImuReadCounts* counts) {
+  PcapReader reader(pcap);
+  ImuReadCounts c;
+  std::vector<ImuSample> samples;
+  UdpDatagram d;
+  while (reader.next(d)) {
+    if (d.dst_port != imu_port) continue;
+    ++c.datagrams;
+    if (d.payload.size() != kOusterImuPacketBytes) {
+      ++c.wrong_size;
+    } else if (const auto s = decode_ouster_imu_packet(std::as_bytes(std::span(d.payload)))) {
+      samples.push_back(*s);
+    } else {
+      ++c.non_finite;
+    }
+  }
+  if (counts) *counts = c;
+  return samples;
+}
+
+Eigen::Matrix3d OusterImuCalibration::imu_to_lidar_rotation() const {
+  return lidar_to_sensor.topLeftCorner<3, 3>().transpose() * imu_to_sensor.topLeftCorner<3, 3>();
+}
+
+OusterImuCalibration parse_ouster_imu_calibration(std::string_view text, const fs::path& file) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(file, fmt::format("not JSON (Ouster metadata expected): {}", e.what()));
+  }
+  if (!root.is_object()) throw InputError(file, "not a JSON object (Ouster metadata expected)");
+  const bool nested = root.contains("sensor_info") || root.contains("lidar_data_format") ||
+                      root.contains("beam_intrinsics") || root.contains("imu_intrinsics");
+  OusterImuCalibration c;
+  const std::string_view port_key = nested ? "config_params/udp_port_imu" : "udp_port_imu";
+  c.udp_port_imu = read_port(find(root, port_key), port_key, file);
+  c.imu_to_sensor =
+      read_transform(root, nested ? "imu_intrinsics/imu_to_sensor_transform" : "imu_to_sensor_transform", file);
+  c.lidar_to_sensor =
+      read_transform(root, nested ? "lidar_intrinsics/lidar_to_sensor_transform" : "lidar_to_sensor_transform", file);
+  const json* profile = nested ? find_any(root, {"lidar_data_format/udp_profile_imu", "config_params/udp_profile_imu"})
+                               : find(root, "data_format/udp_profile_imu");
+  if (profile && (!profile->is_string() || profile->get<std::string>() != "LEGACY")) {
+    throw InputError(file, fmt::format("udp_profile_imu {} is not one saloam decodes (LEGACY, 48-byte packets)",
+                                       plain_error_text(profile->dump(), 60)));
+  }
+  return c;
+}
+
+OusterImuCalibration read_ouster_imu_calibration(const fs::path& file) {
+  return parse_ouster_imu_calibration(open_text_file(file, "Ouster metadata").str(), file);
+}
+
+ImuSample rotated(const ImuSample& sample, const Eigen::Matrix3d& rotation) {
+  return {sample.time, rotation * sample.acceleration, rotation * sample.angular_velocity};
+}
+
+ImuStreamStats imu_stream_stats(const std::vector<ImuSample>& samples) {
+  ImuStreamStats s;
+  s.samples = samples.size();
+  time_stats(samples, s);
+  motion_stats(samples, s);
+  return s;
+}
+
+std::vector<std::string> imu_stream_problems(const ImuStreamStats& s) {
+  if (s.samples == 0) return {"no IMU samples"};
+  std::vector<std::string> out;
+  acceleration_problems(s, out);
+  gyro_problems(s, out);
+  time_problems(s, out);
+  return out;
+}
+
+std::optional<Eigen::Vector3d> imu_up_at_rest(const std::vector<ImuSample>& samples, const Eigen::Matrix3d& rotation) {
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  std::size_t still = 0;
+  for (std::size_t i = 0; i < std::min(samples.size(), kImuUpSamples); ++i) {
+    if (samples[i].angular_velocity.norm() >= kImuRestGyroRadS) continue;
+    sum += samples[i].acceleration;
+    ++still;
+  }
+  if (still < 5) return std::nullopt;
+  const Eigen::Vector3d mean = sum / static_cast<double>(still);
+  if (!mean.allFinite() || mean.norm() < 0.8 * kStandardGravity || mean.norm() > 1.2 * kStandardGravity) return std::nullopt;
+  return (rotation * mean).normalized();
+}
+
+}  // namespace saloam
