@@ -133,8 +133,11 @@ struct GravityConfig {
   /// yaw [deg] (R = Rz(yaw) Ry(pitch) Rx(roll), the URDF / ROS convention), as
   /// a `base_link` robot publishes it; the base's z is up. Empty: not given.
   std::vector<double> mount_rpy_deg;
-  /// Without a mount: estimate up from the scans (true) or take the sensor's
-  /// z as up (false).
+  /// Without a mount: take up from the sensor's own IMU at rest when the
+  /// source has one (an Ouster capture's IMU packets).
+  bool use_imu = true;
+  /// Without a mount (or IMU): estimate up from the scans (true) or take the
+  /// sensor's z as up (false).
   bool estimate = true;
   /// Scans are looked at every this many frames to refine the estimate (or,
   /// with a mount, to check it).
@@ -457,7 +460,8 @@ template <class Visitor>
 void visit_fields(GravityConfig& c, Visitor&& v) {
   v("mount_rpy_deg", c.mount_rpy_deg, "[deg] R_base<-sensor as roll pitch yaw ([] = not given: estimate or assume)",
     Range{-360, 360});
-  v("estimate", c.estimate, "without a mount, estimate up from the scans (false: the sensor's z is up)");
+  v("use_imu", c.use_imu, "without a mount, take up from the sensor's own IMU at rest when the source has one");
+  v("estimate", c.estimate, "without a mount or IMU, estimate up from the scans (false: the sensor's z is up)");
   v("refine_every_frames", c.refine_every_frames, "scans looked at every this many frames to refine up", AtLeast{1});
   v("mount_warning_deg", c.mount_warning_deg, "[deg] warn when the scans' up differs from the mount's by more",
     Range{0, 180});

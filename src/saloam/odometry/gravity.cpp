@@ -48,6 +48,11 @@ constexpr std::size_t kMaxCandidates = 96;
 /// whose ground votes weighed as much as the walls still saw up 6 deg off
 /// gravity 150 m later).
 constexpr double kUprightWeight = 3.0;
+/// A candidate up's score grows by this share of itself times its cosine
+/// with the sensor's z (scan_up()); candidates farther than kMaxSearchTilt
+/// [deg] from the sensor's z are not tried.
+constexpr double kUprightPrior = 0.25;
+constexpr double kMaxSearchTilt = 60.0;
 /// Refinement rounds of a scan's up (votes re-classified each round).
 constexpr int kRefineRounds = 4;
 /// The scans contradict a given mount only with this many votes behind them.
@@ -234,13 +239,15 @@ UpEvidence scan_up_evidence(const LabelledCloud& cloud, bool use_labels, const E
   return classify(voxel_shapes(cloud, use_labels), use_labels, reference.normalized());
 }
 
-std::optional<Eigen::Vector3d> scan_up(const LabelledCloud& cloud, bool use_labels) {
+std::optional<Eigen::Vector3d> scan_up(const LabelledCloud& cloud, bool use_labels,
+                                       const std::optional<Eigen::Vector3d>& prior) {
   const std::vector<VoxelShape> shapes = voxel_shapes(cloud, use_labels);
   std::vector<const VoxelShape*> planar;
   for (const VoxelShape& s : shapes) {
     if (s.planar) planar.push_back(&s);
   }
   if (planar.size() < kMinPlanarVotes) return std::nullopt;
+  if (prior) return refined_up(shapes, use_labels, prior->normalized());
   // Candidates: the sensor's z and every k-th planar normal, both signs.
   std::vector<Eigen::Vector3d> candidates{Eigen::Vector3d::UnitZ()};
   const std::size_t step = std::max<std::size_t>(1, planar.size() / kMaxCandidates);
@@ -251,7 +258,13 @@ std::optional<Eigen::Vector3d> scan_up(const LabelledCloud& cloud, bool use_labe
   Eigen::Vector3d best = candidates.front();
   double best_score = -1;
   for (const Eigen::Vector3d& c : candidates) {
-    const double score = candidate_score(shapes, use_labels, c);
+    // Sensors are mounted about upright more often than not: in a box of a
+    // room or a corridor, where a wall explains the scan as well as the
+    // floor, the candidate nearer the sensor's z wins, and none beyond
+    // kMaxSearchTilt is taken (a sensor mounted on its side needs its mount
+    // or an IMU).
+    if (c.z() < std::cos(kMaxSearchTilt * kDeg)) continue;
+    const double score = candidate_score(shapes, use_labels, c) * (1.0 + kUprightPrior * std::max(0.0, c.z()));
     if (score > best_score) {
       best_score = score;
       best = c;
@@ -314,11 +327,12 @@ std::string GravityReport::describe() const {
 void GravityTracker::start(const LabelledCloud& first_scan, bool use_labels) {
   started_ = true;
   const bool mount = config_.mount_rpy_deg.size() == 3;
-  const bool given = mount || config_.imu_up.has_value();
+  const bool imu = config_.use_imu && config_.imu_up.has_value();
+  const bool given = mount || imu;
   if (mount) {
     source_ = UpSource::kMount;
     up_ = mount_up(config_.mount_rpy_deg);
-  } else if (config_.imu_up) {
+  } else if (imu) {
     source_ = UpSource::kImu;
     up_ = config_.imu_up->normalized();
   } else if (!config_.estimate) {
@@ -326,7 +340,9 @@ void GravityTracker::start(const LabelledCloud& first_scan, bool use_labels) {
     up_ = Eigen::Vector3d::UnitZ();
     return;
   }
-  const std::optional<Eigen::Vector3d> from_scan = scan_up(first_scan, use_labels);
+  // A given up is refined by the scans (to check it), not searched for.
+  const std::optional<Eigen::Vector3d> from_scan =
+      scan_up(first_scan, use_labels, given ? std::optional<Eigen::Vector3d>(up_) : std::nullopt);
   if (!from_scan) return;
   evidence_ = scan_up_evidence(first_scan, use_labels, *from_scan);
   scans_up_ = *from_scan;

@@ -68,11 +68,15 @@ double up_spread_deg(const UpEvidence& evidence, const Eigen::Vector3d& up);
 /// below the sensor; level: within 25 deg of level).
 UpEvidence scan_up_evidence(const LabelledCloud& cloud, bool use_labels, const Eigen::Vector3d& reference);
 
-/// Up in the frame of a single scan with no prior: each planar vote's normal
-/// (both signs) is tried as up and scored by the votes it explains; the best
-/// is refined with scan_up_evidence. Nothing when the scan has too few
-/// planar votes (fewer than 20).
-std::optional<Eigen::Vector3d> scan_up(const LabelledCloud& cloud, bool use_labels);
+/// Up in the frame of a single scan. With no prior, each planar vote's
+/// normal (both signs) within 60 deg of the sensor's z is tried as up and
+/// scored by the votes it explains (the sensor's z slightly preferred: in a
+/// room a wall explains a scan as well as the floor; a sensor mounted on its
+/// side needs its mount or an IMU); the best is refined with the votes
+/// classified against it. With a prior (a mount, an IMU), the prior is
+/// refined. Nothing when the scan has too few planar votes (fewer than 20).
+std::optional<Eigen::Vector3d> scan_up(const LabelledCloud& cloud, bool use_labels,
+                                       const std::optional<Eigen::Vector3d>& prior = std::nullopt);
 
 /// The rotation of least angle taking `up` to z: R * up = (0, 0, 1), the
 /// frame of a scan turned level (yaw unchanged as far as a tilt allows).
