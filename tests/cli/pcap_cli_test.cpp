@@ -90,8 +90,10 @@ TEST(PcapCli, ASimulatedVelodyneCaptureGivesTheFoldersPoses) {
     rotation = std::max(rotation, Eigen::AngleAxisd(d.rotation()).angle());
   }
   std::cout << "folder against capture: up to " << translation * 100 << " cm, " << rotation * 180 / 3.14159265 << " deg\n";
-  // Measured: 0.9 cm and 0.03 deg at most over the 20 frames (14 m), from the 2 mm and 0.01 deg rounding alone.
-  EXPECT_LT(translation, 0.015);
+  // Measured: 1.7 cm and 0.03 deg at most over the 20 frames (14 m), from
+  // the 2 mm and 0.01 deg rounding alone (0.9 cm while up was the sensor's
+  // z: each run now finds up in its own, differently rounded, points).
+  EXPECT_LT(translation, 0.025);
   EXPECT_LT(rotation, 0.05 * 3.14159265 / 180);
 }
 

@@ -281,7 +281,7 @@ std::optional<Eigen::Vector3d> imu_up_at_rest(const std::vector<ImuSample>& samp
   }
   if (still < 5) return std::nullopt;
   const Eigen::Vector3d mean = sum / static_cast<double>(still);
-  if (!mean.allFinite() || mean.norm() < 0.8 * kStandardGravity || mean.norm() > 1.2 * kStandardGravity) return std::nullopt;
+  if (!mean.allFinite() || std::abs(mean.norm() / kStandardGravity - 1.0) > kImuRestTolerance) return std::nullopt;
   return (rotation * mean).normalized();
 }
 
