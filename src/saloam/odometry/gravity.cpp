@@ -22,6 +22,9 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr double kVoteVoxel = 1.0;
 /// At most this many points of a scan are looked at (every k-th).
 constexpr std::size_t kMaxVotePoints = 60000;
+/// [m] Points farther out along an axis do not vote (no sensor sees so far;
+/// their voxel keys would not fit).
+constexpr double kFarthestVote = 1e5;
 /// A voxel needs this many points to vote.
 constexpr int kMinVoxelPoints = 6;
 /// Planar voxel: smallest eigenvalue below this share of the middle one,
@@ -95,7 +98,7 @@ std::vector<VoxelShape> voxel_shapes(const LabelledCloud& cloud, bool use_labels
   const bool labels = use_labels && cloud.label.size() == cloud.size();
   for (std::size_t i = 0; i < cloud.size(); i += step) {
     const Eigen::Vector3d p = cloud.points[i].cast<double>();
-    if (!p.allFinite()) continue;
+    if (!p.allFinite() || p.cwiseAbs().maxCoeff() > kFarthestVote) continue;
     const auto cell = [&](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / kVoteVoxel)) + (1 << 20)) & 0x1fffff; };
     const std::uint64_t key = cell(p.x()) | cell(p.y()) << 21 | cell(p.z()) << 42;
     VoxelSums& v = voxels[key];
