@@ -99,7 +99,9 @@ std::vector<VoxelShape> voxel_shapes(const LabelledCloud& cloud, bool use_labels
   for (std::size_t i = 0; i < cloud.size(); i += step) {
     const Eigen::Vector3d p = cloud.points[i].cast<double>();
     if (!p.allFinite() || p.cwiseAbs().maxCoeff() > kFarthestVote) continue;
-    const auto cell = [&](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / kVoteVoxel)) + (1 << 20)) & 0x1fffff; };
+    const auto cell = [](double v) {
+      return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / kVoteVoxel)) + (1 << 20)) & 0x1fffff;
+    };
     const std::uint64_t key = cell(p.x()) | cell(p.y()) << 21 | cell(p.z()) << 42;
     VoxelSums& v = voxels[key];
     ++v.count;
