@@ -72,7 +72,12 @@ double LidarModel::column_fraction(int column) const { return (column + 0.5) / a
 double LidarModel::column_azimuth(int column) const { return kPi - 2.0 * kPi * column_fraction(column); }
 
 Pose column_pose(const LidarModel& lidar, const SweepSpec& sweep, int column) {
-  return sweep.skew ? interpolate(sweep.start, sweep.end, lidar.column_fraction(column)) : sweep.start;
+  if (!sweep.skew) return sweep.start;
+  const double fraction = lidar.column_fraction(column);
+  if (sweep.knots.size() < 2) return interpolate(sweep.start, sweep.end, fraction);
+  const double f = fraction * static_cast<double>(sweep.knots.size() - 1);
+  const auto i = std::min(static_cast<std::size_t>(f), sweep.knots.size() - 2);
+  return interpolate(sweep.knots[i], sweep.knots[i + 1], f - static_cast<double>(i));
 }
 
 std::vector<Eigen::Vector3d> points_in_world(const SimulatedScan& scan, const LidarModel& lidar, const SweepSpec& sweep) {

@@ -70,6 +70,11 @@ struct LidarModel {
 struct SweepSpec {
   Pose start = Pose::Identity();
   Pose end = Pose::Identity();
+  /// Poses at evenly spaced instants from start (first) to end (last), for
+  /// motion that is not linear within a sweep (the handheld walk): a column's
+  /// pose interpolates between the two around its instant. Empty: linear
+  /// from start to end.
+  std::vector<Pose> knots;
   double time_start = 0;
   double time_end = 0.1;
   std::uint64_t seed = 0;

@@ -191,19 +191,40 @@ LidarModel lidar_for(const SimulationOptions& options) {
   return lidar;
 }
 
+// The world is built along the trajectory, or along a preset's own track
+// (the handheld walk's path, without its gait and look-arounds).
 World world_for(const std::vector<Pose>& trajectory, const SimulationOptions& options) {
   WorldOptions world_options = options.world;
   world_options.frame_period = options.frame_period;
   world_options.sensor_height = sensor_mount_height(options);
-  if (options.camera_poses.empty() && preset_on_hillside(options.preset)) world_options.hillside = true;
-  return build_world(trajectory, options.seed, world_options);
+  if (!options.camera_poses.empty()) return build_world(trajectory, options.seed, world_options);
+  if (preset_on_hillside(options.preset)) world_options.hillside = true;
+  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+  const std::vector<Pose> track = preset_motion(options.preset) ? mounted(preset_track(options.preset, options.frame_period), dz)
+                                                                : trajectory;
+  return build_world(track, options.seed, world_options);
 }
+
+// A preset's motion within sweeps at the sensor's mount height; empty for
+// trajectories that are linear between frames.
+ContinuousMotion continuous_motion(const SimulationOptions& options) {
+  if (!options.camera_poses.empty()) return {};
+  ContinuousMotion motion = preset_motion(options.preset);
+  if (!motion) return {};
+  if (!options.passes.empty()) throw ConfigError(fmt::format("the {} preset is walked once: it takes no passes", options.preset));
+  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+  return [motion = std::move(motion), dz](double t) { return Pose(motion(t) * Eigen::Translation3d(0.0, 0.0, dz)); };
+}
+
+// Knots of a sweep with continuous motion: 20 steps per sweep (5 ms at 10 Hz).
+constexpr int kSweepKnots = 21;
 
 }  // namespace
 
 SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
     : options_(options),
       trajectory_(source_lidar_trajectory(options)),
+      motion_(continuous_motion(options)),
       frames_(selected_frames(options, trajectory_.size())),
       mount_(rotation_from_rpy_deg(options.mount_rpy_deg)),
       cloud_frame_(rotation_from_rpy_deg(options.cloud_frame_rpy_deg)),
@@ -241,6 +262,12 @@ Eigen::Vector3d SimulatedSequence::first_scan_up() const {
 
 SimulatedFrame SimulatedSequence::render(std::size_t k) const {
   SweepSpec sweep = sweep_for_frame(trajectory_, frames_.at(k), options_);
+  if (motion_) {
+    for (int j = 0; j < kSweepKnots; ++j) {
+      const double f = static_cast<double>(j) / (kSweepKnots - 1);
+      sweep.knots.push_back(motion_(sweep.time_start + f * (sweep.time_end - sweep.time_start)) * Pose(mount_));
+    }
+  }
   sweep.start = sweep.start * Pose(mount_);
   sweep.end = sweep.end * Pose(mount_);
   SimulatedScan scan = simulate_scan(world_, lidar_, rays_, sweep);

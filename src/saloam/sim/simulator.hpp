@@ -26,6 +26,7 @@
 #include "saloam/sim/class_shares.hpp"
 #include "saloam/sim/lidar.hpp"
 #include "saloam/sim/label_noise.hpp"
+#include "saloam/sim/trajectories.hpp"
 #include "saloam/sim/world.hpp"
 
 namespace saloam {
@@ -169,6 +170,9 @@ class SimulatedSequence {
  private:
   SimulationOptions options_;
   std::vector<Pose> trajectory_;  ///< source trajectory, LiDAR frame
+  /// The preset's motion within sweeps (the handheld walk), at the sensor's
+  /// mount height; empty: linear between trajectory_'s poses.
+  ContinuousMotion motion_;
   std::vector<std::size_t> frames_;
   Eigen::Matrix3d mount_;        ///< R_vehicle<-sensor
   Eigen::Matrix3d cloud_frame_;  ///< R_cloud<-sensor

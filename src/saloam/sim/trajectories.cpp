@@ -4,12 +4,14 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
+#include "saloam/sim/handheld_walk.hpp"
 
 namespace saloam {
 namespace {
@@ -383,9 +385,23 @@ std::vector<Pose> ramp_start(double frame_period) {
   return drive(ramp_start_plan(), 10.0, frame_period, relief, true);
 }
 
+// A walk's poses (sensor or track) every frame_period over its duration.
+std::vector<Pose> sampled(const HandheldWalk& walk, Pose (HandheldWalk::*pose)(double) const, double frame_period) {
+  std::vector<Pose> poses;
+  const auto frames = static_cast<std::size_t>(std::floor(walk.duration() / frame_period + 1e-9)) + 1;
+  for (std::size_t i = 0; i < frames; ++i) poses.push_back((walk.*pose)(static_cast<double>(i) * frame_period));
+  return poses;
+}
+
+ConfigError unknown_preset(const std::string& name) {
+  return ConfigError(fmt::format("unknown preset '{}' (choose one of: {})", name, fmt::join(preset_names(), ", ")));
+}
+
 }  // namespace
 
-std::vector<std::string> preset_names() { return {"urban-loop", "figure-eight", "straight", "hill-climb", "ramp-start"}; }
+std::vector<std::string> preset_names() {
+  return {"urban-loop", "figure-eight", "straight", "hill-climb", "ramp-start", "handheld-walk"};
+}
 
 bool preset_on_hillside(const std::string& name) { return name == "hill-climb"; }
 
@@ -396,7 +412,19 @@ std::vector<Pose> preset_trajectory(const std::string& name, double frame_period
   if (name == "straight") return drive(straight_road(), 10.0, frame_period);
   if (name == "hill-climb") return hill_climb(frame_period);
   if (name == "ramp-start") return ramp_start(frame_period);
-  throw ConfigError(fmt::format("unknown preset '{}' (choose one of: {})", name, fmt::join(preset_names(), ", ")));
+  if (name == "handheld-walk") return sampled(HandheldWalk(), &HandheldWalk::sensor, frame_period);
+  throw unknown_preset(name);
+}
+
+ContinuousMotion preset_motion(const std::string& name) {
+  if (name != "handheld-walk") return {};
+  return [walk = std::make_shared<const HandheldWalk>()](double t) { return walk->sensor(t); };
+}
+
+std::vector<Pose> preset_track(const std::string& name, double frame_period) {
+  if (name != "handheld-walk") return preset_trajectory(name, frame_period);
+  if (frame_period <= 0) throw ConfigError("frame period must be positive");
+  return sampled(HandheldWalk(), &HandheldWalk::track, frame_period);
 }
 
 Pose kitti_velo_to_cam() {
