@@ -162,7 +162,7 @@ struct OdometryConfig {
   /// and of simulated runs (docs/odometry.md).
   bool deskew = true;
   int max_iterations = 10;       ///< Gauss-Newton iterations per outer loop
-  int outer_iterations = 3;      ///< re-association rounds (at most)
+  int outer_iterations = 3;      ///< re-association rounds (beyond, only while far off: far_outer_iterations)
   /// A round that moved the pose less than this (and after which the scan
   /// did not need de-skewing again) ends the re-association early (0 =
   /// always all rounds): most frames converge in fewer rounds, at nearly the

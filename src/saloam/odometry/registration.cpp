@@ -1,5 +1,6 @@
 #include "saloam/odometry/registration.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <type_traits>
@@ -13,6 +14,18 @@
 
 namespace saloam {
 
+namespace {
+// Rounds in all for a scan far from its optimum (far_outer_iterations): a
+// handheld sensor's look-around, missed by up to ~20 deg, needs ~15
+// (docs/odometry.md, "Fast turns"). Not in OdometryConfig yet.
+constexpr int kFarOuterIterations = 20;
+// A scan whose pose has moved this far from its initial guess over the
+// first outer_iterations rounds started far off: a vehicle's constant-velocity
+// prediction misses by ~1 cm and ~0.1 deg, a hand's look-around by degrees.
+constexpr double kFarTranslation = 0.1;          // [m]
+constexpr double kFarRotation = M_PI / 180.0;    // [rad]
+}  // namespace
+
 RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& config) {
   RegistrationSettings s;
   s.edge_neighbours = config.edge_neighbours;
@@ -21,6 +34,7 @@ RegistrationSettings RegistrationSettings::from_config(const OdometryConfig& con
   s.robust_kernel_scale = config.robust_kernel_scale;
   s.max_iterations = config.max_iterations;
   s.outer_iterations = config.outer_iterations;
+  s.far_outer_iterations = kFarOuterIterations;
   s.reassociation_min_translation = config.reassociation_min_translation;
   s.reassociation_min_rotation = config.reassociation_min_rotation_deg * M_PI / 180.0;
   s.plane_normal_tolerance = config.plane_normal_tolerance;
@@ -283,6 +297,28 @@ bool solve(const FeatureCloud& edges, const FeatureCloud& planars, const std::ve
   return true;
 }
 
+// Whether to associate again after `rounds` rounds, the last of which moved
+// the pose by `moved`, all of them by `from_initial`. `refresh` moves the
+// scan's points (e.g. de-skews them again) for the next round and says
+// whether it did; it runs only when another round follows. Up to
+// outer_iterations rounds, a refreshed scan or a pose that moved by the
+// re-association thresholds goes on; beyond, up to far_outer_iterations, a
+// scan that started far off (kFarTranslation, kFarRotation) while its pose
+// still moves so (a refresh alone, which follows every pose change of a fast
+// turn, does not).
+template <typename Refresh>
+bool another_round(int rounds, const Pose& moved, const Pose& from_initial, const RegistrationSettings& s,
+                   const Refresh& refresh) {
+  const bool moving = moved.translation().norm() >= s.reassociation_min_translation ||
+                      rotation_angle(moved) >= s.reassociation_min_rotation;
+  if (rounds < s.outer_iterations) return refresh() || moving;
+  const bool far = from_initial.translation().norm() >= kFarTranslation || rotation_angle(from_initial) >= kFarRotation;
+  const bool thresholds = s.reassociation_min_translation > 0 && s.reassociation_min_rotation > 0;
+  if (rounds >= s.far_outer_iterations || !thresholds || !far || !moving) return false;
+  refresh();
+  return true;
+}
+
 // Outer rounds: associate at the current pose, solve, refresh the scan (e.g.
 // de-skew it again). Re-associating only pays when the pose or the points
 // moved: a shift well below the map resolution leaves the neighbour sets
@@ -296,18 +332,13 @@ RegistrationResult register_features(const FeatureCloud& edges, const FeatureClo
   std::vector<Match> edge_matches(edges.size());
   std::vector<Match> plane_matches(planars.size());
   const double lever = feature_lever(edges, planars);
-  for (int outer = 0; outer < std::max(1, settings.outer_iterations); ++outer) {
+  for (int rounds = 1;; ++rounds) {
     const Pose round_start = T;
     associate(edges, planars, map, T, settings, edge_matches, plane_matches, result);
     if (result.correspondences() < 20) return result;  // not enough to constrain 6 DoF reliably
     if (!solve(edges, planars, edge_matches, plane_matches, settings, lever, T, result)) return result;
-    if (outer + 1 >= settings.outer_iterations) break;
-    const bool refreshed = refresh && refresh(T);
-    const Pose moved = round_start.inverse() * T;
-    if (!refreshed && moved.translation().norm() < settings.reassociation_min_translation &&
-        rotation_angle(moved) < settings.reassociation_min_rotation) {
-      break;
-    }
+    const Pose moved = round_start.inverse() * T, from_initial = initial.inverse() * T;
+    if (!another_round(rounds, moved, from_initial, settings, [&] { return refresh && refresh(T); })) break;
   }
   result.pose = T;
   result.ok = true;

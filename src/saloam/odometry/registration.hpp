@@ -40,6 +40,13 @@ struct RegistrationSettings {
   /// An outer round that moved the pose less than this ends the re-association.
   double reassociation_min_translation{};  ///< [m] (0: always all rounds)
   double reassociation_min_rotation{};     ///< [rad]
+  /// A scan that started far off (its pose moved by more than 0.1 m or 1 deg
+  /// from the initial guess in outer_iterations rounds, as after a fast turn
+  /// that the prediction missed) re-associates on while its pose still moves
+  /// by the thresholds above, up to this many rounds in all: each round's
+  /// neighbours lie within max_correspondence_distance, so an error of many
+  /// of them is walked in round by round. <= outer_iterations: never beyond.
+  int far_outer_iterations{};
   double plane_normal_tolerance{};         ///< plane constraint: tolerance on |n . up|
   /// A fitted line with |direction . up| below this is matched as the vertical
   /// plane through it (a 1-D residual across it, horizontal); 0: every line

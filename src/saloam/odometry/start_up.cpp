@@ -35,6 +35,7 @@ RegistrationResult StartUp::register_second_frame(ScanFeatures& features, const 
                                                   int& rounds) const {
   RegistrationSettings settings = steady;
   settings.outer_iterations = std::max(settings.outer_iterations, kOuterIterations);
+  settings.far_outer_iterations = 0;  // its own rounds: the guess is known to be far off
   settings.reassociation_min_translation = std::max(settings.reassociation_min_translation, kSettledTranslation);
   settings.reassociation_min_rotation = std::max(settings.reassociation_min_rotation, kSettledRotation);
   auto fit = [&](const SemanticLocalMap& to, const Pose& from, const RegistrationSettings& with) {

@@ -49,6 +49,7 @@ LoopVerificationSettings LoopVerificationSettings::from_config(const SaloamConfi
   s.fine.parallel = false;
   s.fine.max_iterations = kIterations;
   s.fine.outer_iterations = kFineRounds;
+  s.fine.far_outer_iterations = 0;  // a bounded budget per candidate, met or not
   s.fine.inlier_distance = config.loop.inlier_distance;
   // A loop's fit is judged for degeneracy (min_translation_eigenvalue), not held at its guess.
   s.fine.degeneracy_eigenvalue = 0;
