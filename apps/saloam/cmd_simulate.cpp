@@ -16,6 +16,7 @@
 #include "saloam/core/frame_range.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/semantic_classes.hpp"
+#include "saloam/imu/imu_noise.hpp"
 #include "saloam/io/calibration.hpp"
 #include "saloam/io/trajectory_io.hpp"
 #include "saloam/sim/class_shares.hpp"
@@ -175,6 +176,9 @@ int run_simulate(const SimulateArgs& args) {
   spdlog::info("simulating {} ({}, seed {}, skew {}, labels {}) into {}", source,
                options.sensor ? options.sensor->title() : fmt::format("{} beams of the HDL-64E", options.beams),
                options.seed, options.skew ? "on" : "off", options.labels == LabelMode::kNoisy ? "noisy" : "gt", args.out);
+  if (!options.imu.empty() && args.format != "semantickitti") {
+    throw ConfigError("--imu writes imu.txt beside a SemanticKITTI-layout sequence: leave --format at semantickitti");
+  }
   if (args.format == "velodyne-pcap") return write_velodyne_pcap(options, args);
   if (args.format != "semantickitti") return write_in_layout(options, args);
   const SimulationSummary s = simulate_sequence(options, args.out);
@@ -247,6 +251,11 @@ const CommandRegistration kRegistration{Command{
                      "The scans written in a frame turned against the sensor's: roll pitch yaw [deg] (R_cloud<-sensor), "
                      "as a driver publishing in a robot's base link; Tr in calib.txt follows")
           ->expected(1, 3);
+      app.add_option("--imu", args->sim.imu,
+                     "An IMU riding in the sensor, written as OUT/imu.txt (time, specific force, angular velocity in the "
+                     "scans' frame): icm-20948 (inside Ouster sensors, 100 Hz) or adis16465 (400 Hz), with their noise "
+                     "and biases; needs motion within sweeps (--preset handheld-walk)")
+          ->check(CLI::IsMember(imu_model_names()));
       app.add_flag("--no-skew", args->no_skew, "Take each scan at one instant (no motion distortion)");
       app.add_flag("--no-dynamic", args->no_dynamic, "No moving cars or pedestrians");
       app.add_flag("--stats", args->stats,

@@ -1,5 +1,6 @@
 #include "saloam/io/text_input.hpp"
 
+#include <cmath>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -13,7 +14,39 @@ namespace {
 
 constexpr std::string_view kUtf8Bom = "\xEF\xBB\xBF";
 
+bool is_blank_or_comment(const std::string& line) {
+  const auto first = line.find_first_not_of(" \t\r");
+  return first == std::string::npos || line[first] == '#';
+}
+
+/// Parses all numbers of a line; throws with the line number on junk or non-finite values.
+std::vector<double> parse_numbers(const std::string& line, const std::filesystem::path& file, std::size_t line_no) {
+  std::vector<double> values;
+  std::istringstream ss(line);
+  std::string token;
+  while (ss >> token) {
+    double v = 0.0;
+    std::size_t used = 0;
+    try {
+      v = std::stod(token, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != token.size()) throw InputError(file, fmt::format("line {}: '{}' is not a number", line_no, token));
+    if (!std::isfinite(v)) throw InputError(file, fmt::format("line {}: non-finite value '{}'", line_no, token));
+    values.push_back(v);
+  }
+  return values;
+}
+
 }  // namespace
+
+void for_each_number_line(std::istream& in, const std::filesystem::path& file,
+                          const std::function<void(const std::vector<double>& numbers, std::size_t line_no)>& on_line) {
+  for_each_text_line(in, file, [&](const std::string& line, std::size_t line_no) {
+    if (!is_blank_or_comment(line)) on_line(parse_numbers(line, file, line_no), line_no);
+  });
+}
 
 std::istringstream open_text_file(const std::filesystem::path& file, std::string_view what) {
   return std::istringstream(read_file(file, kMaxTextFileBytes, what));

@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "saloam/core/types.hpp"
 
@@ -33,6 +34,12 @@ void for_each_text_line(std::istream& in, const std::filesystem::path& file,
 /// or unreadable (`what` names the kind of file in the message). Nothing
 /// waits: a FIFO in its place is refused, not read.
 std::istringstream open_text_file(const std::filesystem::path& file, std::string_view what = "file");
+
+/// Calls on_line(numbers, line_no) for every line that is neither blank nor
+/// a comment ('#' first): its whitespace-separated numbers. InputError (file,
+/// line) on a token that is not a number or not finite.
+void for_each_number_line(std::istream& in, const std::filesystem::path& file,
+                          const std::function<void(const std::vector<double>& numbers, std::size_t line_no)>& on_line);
 
 /// T with its rotation projected back onto SO(3). InputError (file, line)
 /// when the rotation is not one: ||R^T R - I|| > kRotationTolerance (a scale

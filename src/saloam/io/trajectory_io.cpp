@@ -16,38 +16,6 @@
 namespace saloam {
 namespace {
 
-bool is_blank_or_comment(const std::string& line) {
-  const auto first = line.find_first_not_of(" \t\r");
-  return first == std::string::npos || line[first] == '#';
-}
-
-/// Parses all numbers of a line; throws with the line number on junk or non-finite values.
-std::vector<double> parse_numbers(const std::string& line, const std::filesystem::path& file, std::size_t line_no) {
-  std::vector<double> values;
-  std::istringstream ss(line);
-  std::string token;
-  while (ss >> token) {
-    double v = 0.0;
-    std::size_t used = 0;
-    try {
-      v = std::stod(token, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != token.size()) throw InputError(file, fmt::format("line {}: '{}' is not a number", line_no, token));
-    if (!std::isfinite(v)) throw InputError(file, fmt::format("line {}: non-finite value '{}'", line_no, token));
-    values.push_back(v);
-  }
-  return values;
-}
-
-template <class OnLine>
-void for_each_data_line(std::istream& in, const std::filesystem::path& file, OnLine&& on_line) {
-  for_each_text_line(in, file, [&](const std::string& line, std::size_t line_no) {
-    if (!is_blank_or_comment(line)) on_line(parse_numbers(line, file, line_no), line_no);
-  });
-}
-
 /// Appends a TUM line's timestamp, which must be later than the previous one.
 void push_tum_timestamp(Trajectory& traj, double t, std::size_t& previous_line, const std::filesystem::path& file,
                         std::size_t line_no) {
@@ -76,7 +44,7 @@ std::vector<Pose> read_kitti_poses(const std::filesystem::path& file) {
 
 std::vector<Pose> read_kitti_poses(std::istream& in, const std::filesystem::path& file) {
   std::vector<Pose> poses;
-  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_number_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 12) {
       throw InputError(file, fmt::format("line {}: expected 12 numbers (KITTI 3x4 pose), found {}", line_no, v.size()));
     }
@@ -106,7 +74,7 @@ Trajectory read_tum_trajectory(const std::filesystem::path& file) {
 Trajectory read_tum_trajectory(std::istream& in, const std::filesystem::path& file) {
   Trajectory traj;
   std::size_t previous_line = 0;
-  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_number_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 8) {
       throw InputError(file, fmt::format("line {}: expected 8 numbers (TUM: t x y z qx qy qz qw), found {}", line_no,
                                          v.size()));
@@ -147,7 +115,7 @@ Trajectory read_trajectory(std::istream& in, const std::filesystem::path& file, 
   Trajectory traj;
   std::size_t columns = 0;
   std::size_t previous_line = 0;
-  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_number_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (columns == 0) {
       columns = v.size();
       if (columns != 12 && columns != 8) {
@@ -179,7 +147,7 @@ std::vector<double> read_times(const std::filesystem::path& file) {
 std::vector<double> read_times(std::istream& in, const std::filesystem::path& file) {
   std::vector<double> times;
   std::size_t previous_line = 0;
-  for_each_data_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
+  for_each_number_line(in, file, [&](const std::vector<double>& v, std::size_t line_no) {
     if (v.size() != 1) throw InputError(file, fmt::format("line {}: expected one timestamp, found {} numbers", line_no, v.size()));
     if (!times.empty()) check_time_increases(times.back(), previous_line, v[0], file, line_no);
     times.push_back(v[0]);

@@ -41,19 +41,15 @@
 
 #include <Eigen/Core>
 
+#include "saloam/imu/imu_sample.hpp"
+
 namespace saloam {
 
 inline constexpr std::size_t kOusterImuPacketBytes = 48;
-inline constexpr double kStandardGravity = 9.80665;  ///< [m/s^2] 1 g (CGPM 1901)
-
-struct ImuSample {
-  double time = 0.0;  ///< [s] accelerometer read time, the sensor's clock
-  Eigen::Vector3d acceleration = Eigen::Vector3d::Zero();      ///< [m/s^2] specific force, IMU frame
-  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();  ///< [rad/s] IMU frame
-};
 
 /// The sample in a LEGACY IMU packet's payload: g -> m/s^2 (kStandardGravity),
-/// deg/s -> rad/s, time from the accelerometer's read time. nullopt when the
+/// deg/s -> rad/s, time from the accelerometer's read time (the sensor's
+/// clock [s]), vectors in the IMU's frame. nullopt when the
 /// payload is not kOusterImuPacketBytes long or a value is NaN or infinite.
 [[nodiscard]] std::optional<ImuSample> decode_ouster_imu_packet(std::span<const std::byte> payload);
 

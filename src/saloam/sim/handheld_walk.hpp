@@ -32,6 +32,8 @@ class HandheldWalk {
  private:
   /// Arc length walked by time t [m].
   [[nodiscard]] double walked(double t) const;
+  /// The gait's step phase at time t [rad].
+  [[nodiscard]] double phase(double t) const;
   /// Path position (x, y) and heading at arc length s.
   void path_at(double s, Eigen::Vector2d& xy, double& heading) const;
   /// World = the start's position and heading, z up.

@@ -45,6 +45,7 @@ std::string simulation_record(const SimulationOptions& o) {
   if (!o.cloud_frame_rpy_deg.isZero()) {
     text += fmt::format("cloud_frame_rpy_deg: {:.6g}\n", fmt::join(o.cloud_frame_rpy_deg, " "));
   }
+  if (!o.imu.empty()) text += fmt::format("imu: {}\n", o.imu);
   if (!o.passes.empty()) {
     // Passes of one world: the pass drawn and where its first frame lies in
     // the world (T_world<-L0, 3x4 row-major), so that two passes' poses

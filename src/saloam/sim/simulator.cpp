@@ -13,6 +13,7 @@
 #include "saloam/core/profiling.hpp"
 #include "saloam/core/progress.hpp"
 #include "saloam/io/calibration.hpp"
+#include "saloam/io/imu_text.hpp"
 #include "saloam/io/scan_io.hpp"
 #include "saloam/io/sequence.hpp"
 #include "saloam/io/trajectory_io.hpp"
@@ -260,6 +261,28 @@ Eigen::Vector3d SimulatedSequence::first_scan_up() const {
   return world_from_scan.transpose() * Eigen::Vector3d::UnitZ();
 }
 
+SimulatedImu SimulatedSequence::imu(const ImuNoise& noise, bool noisy) const {
+  if (!motion_) {
+    throw ConfigError("an IMU needs a trajectory with motion within sweeps (--preset handheld-walk): the driving presets "
+                      "and given trajectories are linear between frames");
+  }
+  // The sensor's motion in the route's world; the samples turned into the
+  // scans' frame and put on times.txt's clock.
+  const Eigen::Matrix3d mount = mount_;
+  const ContinuousMotion sensor = [this, mount](double t) { return Pose(motion_(t) * Pose(mount)); };
+  const double start = static_cast<double>(frames_.front()) * options_.frame_period;
+  const double end = static_cast<double>(frames_.back() + 1) * options_.frame_period;
+  SimulatedImu out = simulate_imu(sensor, start, end, noise, hash_combine(options_.seed, 0x1a3ull), noisy);
+  for (ImuSample& sample : out.samples) {
+    sample.time -= start;
+    sample.acceleration = cloud_frame_ * sample.acceleration;
+    sample.angular_velocity = cloud_frame_ * sample.angular_velocity;
+  }
+  out.gyro_bias = cloud_frame_ * out.gyro_bias;
+  out.accel_bias = cloud_frame_ * out.accel_bias;
+  return out;
+}
+
 SimulatedFrame SimulatedSequence::render(std::size_t k) const {
   SweepSpec sweep = sweep_for_frame(trajectory_, frames_.at(k), options_);
   if (motion_) {
@@ -304,6 +327,12 @@ SimulationSummary simulate_sequence(const SimulationOptions& options, const fs::
   // (the reader accepts more poses than scans); trimmed on interruption.
   writer.write_camera_poses(sequence.camera_poses());
   writer.write_times(sequence.times());
+  if (!options.imu.empty()) {
+    const ImuNoise noise = imu_model(options.imu);
+    write_imu_text(out_dir / "imu.txt", sequence.imu(noise).samples,
+                   fmt::format("simulated {} at {:g} Hz in the scans' frame (saloam simulate --imu {})", noise.name,
+                               noise.rate_hz, noise.name));
+  }
   const bool noisy = options.labels == LabelMode::kNoisy;
   if (noisy) create_folder(out_dir / "labels_gt");
 

@@ -23,7 +23,9 @@
 #include "saloam/core/sensor_profile.hpp"
 #include "saloam/core/types.hpp"
 #include "saloam/eval/segmentation_score.hpp"
+#include "saloam/imu/imu_noise.hpp"
 #include "saloam/sim/class_shares.hpp"
+#include "saloam/sim/imu_simulation.hpp"
 #include "saloam/sim/lidar.hpp"
 #include "saloam/sim/label_noise.hpp"
 #include "saloam/sim/trajectories.hpp"
@@ -88,6 +90,10 @@ struct SimulationOptions {
   /// [deg]: the same scans handed over in a turned frame (as a driver that
   /// publishes in a robot's base link). Only the points turn; Tr follows.
   Eigen::Vector3d cloud_frame_rpy_deg = Eigen::Vector3d::Zero();
+  /// An IMU model (imu_model_names()) riding in the sensor, written as
+  /// imu.txt in the scans' frame (io/imu_text.hpp); empty: none. Needs a
+  /// trajectory with motion within sweeps (the handheld walk).
+  std::string imu;
   bool skew = true;
   bool show_progress = true;
   double frame_period = 0.1;
@@ -166,6 +172,11 @@ class SimulatedSequence {
   [[nodiscard]] const std::vector<Pose>& sensor_camera_poses() const { return sensor_camera_poses_; }
   /// Up in the written scans' frame at the first frame (against gravity).
   [[nodiscard]] Eigen::Vector3d first_scan_up() const;
+  /// The IMU riding in the sensor over every sweep, in the written scans'
+  /// frame, times on times.txt's clock (sim/imu_simulation.hpp). ConfigError
+  /// when the trajectory is linear between frames (no motion to measure
+  /// within them: the driving presets, a given trajectory).
+  [[nodiscard]] SimulatedImu imu(const ImuNoise& noise, bool noisy = true) const;
 
  private:
   SimulationOptions options_;
