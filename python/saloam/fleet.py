@@ -21,6 +21,7 @@ import argparse
 import ctypes
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -79,6 +80,101 @@ def thread_plan(client, threads):
         slots[host] = slots.get(host, 0) + nthreads.get(address, 1)
         cores[host] = count
     return {host: max(1, cores[host] // slots[host]) for host in cores}
+
+
+def _identity(path):
+    st = os.stat(path)
+    return st.st_dev, st.st_ino
+
+
+def _same_or_inside(path, folder):
+    """Whether `path` is `folder` or lies inside it, compared by device and inode along the path: a bind mount
+    or a link of the folder is the folder. False when `folder` does not exist."""
+    if not os.path.exists(folder):
+        return False
+    target = _identity(folder)
+    p = os.path.abspath(path)
+    while True:
+        if os.path.exists(p) and _identity(p) == target:
+            return True
+        parent = os.path.dirname(p)
+        if parent == p:
+            return False
+        p = parent
+
+
+def _is_fleet_summary(path):
+    try:
+        with open(path) as f:
+            summary = json.load(f)
+    except (OSError, ValueError):
+        return False
+    return isinstance(summary, dict) and {"map", "drives", "joined"} <= summary.keys()
+
+
+def check_fleet_paths(drives, out, work, summary_file, config=None):
+    """RuntimeError naming the path when a run would destroy an input or a user's file: the old map at `out` is
+    replaced, so no input may lie in it; the work folder holds the per-drive runs, so it may not be the map or
+    lie in it; the summary may not be written into the map, into a drive or over a file that is not an earlier
+    fleet summary; and a drive given twice would double its keyframes."""
+    seen = {}
+    for d in drives:
+        if not os.path.isdir(d):
+            raise RuntimeError(f"{d}: not a folder (a drive is a sequence folder)")
+        if _same_or_inside(d, out):
+            raise RuntimeError(f"{d}: lies in the map {out} that the fleet replaces (it would be deleted with it)")
+        if _identity(d) in seen:
+            raise RuntimeError(f"{d}: the same drive as {seen[_identity(d)]} (given twice)")
+        seen[_identity(d)] = d
+    if config and os.path.exists(config) and _same_or_inside(config, out):
+        raise RuntimeError(f"{config}: the configuration lies in the map {out} that the fleet replaces")
+    if os.path.abspath(work) == os.path.abspath(out) or _same_or_inside(work, out) or _same_or_inside(out, work):
+        raise RuntimeError(f"{work}: the work folder and the map {out} must be apart (the map replaces its folder)")
+    if _same_or_inside(summary_file, out):
+        raise RuntimeError(f"{summary_file}: the summary would be written into the map {out}")
+    for d in drives:
+        if _same_or_inside(summary_file, d):
+            raise RuntimeError(f"{summary_file}: the summary would be written into the drive {d} (an input)")
+    if os.path.exists(summary_file) and not _is_fleet_summary(summary_file):
+        raise RuntimeError(f"{summary_file}: exists and is not a fleet summary (not overwritten)")
+
+
+# An old map is replaced through a journal beside it ({out}.fleet-journal):
+# it names the backup that holds the old map until the new one is in place,
+# so a crash at any step leaves the old map or the new one whole, and the
+# next run restores or removes only the backup that the journal names.
+def _journal(out):
+    return out + ".fleet-journal"
+
+
+def recover_map(out):
+    """Finishes or undoes a replacement of the map at `out` that a crash interrupted (see _place_map)."""
+    journal = _journal(out)
+    if not os.path.isfile(journal):
+        return
+    with open(journal) as f:
+        backup = json.load(f)["backup"]
+    if os.path.isdir(backup):
+        if os.path.isdir(out):
+            shutil.rmtree(backup)  # the new map is in place
+        else:
+            os.rename(backup, out)  # the old map back
+    os.remove(journal)
+
+
+def _place_map(new, out):
+    """Renames the map folder `new` to `out`, the old map at `out` kept as a backup until then."""
+    backup = f"{out}.fleet-previous-{uuid.uuid4().hex[:8]}"
+    journal = _journal(out)
+    with open(journal + ".part", "w") as f:
+        json.dump({"backup": backup, "new": new}, f)
+    os.replace(journal + ".part", journal)
+    if os.path.isdir(out):
+        os.rename(out, backup)
+    os.rename(new, out)
+    if os.path.isdir(backup):
+        shutil.rmtree(backup)
+    os.remove(journal)
 
 
 def _put_in_place(attempt, final):
@@ -173,11 +269,14 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
 
     program = os.path.abspath(program or cli_path())
     out = os.path.abspath(out)
+    recover_map(out)
     if os.path.exists(out) and not os.path.isfile(os.path.join(out, "map.json")):
         raise RuntimeError(f"{out}: exists and is not a saloam map (the fleet's map replaces only a map)")
     work = os.path.abspath(work or out + ".fleet")
+    summary_file = os.path.abspath(summary_file or out + ".fleet.json")
+    check_fleet_paths([os.path.abspath(d) for d in drives or []], out, work, summary_file,
+                      config=next((b for a, b in zip(slam_options, slam_options[1:]) if a == "--config"), None))
     os.makedirs(work, exist_ok=True)
-    summary_file = summary_file or out + ".fleet.json"
     begin = time.time()
     client, cluster = _client(scheduler, workers)
     try:
@@ -233,19 +332,19 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
         if cluster is not None:
             cluster.close()
 
-    # Attempts of dead workers left their partial outputs (*.part): every
-    # task is done and their subprocesses died with them.
-    for folder, prefix in ((work, ""), (os.path.dirname(out), os.path.basename(out) + ".")):
+    # Attempts of dead workers left their partial outputs, named by the
+    # fleet (NAME.XXXXXXXX.part): every task is done and their subprocesses
+    # died with them. Nothing else is touched.
+    for folder, own in ((work, r"(slam|map|merge)_[0-9_]+"), (os.path.dirname(out), re.escape(os.path.basename(out)))):
         for name in os.listdir(folder):
-            if name.startswith(prefix) and name.endswith(".part") and os.path.join(folder, name) != final["map"]:
+            if re.fullmatch(own + r"\.[0-9a-f]{8}\.part", name) and os.path.join(folder, name) != final["map"]:
                 shutil.rmtree(os.path.join(folder, name), ignore_errors=True)
-    # The final map in place (a lone drive's map is copied).
-    if os.path.isdir(out):
-        shutil.rmtree(out)
-    if merge_results:
-        os.rename(final["map"], out)
-    else:
-        shutil.copytree(final["map"], out)
+    # The final map in place (a lone drive's map is copied first).
+    new_map = final["map"]
+    if not merge_results:
+        new_map = f"{out}.{uuid.uuid4().hex[:8]}.part"
+        shutil.copytree(final["map"], new_map)
+    _place_map(new_map, out)
     with open(os.path.join(out, "map.json")) as f:
         manifest = json.load(f)
     sessions = manifest.get("sessions", [])

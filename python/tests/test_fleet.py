@@ -2,6 +2,7 @@
 worker killed in the middle of the run."""
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -151,3 +152,93 @@ def test_fleet_refuses_what_it_cannot_do(tmp_path):
     done = subprocess.run([saloam_cli(), "fleet", "D", "--out", tmp_path / "m", "--threads-per-task", "-1"],
                           capture_output=True, text=True)
     assert done.returncode == 2 and "--threads-per-task must be at least 0" in done.stderr
+
+
+def _map(folder, marker):
+    """A folder that passes for a saloam map (map.json), with a marker to tell maps apart."""
+    folder.mkdir(parents=True)
+    (folder / "map.json").write_text(json.dumps({"marker": marker}))
+    return folder
+
+
+def test_fleet_refuses_to_destroy_its_inputs(tmp_path):
+    from saloam.fleet import check_fleet_paths
+    m = _map(tmp_path / "M", "old")
+    drive = tmp_path / "d0"
+    drive.mkdir()
+    inner = m / "drive"
+    inner.mkdir()
+    bind = tmp_path / "link_to_M"
+    bind.symlink_to(m, target_is_directory=True)
+
+    def refused(drives, out=m, work=tmp_path / "w", summary=tmp_path / "s.json", config=None):
+        with pytest.raises(RuntimeError) as e:
+            check_fleet_paths([str(d) for d in drives], str(out), str(work), str(summary), config)
+        return str(e.value)
+
+    assert "lies in the map" in refused([drive, inner])
+    assert "lies in the map" in refused([drive, bind / "drive"])  # another path to the same folder
+    assert "given twice" in refused([drive, tmp_path / "." / "d0"])
+    assert "work folder and the map" in refused([drive], work=m)
+    assert "work folder and the map" in refused([drive], out=tmp_path / "new", work=tmp_path / "new")
+    assert "written into the map" in refused([drive], summary=m / "map.json")
+    (drive / "poses.txt").write_text("1 0 0 0 0 1 0 0 0 0 1 0\n")
+    assert "into the drive" in refused([drive], summary=drive / "poses.txt")
+    (tmp_path / "notes.json").write_text("{}")
+    assert "not a fleet summary" in refused([drive], summary=tmp_path / "notes.json")
+    (m / "cfg.yaml").write_text("odometry: {}\n")
+    assert "configuration lies in the map" in refused([drive], config=str(m / "cfg.yaml"))
+    # What may be done: a new map beside the drives, an earlier summary replaced.
+    (tmp_path / "old.json").write_text(json.dumps({"map": "M", "drives": [], "joined": []}))
+    check_fleet_paths([str(drive)], str(tmp_path / "N"), str(tmp_path / "w"), str(tmp_path / "old.json"))
+    # From the command line, before any work starts.
+    done = subprocess.run([saloam_cli(), "fleet", drive, inner, "--out", m], capture_output=True, text=True)
+    assert done.returncode == 2 and "lies in the map" in done.stderr
+    assert inner.is_dir() and (m / "map.json").is_file()
+
+
+def test_a_crash_while_the_map_is_replaced_leaves_a_whole_map(tmp_path, monkeypatch):
+    from saloam import fleet as f
+    out = str(tmp_path / "M")
+
+    def crash_at(step):
+        """Replaces the map, the process dying (an exception here) at the given rename or removal."""
+        if not os.path.isdir(out):
+            _map(tmp_path / "M", "old")
+        new = _map(tmp_path / f"M.{step:08x}.part", "new")
+        calls = {"n": 0}
+        real_rename, real_rmtree = os.rename, shutil.rmtree
+
+        def counting(real):
+            def call(*args, **kwargs):
+                calls["n"] += 1
+                if calls["n"] == step:
+                    raise KeyboardInterrupt("killed")
+                return real(*args, **kwargs)
+            return call
+        monkeypatch.setattr(f.os, "rename", counting(real_rename))
+        monkeypatch.setattr(f.shutil, "rmtree", counting(real_rmtree))
+        try:
+            f._place_map(str(new), out)
+        except KeyboardInterrupt:
+            pass
+        monkeypatch.undo()
+        f.recover_map(out)
+        marker = json.loads((tmp_path / "M" / "map.json").read_text())["marker"]
+        assert not os.path.exists(out + ".fleet-journal")
+        assert not [p for p in os.listdir(tmp_path) if ".fleet-previous-" in p]
+        shutil.rmtree(out)
+        for p in os.listdir(tmp_path):
+            shutil.rmtree(tmp_path / p)
+        return marker
+
+    assert crash_at(1) == "old"   # before the old map moved aside
+    assert crash_at(2) == "old"   # the old map aside, the new one not yet in place: the old one back
+    assert crash_at(3) == "new"   # the new map in place, the backup not yet removed
+    assert crash_at(99) == "new"  # no crash
+    # A user's folder named like a backup is never touched.
+    _map(tmp_path / "M", "old")
+    user = _map(tmp_path / "M.fleet-previous-12345678", "user's")
+    f._place_map(str(_map(tmp_path / "M.0000000a.part", "new")), out)
+    f.recover_map(out)
+    assert json.loads((user / "map.json").read_text())["marker"] == "user's"
