@@ -25,6 +25,7 @@
 #include "config_dict.hpp"
 #include "program.hpp"
 #include "saloam/core/error.hpp"
+#include "saloam/core/path_rules.hpp"
 #include "saloam/eval/evaluation_report.hpp"
 #include "saloam/eval/trajectory_metrics.hpp"
 #include "saloam/io/trajectory_io.hpp"
@@ -289,6 +290,11 @@ struct Slam {
     py::gil_scoped_release release;
     std::lock_guard lock(mutex);
     if (slam->keyframes().empty()) throw ConfigError("save_map: no keyframe yet (register scans first)");
+    // The map replaces its folder: the scans it was made from (source, when
+    // it names a path) may not lie in it.
+    PathRules().input("source", std::filesystem::exists(source) ? std::filesystem::path(source) : std::filesystem::path())
+        .output("path", path, OutputUse::kReplacedFolder)
+        .check();
     check_map_destination(path);
     write_slam_map(path, *slam, config, manifest);
   }
@@ -338,6 +344,14 @@ struct Map {
     const std::filesystem::path out_dir = fspath(out);
     py::gil_scoped_release release;
     std::lock_guard lock(source->mutex);
+    PathRules()
+        .input("map", folder)
+        .input("source", source->info().folder.value_or(std::filesystem::path()))
+        .input("config", options.config_file.empty() || !std::filesystem::exists(options.config_file)
+                             ? std::filesystem::path()
+                             : std::filesystem::path(options.config_file))
+        .output("out", out_dir, OutputUse::kFolder)
+        .check();
     const PriorMap map =
         PriorMap::open(folder, SavedMap(saved), static_cast<std::size_t>(config.localize.cached_keyframes));
     LocalizeRunOptions run_options;
@@ -704,6 +718,13 @@ paired by index. align: "se3", "sim3" or "none".)");
           std::optional<Pose> tr;
           if (!velo_to_cam.is_none()) tr = pose_from_array(velo_to_cam, "velo_to_cam");
           py::gil_scoped_release release;
+          // A sequence's folder holds its ground truth as poses.txt: an input, never overwritten.
+          for (const char* part : {"velodyne", "times.txt", "calib.txt", "labels"}) {
+            if (std::filesystem::exists(dir / part)) {
+              throw InputError(dir, fmt::format("holds a sequence ({} is there): its poses.txt is the ground truth, "
+                                                "not overwritten; write the poses into another folder", part));
+            }
+          }
           std::filesystem::create_directories(dir);
           TrajectoryWriter writer(dir / "poses.txt", dir / "poses_tum.txt", tr);
           for (std::size_t i = 0; i < p.size(); ++i) writer.write(t[i], p[i]);

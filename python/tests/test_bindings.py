@@ -286,3 +286,32 @@ def test_merge_gives_the_map_of_saloam_merge(two_maps, tmp_path):
     with pytest.raises(saloam.Error, match="inside"):
         saloam.merge(map_a, map_b, map_a / "merged")
     assert not (map_a / "merged").exists()
+
+
+def test_the_writers_never_overwrite_an_input(sequence, two_maps, tmp_path):
+    """Issue #53: a sequence's ground truth, a map localised in, the scans a map is made from."""
+    source = saloam.open_source(sequence, frames="0:12")
+    poses = np.tile(np.eye(4), (12, 1, 1))
+    truth = (sequence / "poses.txt").read_bytes()
+    with pytest.raises(saloam.InputError, match="holds a sequence"):
+        saloam.write_poses(sequence, poses, source.times, source.velo_to_cam)
+    assert (sequence / "poses.txt").read_bytes() == truth
+    map_a, _ = two_maps
+    before = sorted(os.listdir(map_a))
+    with pytest.raises(saloam.InputError):
+        saloam.Map(map_a).localize(source, map_a / "runs")
+    with pytest.raises(saloam.InputError):
+        saloam.Map(map_a).localize(source, sequence)
+    assert sorted(os.listdir(map_a)) == before
+    # A map made from scans that lie in the old map it would replace.
+    slam = saloam.Slam(source.config)
+    for frame in source:
+        slam.register(*frame)
+    slam.save_map(tmp_path / "M")
+    inner = tmp_path / "M" / "seq"
+    subprocess.run(["cp", "-r", str(sequence), str(inner)], check=True)
+    with pytest.raises(saloam.InputError, match="source"):
+        slam.save_map(tmp_path / "M", source=str(inner))
+    assert (inner / "poses.txt").is_file()
+    slam.save_map(tmp_path / "M", source=str(sequence))  # from scans elsewhere: replaced
+    assert not inner.exists()
