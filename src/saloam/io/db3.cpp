@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "saloam/core/cancellation.hpp"
 #include "saloam/core/error.hpp"
 #include "saloam/core/files.hpp"
 
@@ -33,11 +34,17 @@ class Statement {
   void bind(int index, std::span<const std::byte> value) {
     sqlite3_bind_blob64(stmt_, index, value.data(), value.size(), SQLITE_STATIC);
   }
-  /// True while there is a row; InputError for a corrupt database.
+  /// True while there is a row; InputError for a corrupt database, or when
+  /// the work was cut short (bounded_work: stopped, or beyond its budget).
   bool step() {
     const int rc = sqlite3_step(stmt_);
     if (rc == SQLITE_ROW) return true;
     if (rc == SQLITE_DONE) return false;
+    if (rc == SQLITE_INTERRUPT) {
+      throw InputError(file_, stop_requested() ? "reading the rosbag2 database stopped (interrupted)"
+                                               : "reading the rosbag2 database stopped: it needs more work than a bag "
+                                                 "of its size (its index is read with bounded work)");
+    }
     throw InputError(file_, fmt::format("corrupt rosbag2 database: {}", sqlite3_errmsg(sqlite3_db_handle(stmt_))));
   }
   void reset() { sqlite3_reset(stmt_); }
@@ -61,6 +68,40 @@ void execute(sqlite3* db, const char* sql, const fs::path& file) {
   }
 }
 
+// SQLite calls the progress handler every kProgressOpcodes virtual-machine
+// instructions; a read is interrupted on Ctrl-C or when it has taken
+// kOpcodesPerByte instructions per byte of the file beyond kBaseOpcodes:
+// listing and sorting the messages of a real bag takes far fewer, a query
+// that never ends (a view's endless recursion) is cut off.
+constexpr int kProgressOpcodes = 1000;
+constexpr std::uint64_t kOpcodesPerByte = 64;
+constexpr std::uint64_t kBaseOpcodes = 1'000'000'000;
+
+struct WorkBudget {
+  std::uint64_t calls_left = 0;
+};
+
+int bounded_work(void* budget) {
+  auto* b = static_cast<WorkBudget*>(budget);
+  if (stop_requested() || b->calls_left == 0) return 1;
+  --b->calls_left;
+  return 0;
+}
+
+// A bag's data are read from its tables only: `messages` or `topics` as a
+// view (which may compute anything, forever) is refused.
+void require_tables(sqlite3* db, const fs::path& file) {
+  for (const char* name : {"messages", "topics"}) {
+    Statement kind(db, "SELECT type FROM sqlite_master WHERE name = ?", file);
+    kind.bind(1, std::string(name));
+    if (!kind.step()) throw InputError(file, fmt::format("not a rosbag2 database: no table '{}'", name));
+    if (kind.text(0) != "table") {
+      throw InputError(file, fmt::format("not a rosbag2 database: '{}' is a {}, not a table (a bag is read from its "
+                                         "tables only)", name, kind.text(0)));
+    }
+  }
+}
+
 std::uint64_t size_of(const fs::path& file) {
   std::error_code ec;
   const auto size = fs::file_size(file, ec);
@@ -73,6 +114,7 @@ std::uint64_t size_of(const fs::path& file) {
 struct Db3Reader::Impl {
   sqlite3* db = nullptr;
   std::uint64_t file_size = 0;
+  WorkBudget budget;
   std::vector<std::int64_t> rows;  ///< of the selected topic, in log-time order
   ~Impl() { sqlite3_close(db); }
 };
@@ -84,6 +126,9 @@ Db3Reader::Db3Reader(fs::path file) : file_(std::move(file)), impl_(std::make_un
     throw InputError(file_, fmt::format("cannot open the rosbag2 database: {}", sqlite3_errmsg(impl_->db)));
   }
   sqlite3_db_config(impl_->db, SQLITE_DBCONFIG_DEFENSIVE, 1, nullptr);
+  impl_->budget.calls_left = (kBaseOpcodes + kOpcodesPerByte * impl_->file_size) / kProgressOpcodes;
+  sqlite3_progress_handler(impl_->db, kProgressOpcodes, bounded_work, &impl_->budget);
+  require_tables(impl_->db, file_);
   std::map<std::int64_t, std::size_t> counts;
   Statement count(impl_->db, "SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id", file_);
   while (count.step()) counts[count.integer(0)] = static_cast<std::size_t>(count.integer(1));

@@ -7,9 +7,12 @@
 //          offered_qos_profiles TEXT[, type_description_hash TEXT since Iron])
 //   messages(id INTEGER PRIMARY KEY, topic_id INTEGER, timestamp INTEGER [ns], data BLOB)
 // The reader needs only topics(id, name, type, serialization_format) and
-// messages; it opens the file read-only and in SQLite's defensive mode, and
-// checks each message's size against the file's before allocating (SQLite
-// itself reports a corrupt database as such). Messages are read one at a
+// messages; it opens the file read-only and in SQLite's defensive mode,
+// reads `topics` and `messages` only as tables (a view of that name, which
+// may compute anything, forever, is refused), bounds the work of its queries
+// by the file's size and stops them on Ctrl-C, and checks each message's
+// size against the file's before allocating (SQLite itself reports a corrupt
+// database as such). Messages are read one at a
 // time (incremental blob I/O), a header's prefix without the rest.
 
 #include <cstdint>
