@@ -302,6 +302,27 @@ TEST(Viewer, LargeRequestBodiesAreRefused) {
   EXPECT_EQ(small->status, 200);
 }
 
+// Bounded answers (issue #53): a request for many byte ranges (the probe's
+// 2,650 ranges of the page made a 2.4 GB answer) is refused, small; one range is served.
+TEST(Viewer, ManyByteRangesAreRefused) {
+  ServingRun serving;
+  httplib::Client client("127.0.0.1", serving.port);
+  const std::string host = fmt::format("127.0.0.1:{}", serving.port);
+  std::string ranges = "bytes=0-";
+  for (int i = 1; i < 2650; ++i) ranges += ",0-";
+  const auto many = client.Get("/", {{"Host", host}, {"Range", ranges}});
+  ASSERT_TRUE(many);
+  EXPECT_EQ(many->status, 416);
+  EXPECT_LT(many->body.size(), 1u << 20);
+  const auto one = client.Get("/", {{"Host", host}, {"Range", "bytes=0-99"}});
+  ASSERT_TRUE(one);
+  EXPECT_EQ(one->status, 206);
+  EXPECT_EQ(one->body.size(), 100u);
+  const auto page = client.Get("/", {{"Host", host}});
+  ASSERT_TRUE(page);
+  EXPECT_EQ(page->status, 200);
+}
+
 TEST(Viewer, IdleConnectionsDoNotStallTheServer) {
   // Twelve connections that send nothing (more than httplib's default pool
   // of 8 workers, each of which would wait 5 s on one): a request still

@@ -86,12 +86,22 @@ bool viewer_host_allowed(std::string_view host, int port) {
 void ViewerServer::Impl::add_common_routes() {
   // DNS rebinding: a page of another site whose name now resolves to
   // 127.0.0.1 sends its own name as Host. Only the loopback names pass.
+  // Bounded answers: httplib answers every byte range of a request, each
+  // with the whole body behind it (2,650 ranges of the page made 2.4 GB),
+  // so a request for more than one range is refused (416); the pages ask for none.
   server.set_pre_routing_handler([this](const httplib::Request& request, httplib::Response& response) {
-    if (viewer_host_allowed(request.get_header_value("Host"), port)) return httplib::Server::HandlerResponse::Unhandled;
-    response.status = 403;
-    response.set_content("forbidden: the viewer answers only to 127.0.0.1, localhost or [::1] with its port\n",
-                         "text/plain");
-    return httplib::Server::HandlerResponse::Handled;
+    if (!viewer_host_allowed(request.get_header_value("Host"), port)) {
+      response.status = 403;
+      response.set_content("forbidden: the viewer answers only to 127.0.0.1, localhost or [::1] with its port\n",
+                           "text/plain");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    if (request.ranges.size() > 1) {
+      response.status = 416;
+      response.set_content("one byte range at most\n", "text/plain");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    return httplib::Server::HandlerResponse::Unhandled;
   });
   server.set_error_handler([](const httplib::Request&, httplib::Response& response) {
     if (response.body.empty()) response.set_content(fmt::format("error {}\n", response.status), "text/plain");
