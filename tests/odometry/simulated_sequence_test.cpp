@@ -323,5 +323,28 @@ TEST(SimulatedSequence, FollowsAHandheldLookAround) {
   }
 }
 
+// A clock jump of an hour between two frames (issue #53: the last motion was
+// extrapolated across it, 36 km for a car at 10 m/s, exit 0): the motion is
+// not carried across a gap, and the run goes on from the previous pose.
+TEST(SimulatedSequence, AClockJumpIsNotExtrapolated) {
+  testing::TempDir dir("saloam_odom_jump");
+  SimulationOptions options;
+  options.preset = "straight";
+  options.end_frame = 30;
+  options.show_progress = false;
+  ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 30u);
+  const SequenceReader reader(dir.path());
+  SemanticOdometry odometry{OdometryConfig{}};
+  for (std::size_t i = 0; i < reader.size(); ++i) {
+    odometry.register_frame(reader.load_scan(i), reader.times()[i] + (i >= 15 ? 3600.0 : 0.0));
+  }
+  const auto gt = reader.lidar_poses();
+  const double final_error = (gt.back().translation() - odometry.poses().back().translation()).norm();
+  const double path = (gt.back().translation() - gt.front().translation()).norm();
+  std::printf("an hour's jump at frame 15: final error %.3f m over %.1f m\n", final_error, path);
+  ASSERT_GT(path, 20.0);
+  EXPECT_LT(final_error, 0.3);
+}
+
 }  // namespace
 }  // namespace saloam

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <thread>
 
+#include <spdlog/spdlog.h>
+
 #include "saloam/core/lie.hpp"
 #include "saloam/core/profiling.hpp"
 #include "saloam/odometry/deskew.hpp"
@@ -21,6 +23,10 @@ constexpr double kRedeskewRotation = 0.1 * M_PI / 180;  // [rad per frame]
 constexpr double kResidualMemory = 0.9;
 constexpr double kMinClassDof = 50;
 constexpr double kMaxWeightRatio = 4.0;
+// A step between frames longer than this is a gap (a recording paused, a
+// clock jump, a live run's long stall): the last motion is not carried
+// across it (a 1 h jump extrapolated a car's 10 m/s to 36 km).
+constexpr double kMaxExtrapolation = 1.0;  // [s]
 
 }  // namespace
 
@@ -90,6 +96,12 @@ SemanticOdometry::MotionPrediction SemanticOdometry::predict_motion(double times
   p.pose = k > 0 ? sweep_poses_.back() : Pose::Identity();
   p.period = config_.features.sweep_duration;
   if (k >= 1 && timestamp - timestamps_[k - 1] > 1e-6) p.period = timestamp - timestamps_[k - 1];
+  if (k >= 1 && timestamp - timestamps_[k - 1] > kMaxExtrapolation) {
+    spdlog::warn("frame {}: {:.3f} s after the previous frame: a gap, across which the last motion is not carried (the "
+                 "pose starts from the previous one)",
+                 k, timestamp - timestamps_[k - 1]);
+    return p;
+  }
   if (k >= 2) {
     // Constant velocity: the last frame's motion, rescaled to this time step.
     const double dt_prev = timestamps_[k - 1] - timestamps_[k - 2];
