@@ -1,5 +1,6 @@
 #include "saloam/core/path_rules.hpp"
 
+#include <cstdlib>
 #include <fstream>
 
 #include <gtest/gtest.h>
@@ -64,6 +65,28 @@ TEST(PathRules, FollowsLinksAndHardLinks) {
             "");
   EXPECT_EQ(breach(PathRules().input("SEQ", tmp / "seq").output("--out", tmp / "alias/../run", OutputUse::kFolder)),
             "");
+}
+
+// Issue #53: a bind mount of a folder is that folder under another path,
+// which no comparison of paths sees (same device and inode). Needs the
+// right to mount (root in a container that allows it): skipped otherwise.
+TEST(PathRules, ABindMountOfAnInputIsTheInput) {
+  testing::TempDir tmp;
+  fs::create_directories(tmp / "map/seq");
+  fs::create_directories(tmp / "view");
+  const std::string mount = "mount --bind '" + (tmp / "map").string() + "' '" + (tmp / "view").string() + "' 2>/dev/null";
+  if (std::system(mount.c_str()) != 0) GTEST_SKIP() << "no right to bind-mount here";
+  const std::string a = breach(PathRules().input("SEQ", tmp / "view/seq").output("--save-map", tmp / "map",
+                                                                                  OutputUse::kReplacedFolder));
+  const std::string b = breach(PathRules().input("--map", tmp / "map").output("--out", tmp / "view/run",
+                                                                             OutputUse::kFolder));
+  const std::string c = breach(PathRules().input("SEQ", tmp / "elsewhere").output("--out", tmp / "view/run",
+                                                                                 OutputUse::kFolder));
+  const std::string unmount = "umount '" + (tmp / "view").string() + "'";
+  EXPECT_EQ(std::system(unmount.c_str()), 0);
+  EXPECT_NE(a.find("holds the input SEQ"), std::string::npos) << a;
+  EXPECT_NE(b.find("lies inside the input --map"), std::string::npos) << b;
+  EXPECT_EQ(c, "");
 }
 
 TEST(PathRules, AReplacedFolderNeverHoldsAnotherOutput) {

@@ -25,6 +25,20 @@ bool same_place(const fs::path& a, const fs::path& b) {
   return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec) && !ec;
 }
 
+// `inner` is `outer` or lies inside it: by components, or because an
+// existing folder along `inner` is `outer` itself under another name (a bind
+// mount of it: the same device and inode, which no path comparison sees).
+bool lies_within(const fs::path& inner, const fs::path& outer) {
+  if (path_within(inner, outer)) return true;
+  std::error_code ec;
+  if (!fs::is_directory(outer, ec)) return false;
+  for (fs::path p = inner; !p.empty(); p = p.parent_path()) {
+    if (fs::exists(p, ec) && fs::equivalent(p, outer, ec) && !ec) return true;
+    if (p == p.root_path()) break;
+  }
+  return false;
+}
+
 std::string named(const std::string& option, const fs::path& given) {
   return option.empty() ? given.string() : fmt::format("{} {}", option, given.string());
 }
@@ -83,11 +97,11 @@ void PathRules::check() const {
         throw InputError(out.given, fmt::format("{} is the input {}: an output never replaces an input (choose another "
                                                 "output)", what, input));
       }
-      if (path_within(in.path, out.path)) {
+      if (lies_within(in.path, out.path)) {
         throw InputError(out.given, fmt::format("{} holds the input {}: an output never contains an input (choose "
                                                 "another output)", what, input));
       }
-      if (path_within(out.path, in.path)) {
+      if (lies_within(out.path, in.path)) {
         throw InputError(out.given, fmt::format("{} lies inside the input {}: an output is never written into an "
                                                 "input (choose another output)", what, input));
       }
@@ -102,7 +116,7 @@ void PathRules::check() const {
                                               named(b.option, b.given), named(a.option, a.given)));
       }
       for (const auto& [replaced, other] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
-        if (replaced->use == OutputUse::kReplacedFolder && path_within(other->path, replaced->path)) {
+        if (replaced->use == OutputUse::kReplacedFolder && lies_within(other->path, replaced->path)) {
           throw InputError(replaced->given,
                            fmt::format("{} holds the output {}: replacing the folder would delete it (choose "
                                        "another folder)", named(replaced->option, replaced->given),

@@ -10,7 +10,9 @@
 // that creates the missing folders would reach them (every link followed,
 // also after a missing folder and `..`; `.` and `..` removed), then by
 // components: /a/bc is not inside /a/b. Two existing paths that are one
-// file (a hard link) are equal.
+// file (a hard link) are equal, and a path through a bind mount of a folder
+// lies in that folder (an existing folder along it is the folder: device
+// and inode).
 
 #include <filesystem>
 #include <string>
