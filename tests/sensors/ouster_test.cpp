@@ -59,6 +59,34 @@ TEST(OusterMetadata, FlatAndNestedLayouts) {
   EXPECT_EQ(m.pixel_shift_by_row, std::vector<int>{0});
 }
 
+// Issue #53: metadata that would put points anywhere is refused, naming the
+// field (an origin of 1e300 mm put the points 1,700 km away).
+TEST(OusterMetadata, ValuesThatMovePointsAnywhereAreRefused) {
+  const std::string good = flat_metadata("LEGACY");
+  const auto error = [](const std::string& text) {
+    return testing::input_error_of([&] { (void)parse_ouster_metadata(text, "m.json"); });
+  };
+  const auto replaced = [&](const std::string& from, const std::string& to) {
+    std::string text = good;
+    const auto at = text.find(from);
+    EXPECT_NE(at, std::string::npos) << from;
+    return text.replace(at, from.size(), to);
+  };
+  EXPECT_EQ(error(good), "no error");
+  EXPECT_NE(error(replaced("\"lidar_origin_to_beam_origin_mm\": 10", "\"lidar_origin_to_beam_origin_mm\": 1e300"))
+                .find("m.json: Ouster metadata: lidar_origin_to_beam_origin_mm"),
+            std::string::npos);
+  EXPECT_NE(error(replaced("\"beam_altitude_angles\": [10", "\"beam_altitude_angles\": [1e300"))
+                .find("beam_altitude_angles[0]"),
+            std::string::npos);
+  EXPECT_NE(error(replaced("[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]", "[2,0,0,0, 0,2,0,0, 0,0,2,0, 0,0,0,1]"))
+                .find("lidar_to_sensor_transform is not a rigid transform"),
+            std::string::npos);
+  EXPECT_NE(error(replaced("[1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]", "[1,0,0,1e9, 0,1,0,0, 0,0,1,0, 0,0,0,1]"))
+                .find("lidar_to_sensor_transform"),
+            std::string::npos);
+}
+
 TEST(OusterMetadata, ErrorsNameTheFileAndTheKey) {
   const auto error = [](const std::string& text) {
     return testing::input_error_of([&] { (void)parse_ouster_metadata(text, "meta.json"); });

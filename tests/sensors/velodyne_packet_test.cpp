@@ -115,6 +115,20 @@ TEST(VelodynePacket, CalibrationErrorsNameTheFile) {
             std::string::npos);
 }
 
+// Issue #53: corrections that would put points anywhere (1e300 put them
+// 1,700 km away) are refused, naming the laser and the key.
+TEST(VelodynePacket, CalibrationValuesOutOfRangeAreRefused) {
+  const auto error = [](const std::string& laser) {
+    return testing::input_error_of([&] { (void)parse_velodyne_calibration("lasers:\n- {laser_id: 0, " + laser + "}\n", "c.yaml"); });
+  };
+  EXPECT_NE(error("vert_correction: .nan").find("c.yaml: Velodyne calibration: laser entry 0: \"vert_correction\""),
+            std::string::npos);
+  EXPECT_NE(error("dist_correction: 1e300").find("\"dist_correction\""), std::string::npos);
+  EXPECT_NE(error("rot_correction: 7").find("\"rot_correction\""), std::string::npos);
+  EXPECT_NE(error("horiz_offset_correction: -.inf").find("horiz_offset_correction"), std::string::npos);
+  EXPECT_EQ(error("rot_correction: -0.1, vert_correction: 0.2, dist_correction: 1.4"), "no error");
+}
+
 TEST(VelodynePacket, CorruptPacketsAreRefused) {
   auto packet = encode_velodyne_packet(VelodyneModel::kVlp16, firings(0, 40, 100), 0);
   EXPECT_NE(check_velodyne_packet(std::span(packet).first(1000)), "");

@@ -2,6 +2,7 @@
 
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <limits>
 #include <type_traits>
 
@@ -173,10 +174,36 @@ void read_format(const Reader& in, const Paths& p, OusterMetadata& m) {
   m.profile = parse_profile(profile, in);
 }
 
+// A rigid transform [mm]: a rotation (orthonormal within 1e-3, det +1), a
+// translation within 10 m, the last row 0 0 0 1; else the points it maps
+// would be scaled, sheared or moved anywhere.
+void check_rigid(const Reader& in, const Eigen::Matrix4d& T, const char* name) {
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const bool rigid = T.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-3 &&
+                     R.determinant() > 0 && T.topRightCorner<3, 1>().norm() <= 10000.0 &&
+                     T.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1));
+  if (!rigid) in.fail(fmt::format("{} is not a rigid transform (rotation and a translation within 10 m)", name));
+}
+
+// Each beam's angles finite and within a half turn (elevations a quarter):
+// real ones are within a few degrees of the nominal pattern.
+void check_angles(const Reader& in, const std::vector<double>& angles, double bound, const char* name) {
+  for (std::size_t i = 0; i < angles.size(); ++i) {
+    if (!std::isfinite(angles[i]) || std::abs(angles[i]) > bound) {
+      in.fail(fmt::format("{}[{}] = {} is not within +-{} deg", name, i, angles[i], bound));
+    }
+  }
+}
+
 void read_beams(const Reader& in, const Paths& p, bool nested, OusterMetadata& m) {
   m.beam_altitude_angles = in.list<double>(p.altitude, m.pixels_per_column);
   m.beam_azimuth_angles = in.list<double>(p.azimuth, m.pixels_per_column);
+  check_angles(in, m.beam_altitude_angles, 90.0, "beam_altitude_angles");
+  check_angles(in, m.beam_azimuth_angles, 180.0, "beam_azimuth_angles");
   m.lidar_origin_to_beam_origin_mm = in.get<double>(p.origin);
+  if (!std::isfinite(m.lidar_origin_to_beam_origin_mm) || std::abs(m.lidar_origin_to_beam_origin_mm) > 1000.0) {
+    in.fail(fmt::format("lidar_origin_to_beam_origin_mm {} is not within +-1000 mm", m.lidar_origin_to_beam_origin_mm));
+  }
   m.beam_to_lidar = Eigen::Matrix4d::Identity();
   if (nested && in.find("beam_intrinsics/beam_to_lidar_transform")) {
     m.beam_to_lidar = in.matrix("beam_intrinsics/beam_to_lidar_transform");
@@ -184,6 +211,8 @@ void read_beams(const Reader& in, const Paths& p, bool nested, OusterMetadata& m
     m.beam_to_lidar(0, 3) = m.lidar_origin_to_beam_origin_mm;
   }
   m.lidar_to_sensor = in.matrix(p.lidar_to_sensor);
+  check_rigid(in, m.beam_to_lidar, "beam_to_lidar_transform");
+  check_rigid(in, m.lidar_to_sensor, "lidar_to_sensor_transform");
 }
 
 }  // namespace

@@ -56,6 +56,20 @@ double yaml_number(const YAML::Node& laser, const char* key, double fallback, co
   }
 }
 
+// A laser's correction: finite and within `bound` (angles [rad] within a
+// half or a quarter turn, offsets [m] within 10 m: real ones are
+// centimetres), or the calibration would put points anywhere (1e300 put
+// them 1,700 km away).
+double laser_correction(const YAML::Node& laser, const char* key, double fallback, double bound, std::size_t index,
+                        const fs::path& file) {
+  const double v = yaml_number(laser, key, fallback, file);
+  if (!std::isfinite(v) || std::abs(v) > bound) {
+    throw InputError(file, fmt::format("Velodyne calibration: laser entry {}: \"{}\" {} is not within +-{}", index, key,
+                                       v, bound));
+  }
+  return v;
+}
+
 }  // namespace
 
 std::string_view velodyne_model_name(VelodyneModel model) {
@@ -129,13 +143,14 @@ VelodyneCalibration parse_velodyne_calibration(std::string_view text, const fs::
     if (seen[id]) throw InputError(file, fmt::format("Velodyne calibration: laser_id {} twice", id));
     seen[id] = true;
     VelodyneLaser& laser = c.lasers[id];
-    laser.rot_correction = yaml_number(l, "rot_correction", 0, file);
-    laser.vert_correction = yaml_number(l, "vert_correction", 0, file);
-    laser.dist_correction = yaml_number(l, "dist_correction", 0, file);
-    laser.dist_correction_x = yaml_number(l, "dist_correction_x", laser.dist_correction, file);
-    laser.dist_correction_y = yaml_number(l, "dist_correction_y", laser.dist_correction, file);
-    laser.vert_offset = yaml_number(l, "vert_offset_correction", 0, file);
-    laser.horiz_offset = yaml_number(l, "horiz_offset_correction", 0, file);
+    constexpr double kMetres = 10.0;
+    laser.rot_correction = laser_correction(l, "rot_correction", 0, std::numbers::pi, i, file);
+    laser.vert_correction = laser_correction(l, "vert_correction", 0, std::numbers::pi / 2, i, file);
+    laser.dist_correction = laser_correction(l, "dist_correction", 0, kMetres, i, file);
+    laser.dist_correction_x = laser_correction(l, "dist_correction_x", laser.dist_correction, kMetres, i, file);
+    laser.dist_correction_y = laser_correction(l, "dist_correction_y", laser.dist_correction, kMetres, i, file);
+    laser.vert_offset = laser_correction(l, "vert_offset_correction", 0, kMetres, i, file);
+    laser.horiz_offset = laser_correction(l, "horiz_offset_correction", 0, kMetres, i, file);
   }
   c.source = file.string();
   return c;
