@@ -3,14 +3,18 @@
 // in the frame of its scans.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include "saloam/core/error.hpp"
 #include "saloam/core/lie.hpp"
 #include "saloam/imu/imu_noise.hpp"
+#include "saloam/io/imu_text.hpp"
+#include "saloam/io/sequence_source.hpp"
 #include "saloam/sim/imu_simulation.hpp"
 #include "saloam/sim/simulator.hpp"
+#include "testing/test_support.hpp"
 
 namespace saloam {
 namespace {
@@ -95,6 +99,30 @@ TEST(SimulatedImu, TheSequencesImuIsInItsScansFrame) {
   options.cloud_frame_rpy_deg.setZero();
   EXPECT_THROW(SimulatedSequence(options).imu(part), ConfigError);
   EXPECT_THROW(imu_model("mpu-6050"), ConfigError);
+}
+
+// simulate --imu writes imu.txt beside the scans; the sequence's source
+// describes it (saloam info) and gives its up at rest to the run.
+TEST(SimulatedImu, TheSequencesImuTxtIsDescribedByItsSource) {
+  testing::TempDir dir("saloam_imu_sequence");
+  SimulationOptions options;
+  options.preset = "handheld-walk";
+  options.end_frame = 3;
+  options.imu = "icm-20948";
+  options.show_progress = false;
+  ASSERT_EQ(simulate_sequence(options, dir.path()).frames, 3u);
+  const std::vector<ImuSample> samples = read_imu_text(dir.path() / "imu.txt");
+  EXPECT_EQ(samples.size(), 31u);  // 100 Hz over the three sweeps
+  const SequenceFolderSource source{SequenceReader(dir.path())};
+  const auto& notes = source.info().notes;
+  EXPECT_TRUE(std::any_of(notes.begin(), notes.end(),
+                          [](const std::string& n) { return n.rfind("IMU: 31 samples in imu.txt, 100 Hz", 0) == 0; }));
+  ASSERT_TRUE(source.info().imu_up.has_value());
+  EXPECT_LT(std::acos(std::clamp(source.info().imu_up->z(), -1.0, 1.0)), 10 * kDeg);
+  options.imu.clear();
+  testing::TempDir plain("saloam_imu_none");
+  simulate_sequence(options, plain.path());
+  EXPECT_FALSE(SequenceFolderSource{SequenceReader(plain.path())}.info().imu_up.has_value());
 }
 
 }  // namespace

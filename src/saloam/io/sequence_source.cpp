@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include "saloam/core/error.hpp"
+#include "saloam/imu/imu_stream.hpp"
+#include "saloam/io/imu_text.hpp"
 #include "saloam/io/trajectory_io.hpp"
 
 namespace saloam {
@@ -51,6 +53,14 @@ SequenceFolderSource::SequenceFolderSource(SequenceReader reader, bool read_cali
   info_.point_fields = "x y z remission";
   info_.notes = notes(reader_, info_.velo_to_cam.has_value());
   info_.notes.push_back(intensity_.note());
+  // An IMU beside the scans (imu.txt, in their frame: saloam simulate --imu):
+  // described, and the up it gives at rest (odometry.gravity.use_imu).
+  const std::filesystem::path imu = reader_.root() / "imu.txt";
+  if (std::filesystem::exists(imu)) {
+    ImuStreamReport report = describe_imu_stream(read_imu_text(imu), "in imu.txt", Eigen::Matrix3d::Identity(), "scans'");
+    info_.notes.insert(info_.notes.end(), report.notes.begin(), report.notes.end());
+    info_.imu_up = report.up;
+  }
 }
 
 IntensityScale sequence_intensity_scale(const SequenceReader& reader, std::optional<float> given) {

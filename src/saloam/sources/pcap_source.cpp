@@ -339,18 +339,10 @@ void PcapSource::read_imu(const fs::path& metadata) {
     info_.notes.push_back(fmt::format("IMU: no packets on port {}", calibration.udp_port_imu));
     return;
   }
-  const ImuStreamStats stats = imu_stream_stats(samples);
-  info_.notes.push_back(fmt::format("IMU: {} samples on port {}, {:.0f} Hz, largest gap {:.3f} s; at rest ({} samples) "
-                                    "|a| {:.3f} m/s^2 ({:.3f} g), gyroscope noise {:.2f} deg/s",
-                                    stats.samples, calibration.udp_port_imu, stats.rate_hz, stats.largest_gap_s,
-                                    stats.rest_samples, stats.gravity_at_rest, stats.gravity_at_rest / kStandardGravity,
-                                    stats.gyro_noise_dps));
-  for (const std::string& problem : imu_stream_problems(stats)) info_.notes.push_back("IMU: " + problem);
-  if (const auto up = imu_up_at_rest(samples, calibration.imu_to_lidar_rotation())) {
-    info_.imu_up = *up;
-    info_.notes.push_back(fmt::format("IMU: up ({:.3f}, {:.3f}, {:.3f}) in the lidar frame, {:.1f} deg from its z",
-                                      up->x(), up->y(), up->z(), std::acos(std::clamp(up->z(), -1.0, 1.0)) * 180.0 / M_PI));
-  }
+  ImuStreamReport report = describe_imu_stream(samples, fmt::format("on port {}", calibration.udp_port_imu),
+                                               calibration.imu_to_lidar_rotation(), "lidar");
+  info_.notes.insert(info_.notes.end(), report.notes.begin(), report.notes.end());
+  info_.imu_up = report.up;
 }
 
 PcapSource::~PcapSource() = default;
