@@ -102,7 +102,8 @@ TEST(SimulatedImu, TheSequencesImuIsInItsScansFrame) {
 }
 
 // simulate --imu writes imu.txt beside the scans; the sequence's source
-// describes it (saloam info) and gives its up at rest to the run.
+// describes it (saloam info) but does not hand its up to the run (its rest
+// test takes a walker setting off for rest: docs/imu.md).
 TEST(SimulatedImu, TheSequencesImuTxtIsDescribedByItsSource) {
   testing::TempDir dir("saloam_imu_sequence");
   SimulationOptions options;
@@ -117,12 +118,8 @@ TEST(SimulatedImu, TheSequencesImuTxtIsDescribedByItsSource) {
   const auto& notes = source.info().notes;
   EXPECT_TRUE(std::any_of(notes.begin(), notes.end(),
                           [](const std::string& n) { return n.rfind("IMU: 31 samples in imu.txt, 100 Hz", 0) == 0; }));
-  ASSERT_TRUE(source.info().imu_up.has_value());
-  EXPECT_LT(std::acos(std::clamp(source.info().imu_up->z(), -1.0, 1.0)), 10 * kDeg);
-  options.imu.clear();
-  testing::TempDir plain("saloam_imu_none");
-  simulate_sequence(options, plain.path());
-  EXPECT_FALSE(SequenceFolderSource{SequenceReader(plain.path())}.info().imu_up.has_value());
+  EXPECT_TRUE(std::any_of(notes.begin(), notes.end(), [](const std::string& n) { return n.rfind("IMU: up (", 0) == 0; }));
+  EXPECT_FALSE(source.info().imu_up.has_value());
 }
 
 }  // namespace
