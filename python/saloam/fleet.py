@@ -139,6 +139,14 @@ def check_fleet_paths(drives, out, work, summary_file, config=None):
         raise RuntimeError(f"{summary_file}: exists and is not a fleet summary (not overwritten)")
 
 
+def _write_json(path, value):
+    """Writes `value` as JSON to `path` whole or not at all (a temporary file renamed)."""
+    with open(path + ".part", "w") as f:
+        json.dump(value, f, indent=2)
+        f.write("\n")
+    os.replace(path + ".part", path)
+
+
 # An old map is replaced through a journal beside it ({out}.fleet-journal):
 # it names the backup that holds the old map until the new one is in place,
 # so a crash at any step leaves the old map or the new one whole, and the
@@ -166,9 +174,7 @@ def _place_map(new, out):
     """Renames the map folder `new` to `out`, the old map at `out` kept as a backup until then."""
     backup = f"{out}.fleet-previous-{uuid.uuid4().hex[:8]}"
     journal = _journal(out)
-    with open(journal + ".part", "w") as f:
-        json.dump({"backup": backup, "new": new}, f)
-    os.replace(journal + ".part", journal)
+    _write_json(journal, {"backup": backup})
     if os.path.isdir(out):
         os.rename(out, backup)
     os.rename(new, out)
@@ -382,10 +388,7 @@ def map_fleet(drives, out, work=None, scheduler=None, workers=2, program=None, s
         stages["eval_s"] = round(time.time() - t, 3)
     stages["total_s"] = round(time.time() - begin, 3)
     summary["stages"] = stages
-    with open(summary_file + ".part", "w") as f:
-        json.dump(summary, f, indent=2)
-        f.write("\n")
-    os.replace(summary_file + ".part", summary_file)
+    _write_json(summary_file, summary)
     log(f"{len(drives)} drives -> {out}: {summary['linked_drives']} of {len(joined)} sessions linked, "
         f"{summary['cross_drive_loops']} cross-drive loops; SLAM {stages['slam_s']:.1f} s, merges "
         f"{stages['merge_s']:.1f} s, total {stages['total_s']:.1f} s; summary {summary_file}")

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "saloam/core/error.hpp"
+#include "saloam/core/lie.hpp"
 #include "saloam/io/text_input.hpp"
 
 namespace fs = std::filesystem;
@@ -174,12 +175,12 @@ void read_format(const Reader& in, const Paths& p, OusterMetadata& m) {
   m.profile = parse_profile(profile, in);
 }
 
-// A rigid transform [mm]: a rotation (orthonormal within 1e-3, det +1), a
+// A rigid transform [mm]: a rotation (orthonormal within kRotationTolerance, det +1), a
 // translation within 10 m, the last row 0 0 0 1; else the points it maps
 // would be scaled, sheared or moved anywhere.
 void check_rigid(const Reader& in, const Eigen::Matrix4d& T, const char* name) {
   const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
-  const bool rigid = T.allFinite() && (R.transpose() * R - Eigen::Matrix3d::Identity()).norm() < 1e-3 &&
+  const bool rigid = T.allFinite() && orthonormality_error(R) < kRotationTolerance &&
                      R.determinant() > 0 && T.topRightCorner<3, 1>().norm() <= 10000.0 &&
                      T.row(3).isApprox(Eigen::RowVector4d(0, 0, 0, 1));
   if (!rigid) in.fail(fmt::format("{} is not a rigid transform (rotation and a translation within 10 m)", name));
