@@ -99,6 +99,11 @@ TEST(SimulatedImu, TheSequencesImuIsInItsScansFrame) {
   options.cloud_frame_rpy_deg.setZero();
   EXPECT_THROW(SimulatedSequence(options).imu(part), ConfigError);
   EXPECT_THROW(imu_model("mpu-6050"), ConfigError);
+  // Asked of the whole simulation, refused before anything is written.
+  options.imu = "icm-20948";
+  testing::TempDir dir("saloam_imu_drive");
+  EXPECT_THROW(simulate_sequence(options, dir.path() / "seq"), ConfigError);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "seq"));
 }
 
 // simulate --imu writes imu.txt beside the scans; the sequence's source

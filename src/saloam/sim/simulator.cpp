@@ -42,6 +42,14 @@ double sensor_mount_height(const SimulationOptions& options) {
   return options.sensor ? options.sensor->simulation.mount_height : options.world.sensor_height;
 }
 
+namespace {
+/// [m] the sensor rides this far above (below: negative) KITTI's mount along
+/// each pose's up axis.
+double mount_offset(const SimulationOptions& options) {
+  return sensor_mount_height(options) - options.world.sensor_height;
+}
+}  // namespace
+
 RoutePass parse_route_pass(std::string_view text) {
   const std::string t(text);
   const auto bad = [&] {
@@ -122,7 +130,7 @@ std::vector<Pose> route_trajectory(const SimulationOptions& options) {
 }  // namespace
 
 std::vector<Pose> source_lidar_trajectory(const SimulationOptions& options) {
-  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+  const double dz = mount_offset(options);
   std::vector<Pose> route = route_trajectory(options);
   if (!options.passes.empty()) {
     if (options.pass >= options.passes.size()) {
@@ -200,7 +208,7 @@ World world_for(const std::vector<Pose>& trajectory, const SimulationOptions& op
   world_options.sensor_height = sensor_mount_height(options);
   if (!options.camera_poses.empty()) return build_world(trajectory, options.seed, world_options);
   if (preset_on_hillside(options.preset)) world_options.hillside = true;
-  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+  const double dz = mount_offset(options);
   const std::vector<Pose> track = preset_motion(options.preset) ? mounted(preset_track(options.preset, options.frame_period), dz)
                                                                 : trajectory;
   return build_world(track, options.seed, world_options);
@@ -213,8 +221,17 @@ ContinuousMotion continuous_motion(const SimulationOptions& options) {
   ContinuousMotion motion = preset_motion(options.preset);
   if (!motion) return {};
   if (!options.passes.empty()) throw ConfigError(fmt::format("the {} preset is walked once: it takes no passes", options.preset));
-  const double dz = sensor_mount_height(options) - options.world.sensor_height;
+  const double dz = mount_offset(options);
   return [motion = std::move(motion), dz](double t) { return Pose(motion(t) * Eigen::Translation3d(0.0, 0.0, dz)); };
+}
+
+// An IMU is simulated from motion within sweeps: ConfigError for a
+// trajectory without.
+void require_imu_motion(const ContinuousMotion& motion) {
+  if (!motion) {
+    throw ConfigError("an IMU needs a trajectory with motion within sweeps (--preset handheld-walk): the driving presets "
+                      "and given trajectories are linear between frames");
+  }
 }
 
 // Knots of a sweep with continuous motion: 20 steps per sweep (5 ms at 10 Hz).
@@ -236,6 +253,10 @@ SimulatedSequence::SimulatedSequence(const SimulationOptions& options)
       velo_to_cam_(orthonormalized(output_velo_to_cam(options) * Pose(mount_ * cloud_frame_.transpose()))) {
   if (!options.mount_rpy_deg.allFinite() || !options.cloud_frame_rpy_deg.allFinite()) {
     throw ConfigError("the mount's and the cloud frame's roll, pitch and yaw must be finite numbers [deg]");
+  }
+  if (!options.imu.empty()) {  // refused before anything is written
+    (void)imu_model(options.imu);
+    require_imu_motion(motion_);
   }
   // poses.txt is the vehicle's camera, whatever the sensor's tilt.
   const Pose vehicle_to_cam = output_velo_to_cam(options);
@@ -262,10 +283,7 @@ Eigen::Vector3d SimulatedSequence::first_scan_up() const {
 }
 
 SimulatedImu SimulatedSequence::imu(const ImuNoise& noise, bool noisy) const {
-  if (!motion_) {
-    throw ConfigError("an IMU needs a trajectory with motion within sweeps (--preset handheld-walk): the driving presets "
-                      "and given trajectories are linear between frames");
-  }
+  require_imu_motion(motion_);
   // The sensor's motion in the route's world; the samples turned into the
   // scans' frame and put on times.txt's clock.
   const Eigen::Matrix3d mount = mount_;
